@@ -1,0 +1,83 @@
+// Drag laws for a sphere in a Newtonian or Bingham-plastic fluid at rest.
+//
+// Every law is written as one resisting-force curve of the slip speed s >= 0:
+//   F(s) = s_w (pi d / 2)^2 tau_y + s_A (A / 2) (tau_y + eta s / d) G(Re'),
+//   Re'  = rho s^2 / (tau_y + eta s / d),   G = Cd(Re') Re',   A = pi d^2 / 4,
+// which is the Dedegil form of Zhang & Li (2024) for a Bingham fluid and, with tau_y = 0, exactly
+// the Newtonian drag 1/2 rho A Cd(Re) s^2 with Re = rho s d / mu (Stokes: F = 3 pi mu d s).
+// s_A and s_w scale the projected area and the yield term for a partly submerged sphere.
+#pragma once
+
+#include <array>
+#include <optional>
+#include <string>
+#include <string_view>
+
+namespace sediment {
+
+enum class DragLaw { Stokes, SchillerNaumann, Dallavalle, ZhangLi, ZhangLiSmooth };
+
+std::optional<DragLaw> drag_law_from_name(std::string_view name);
+const char *drag_law_name(DragLaw law);
+// The names accepted by drag_law_from_name, separated by ", " (for error messages).
+std::string drag_law_names();
+
+struct Fluid {
+  double density = 0.0;         // rho_f
+  double viscosity = 0.0;       // mu (Newtonian) or plastic viscosity eta_B (Bingham)
+  double yield_stress = 0.0;    // tau_y; 0 for a Newtonian fluid
+};
+
+// Cd * Re and its derivative with respect to Re.
+struct DragCurve {
+  double g;
+  double dg;
+};
+DragCurve drag_curve(DragLaw law, double re);
+double drag_coefficient(DragLaw law, double re);
+
+// A speed at which the force curve jumps (Cd discontinuity), with the one-sided forces.
+struct ForceJump {
+  double speed;
+  double force_below;
+  double force_above;
+};
+
+// Projected-area and yield (wetted-surface) scale factors; both 1 for a fully immersed sphere.
+struct DragScale {
+  double area = 1.0;
+  double wetted = 1.0;
+};
+
+class DragModel {
+ public:
+  static constexpr int max_jumps = 2;
+
+  DragModel(DragLaw law, const Fluid &fluid);
+
+  DragLaw law() const { return law_; }
+  const Fluid &fluid() const { return fluid_; }
+
+  double reynolds(double d, double speed) const;
+  // Resisting force magnitude for speed > 0 (limit from above at speed = 0).
+  double force(double d, double speed, DragScale scale = {}) const;
+  // dF/ds for speed >= 0 (right derivative at 0).
+  double tangent(double d, double speed, DragScale scale = {}) const;
+  // F(0+): the largest force a sphere at rest resists (zero for a Newtonian fluid).
+  double static_force(double d, DragScale scale = {}) const;
+  // Jumps of F in increasing speed; returns how many were written.
+  int jumps(double d, std::array<ForceJump, max_jumps> &out, DragScale scale = {}) const;
+
+ private:
+  double viscous_scale(double d, double speed) const;    // tau_y + eta s / d
+  double speed_at_reynolds(double d, double re) const;  // inverse of reynolds()
+  double force_at(double d, double speed, double g, DragScale scale) const;
+
+  DragLaw law_;
+  Fluid fluid_;
+};
+
+// Linear relaxation time m / F'(0) of a sphere of density rho_p (Stokes: rho_p d^2 / (18 mu)).
+double relaxation_time(const DragModel &model, double d, double particle_density);
+
+}    // namespace sediment

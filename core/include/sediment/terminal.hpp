@@ -1,0 +1,39 @@
+// Terminal (steady settling) velocity of a sphere under a drag law.
+#pragma once
+
+#include "sediment/drag.hpp"
+
+namespace sediment {
+
+enum class TerminalRegime {
+  Moving,     // F(v) equals the net weight
+  AtRest,     // the net weight does not exceed the static yield resistance
+  AtJump,     // the net weight falls inside a jump of the force curve: v sits at the jump
+};
+
+struct TerminalState {
+  double speed;
+  TerminalRegime regime;
+};
+
+// Net weight (rho_p - rho_f) g V of a fully immersed sphere; g is the magnitude of gravity.
+double net_weight(const Fluid &fluid, double d, double particle_density, double g);
+
+// Steady speed where the resisting force balances `driving_force` (a magnitude >= 0).
+// The force curve is monotone, so bisection finds the unique (set-valued) root.
+TerminalState steady_speed(const DragModel &model, double d, double driving_force,
+                           DragScale scale = {});
+
+// Terminal settling (or rising, for rho_p < rho_f) speed of a fully immersed sphere.
+TerminalState terminal_velocity(const DragModel &model, double d, double particle_density,
+                                double g);
+
+// Time for a sphere released at rest to reach `fraction` of its terminal speed (exact ODE
+// solution by adaptive quadrature of dt = m dv / (W - F(v))).
+double time_to_fraction(const DragModel &model, double d, double particle_density, double g,
+                        double fraction);
+
+// Yield number Y = tau_y / ((rho_p - rho_f) g d) below which a sphere moves (spec: 0.0440).
+double critical_yield_number(const DragModel &model);
+
+}    // namespace sediment

@@ -1,0 +1,168 @@
+#include "sediment/drag.hpp"
+
+#include "sediment/geometry.hpp"
+
+#include <cmath>
+#include <limits>
+
+namespace sediment {
+
+namespace {
+
+struct LawName {
+  DragLaw law;
+  const char *name;
+};
+
+constexpr LawName law_names[] = {
+    {DragLaw::Stokes, "stokes"},
+    {DragLaw::SchillerNaumann, "schiller-naumann"},
+    {DragLaw::Dallavalle, "dallavalle"},
+    {DragLaw::ZhangLi, "zhang-li"},
+    {DragLaw::ZhangLiSmooth, "zhang-li/smooth"},
+};
+
+// Reynolds numbers where the faithful laws switch branch.
+constexpr double schiller_naumann_switch = 1000.0;
+constexpr double zhang_li_low = 1.0;
+constexpr double zhang_li_high = 150.0;
+
+}    // namespace
+
+std::optional<DragLaw> drag_law_from_name(std::string_view name)
+{
+  for (const auto &entry : law_names)
+    if (name == entry.name) return entry.law;
+  return std::nullopt;
+}
+
+const char *drag_law_name(DragLaw law)
+{
+  for (const auto &entry : law_names)
+    if (law == entry.law) return entry.name;
+  return "unknown";
+}
+
+std::string drag_law_names()
+{
+  std::string names;
+  for (const auto &entry : law_names) {
+    if (!names.empty()) names += ", ";
+    names += entry.name;
+  }
+  return names;
+}
+
+DragCurve drag_curve(DragLaw law, double re)
+{
+  switch (law) {
+    case DragLaw::Stokes:
+      return {24.0, 0.0};
+    case DragLaw::SchillerNaumann:
+      if (re <= schiller_naumann_switch) {
+        const double p = 0.15 * std::pow(re, 0.687);
+        return {24.0 * (1.0 + p), re > 0.0 ? 24.0 * 0.687 * p / re : 0.0};
+      }
+      return {0.44 * re, 0.44};
+    case DragLaw::Dallavalle: {
+      // Cd = (0.63 + 4.8 / sqrt(Re))^2  =>  Cd Re = (0.63 sqrt(Re) + 4.8)^2
+      const double root = std::sqrt(re);
+      const double inner = 0.63 * root + 4.8;
+      return {inner * inner, re > 0.0 ? inner * 0.63 / root : 0.0};
+    }
+    case DragLaw::ZhangLi:
+      if (re < zhang_li_low) return {24.0, 0.0};
+      if (re <= zhang_li_high) return {29.12 + 0.195 * re, 0.195};
+      return {0.4 * re, 0.4};
+    case DragLaw::ZhangLiSmooth:
+      // Continuous variant: a linear ramp of Cd Re from 24 to 29.315 over Re' < 1, then
+      // Cd = max(29.12 / Re' + 0.195, 0.4). Same static force and same law for 1 <= Re' <= 142.
+      if (re < zhang_li_low) return {24.0 + 5.315 * re, 5.315};
+      if (29.12 + 0.195 * re >= 0.4 * re) return {29.12 + 0.195 * re, 0.195};
+      return {0.4 * re, 0.4};
+  }
+  return {24.0, 0.0};
+}
+
+double drag_coefficient(DragLaw law, double re) { return drag_curve(law, re).g / re; }
+
+DragModel::DragModel(DragLaw law, const Fluid &fluid) : law_(law), fluid_(fluid) {}
+
+double DragModel::viscous_scale(double d, double speed) const
+{
+  return fluid_.yield_stress + fluid_.viscosity * speed / d;
+}
+
+double DragModel::reynolds(double d, double speed) const
+{
+  if (speed <= 0.0) return 0.0;
+  return fluid_.density * speed * speed / viscous_scale(d, speed);
+}
+
+double DragModel::speed_at_reynolds(double d, double re) const
+{
+  // rho s^2 - (re eta / d) s - re tau_y = 0, positive root
+  const double b = re * fluid_.viscosity / d;
+  const double disc = b * b + 4.0 * fluid_.density * re * fluid_.yield_stress;
+  return (b + std::sqrt(disc)) / (2.0 * fluid_.density);
+}
+
+double DragModel::force_at(double d, double speed, double g, DragScale scale) const
+{
+  const double yield = pi * pi * d * d / 4.0 * fluid_.yield_stress;
+  return scale.wetted * yield + scale.area * 0.5 * sphere_area(d) * viscous_scale(d, speed) * g;
+}
+
+double DragModel::force(double d, double speed, DragScale scale) const
+{
+  return force_at(d, speed, drag_curve(law_, reynolds(d, speed)).g, scale);
+}
+
+double DragModel::static_force(double d, DragScale scale) const
+{
+  if (fluid_.yield_stress <= 0.0) return 0.0;
+  return force_at(d, 0.0, drag_curve(law_, 0.0).g, scale);
+}
+
+double DragModel::tangent(double d, double speed, DragScale scale) const
+{
+  const double re = reynolds(d, speed);
+  const DragCurve curve = drag_curve(law_, re);
+  const double visc = viscous_scale(d, speed);
+  double dforce = fluid_.viscosity / d * curve.g;
+  if (speed > 0.0) {
+    // dRe'/ds = rho s (2 tau_y + eta s / d) / (tau_y + eta s / d)^2
+    const double dre =
+        fluid_.density * speed * (2.0 * fluid_.yield_stress + fluid_.viscosity * speed / d) /
+        (visc * visc);
+    dforce += visc * curve.dg * dre;
+  }
+  return scale.area * 0.5 * sphere_area(d) * dforce;
+}
+
+int DragModel::jumps(double d, std::array<ForceJump, max_jumps> &out, DragScale scale) const
+{
+  double switches[max_jumps];
+  int n = 0;
+  if (law_ == DragLaw::ZhangLi) {
+    switches[n++] = zhang_li_low;
+    switches[n++] = zhang_li_high;
+  } else if (law_ == DragLaw::SchillerNaumann) {
+    switches[n++] = schiller_naumann_switch;
+  }
+  const double inf = std::numeric_limits<double>::infinity();
+  for (int k = 0; k < n; ++k) {
+    const double speed = speed_at_reynolds(d, switches[k]);
+    const double g_below = drag_curve(law_, std::nextafter(switches[k], 0.0)).g;
+    const double g_above = drag_curve(law_, std::nextafter(switches[k], inf)).g;
+    out[k] = {speed, force_at(d, speed, g_below, scale), force_at(d, speed, g_above, scale)};
+  }
+  return n;
+}
+
+double relaxation_time(const DragModel &model, double d, double particle_density)
+{
+  return particle_density * sphere_volume(d) / model.tangent(d, 0.0);
+}
+
+}    // namespace sediment

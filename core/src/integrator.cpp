@@ -1,0 +1,196 @@
+#include "sediment/integrator.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+
+namespace sediment {
+
+double phi1(double z)
+{
+  if (z == 0.0) return 1.0;
+  return -std::expm1(-z) / z;
+}
+
+double phi2(double z)
+{
+  // The direct form loses digits to cancellation for small z: use the series sum (-z)^n/(n+2)!,
+  // whose 11 terms are exact to round-off for |z| < 0.1.
+  if (std::abs(z) < 0.1) {
+    double nested = 1.0;    // 1 - z/3 (1 - z/4 (1 - z/5 (...)))
+    for (int n = 12; n >= 3; --n) nested = 1.0 - z / n * nested;
+    return 0.5 * nested;
+  }
+  return (z + std::expm1(-z)) / (z * z);
+}
+
+namespace {
+
+// Exact solution of ds/dt = c - k s over a time t, from s0.
+struct Segment {
+  double speed;
+  double distance;
+};
+
+Segment advance(double s0, double c, double k, double t)
+{
+  const double z = k * t;
+  const double p1 = phi1(z);
+  return {s0 * std::exp(-z) + c * t * p1, s0 * t * p1 + c * t * t * phi2(z)};
+}
+
+// Time for ds/dt = c - k s to go from s0 to `target`, which lies between s0 and the asymptote.
+double time_to_reach(double s0, double c, double k, double target)
+{
+  if (k > 0.0) return std::log1p((s0 - target) / (target - c / k)) / k;
+  return (target - s0) / c;
+}
+
+struct AlongSlip {
+  double speed;
+  double distance;
+  double rate;    // k of the last piece, for the weight of a_{n+1}
+  SlipState state;
+};
+
+// Advances the slip speed s >= 0 along a fixed direction over dt, under the acceleration a_par
+// along it, stopping at the points where the force curve is set-valued.
+AlongSlip advance_along(const SphereDrag &drag, double mass, double s, double a_par, double dt)
+{
+  const DragModel &model = *drag.model;
+  const double d = drag.diameter;
+  const double static_force = model.static_force(d, drag.scale);
+  std::array<ForceJump, DragModel::max_jumps> jumps;
+  const int njumps = model.jumps(d, jumps, drag.scale);
+  const double drive = mass * a_par;
+  constexpr double at_jump = 1e-12;    // relative distance that counts as sitting on a jump
+
+  double left = dt;
+  double distance = 0.0;
+  double rate = 0.0;
+  for (int piece = 0; piece <= njumps + 1; ++piece) {
+    // Which side of a jump the linearisation takes, when the speed sits on one.
+    double s_eval = s;
+    for (int j = 0; j < njumps; ++j) {
+      if (std::abs(s - jumps[j].speed) > at_jump * jumps[j].speed) continue;
+      if (drive >= jumps[j].force_below && drive <= jumps[j].force_above)
+        return {s, distance + s * left, rate, SlipState::HeldAtJump};
+      s_eval = drive > jumps[j].force_above ? s * (1.0 + 1e-11) : s * (1.0 - 1e-11);
+    }
+
+    // Newton linearisation F(w) ~ F(s) + F'(s) (w - s) around the current slip.
+    const double force = model.force(d, s_eval, drag.scale);
+    const double slope = model.tangent(d, s_eval, drag.scale);
+    rate = slope / mass;
+    const double c = a_par - (force - slope * s) / mass;
+    const Segment full = advance(s, c, rate, left);
+
+    // First set-valued point crossed on the way from s to full.speed.
+    double event = -1.0;
+    int event_jump = -1;
+    if (full.speed > s) {
+      for (int j = 0; j < njumps; ++j)
+        if (jumps[j].speed > s * (1.0 + at_jump) && jumps[j].speed < full.speed &&
+            (event_jump < 0 || jumps[j].speed < event)) {
+          event = jumps[j].speed;
+          event_jump = j;
+        }
+    } else {
+      for (int j = 0; j < njumps; ++j)
+        if (jumps[j].speed < s * (1.0 - at_jump) && jumps[j].speed > full.speed &&
+            (event_jump < 0 || jumps[j].speed > event)) {
+          event = jumps[j].speed;
+          event_jump = j;
+        }
+      if (event_jump < 0 && static_force > 0.0 && full.speed < 0.0) event = 0.0;
+    }
+    if (event < 0.0) return {full.speed, distance + full.distance, rate, SlipState::Free};
+
+    const double t_event = std::clamp(time_to_reach(s, c, rate, event), 0.0, left);
+    distance += advance(s, c, rate, t_event).distance;
+    left -= t_event;
+    s = event;
+    if (event_jump < 0) return {0.0, distance, rate, SlipState::Stuck};
+  }
+  return {s, distance + s * left, rate, SlipState::Free};
+}
+
+double dot(const double a[3], const double b[3]) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+
+}    // namespace
+
+StepCorrection drag_step_initial(const SphereDrag &drag, double mass, const double a[3],
+                                 const double u[3], double dt, double v[3], double dx[3])
+{
+  StepCorrection corr;
+  const bool no_drag = drag.model == nullptr || (drag.scale.area <= 0.0 && drag.scale.wetted <= 0.0);
+  if (no_drag) {
+    for (int k = 0; k < 3; ++k) {
+      v[k] += 0.5 * dt * a[k];
+      dx[k] = dt * v[k];
+    }
+    corr.along = corr.across = 0.5 * dt;
+    return corr;
+  }
+
+  double w[3] = {v[0] - u[0], v[1] - u[1], v[2] - u[2]};
+  const double s = std::sqrt(dot(w, w));
+  const double a_norm = std::sqrt(dot(a, a));
+  double *dir = corr.dir;
+  if (s > 0.0) {
+    for (int k = 0; k < 3; ++k) dir[k] = w[k] / s;
+  } else if (a_norm > 0.0) {
+    for (int k = 0; k < 3; ++k) dir[k] = a[k] / a_norm;
+  }
+  const double a_par = dot(a, dir);
+  const double a_perp[3] = {a[0] - a_par * dir[0], a[1] - a_par * dir[1], a[2] - a_par * dir[2]};
+
+  const double static_force = drag.model->static_force(drag.diameter, drag.scale);
+  const bool stays_at_rest = s == 0.0 && static_force > 0.0 && mass * a_norm <= static_force;
+  const AlongSlip along = stays_at_rest ? AlongSlip{0.0, 0.0, 0.0, SlipState::Stuck}
+                                        : advance_along(drag, mass, s, a_par, dt);
+  corr.state = along.state;
+  if (along.state == SlipState::Stuck) {
+    for (int k = 0; k < 3; ++k) {
+      v[k] = u[k];
+      dx[k] = u[k] * dt + along.distance * dir[k];
+    }
+    corr.along = corr.across = 0.0;
+    return corr;
+  }
+
+  // Across the slip the force turns with the slip: secant rate F(s) / s.
+  const double rate_across = s > 0.0 ? drag.model->force(drag.diameter, s, drag.scale) / (s * mass)
+                                     : drag.model->tangent(drag.diameter, 0.0, drag.scale) / mass;
+  const double z_across = rate_across * dt;
+  const double p1 = phi1(z_across);
+  const double p2 = phi2(z_across);
+  corr.along = along.state == SlipState::Free ? dt * phi2(along.rate * dt) : 0.0;
+  corr.across = dt * p2;
+  for (int k = 0; k < 3; ++k) {
+    v[k] = u[k] + along.speed * dir[k] + a_perp[k] * dt * p1;
+    dx[k] = u[k] * dt + along.distance * dir[k] + a_perp[k] * dt * dt * p2;
+    // The share of a_n in the ETD2 weights; drag_step_final adds the same share of a_{n+1}.
+    v[k] -= corr.along * a_par * dir[k] + corr.across * a_perp[k];
+  }
+  return corr;
+}
+
+void drag_step_final(const StepCorrection &corr, const double a[3], double v[3])
+{
+  const double a_par = dot(a, corr.dir);
+  for (int k = 0; k < 3; ++k)
+    v[k] += corr.along * a_par * corr.dir[k] + corr.across * (a[k] - a_par * corr.dir[k]);
+}
+
+double rotation_step_initial(double rate, const double alpha[3], double dt, double omega[3])
+{
+  const double z = rate * dt;
+  const double decay = std::exp(-z);
+  const double p2 = phi2(z);
+  const double weight_now = dt * (phi1(z) - p2);
+  for (int k = 0; k < 3; ++k) omega[k] = omega[k] * decay + weight_now * alpha[k];
+  return dt * p2;
+}
+
+}    // namespace sediment

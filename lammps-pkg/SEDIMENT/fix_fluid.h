@@ -1,0 +1,54 @@
+/* ----------------------------------------------------------------------
+   SEDIMENT package: a fluid at rest (or in uniform motion) around DEM spheres.
+   Holds the fluid's properties and geometry; applies no force itself.
+------------------------------------------------------------------------- */
+
+#ifdef FIX_CLASS
+// clang-format off
+FixStyle(fluid,FixFluid);
+// clang-format on
+#else
+
+#ifndef LMP_FIX_FLUID_H
+#define LMP_FIX_FLUID_H
+
+#include "fix.h"
+
+#include "sediment/drag.hpp"
+#include "sediment/geometry.hpp"
+
+namespace LAMMPS_NS {
+
+class FixFluid : public Fix {
+ public:
+  FixFluid(class LAMMPS *, int, char **);
+  ~FixFluid() override;
+  int setmask() override;
+  void init() override;
+
+  // Call once per step before immersion(): refreshes a moving region.
+  void prepare();
+  // How much of sphere (centre x, radius r) is in the fluid.
+  sediment::Submergence immersion(const double *x, double radius) const;
+
+  const sediment::Fluid &properties() const { return fluid; }
+  bool is_bingham() const { return fluid.yield_stress > 0.0; }
+  const double *velocity() const { return flow; }
+
+  // Finds fix ID `fluid_id` and checks that it is a fix fluid; `caller` names the style asking.
+  static FixFluid *find(class LAMMPS *lmp, const char *fluid_id, const char *caller);
+
+ private:
+  sediment::Fluid fluid;
+  double flow[3];
+  int has_surface;
+  double surface_normal[3];    // unit normal pointing out of the fluid
+  double surface_offset;       // surface is {x : x . normal = offset}
+  char *region_id;
+  class Region *region;
+};
+
+}    // namespace LAMMPS_NS
+
+#endif
+#endif

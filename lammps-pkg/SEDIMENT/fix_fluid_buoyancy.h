@@ -1,0 +1,40 @@
+/* ----------------------------------------------------------------------
+   SEDIMENT package: Archimedes buoyancy with partial submergence.
+------------------------------------------------------------------------- */
+
+#ifdef FIX_CLASS
+// clang-format off
+FixStyle(fluid/buoyancy,FixFluidBuoyancy);
+// clang-format on
+#else
+
+#ifndef LMP_FIX_FLUID_BUOYANCY_H
+#define LMP_FIX_FLUID_BUOYANCY_H
+
+#include "fix.h"
+
+namespace LAMMPS_NS {
+
+class FixFluidBuoyancy : public Fix {
+ public:
+  FixFluidBuoyancy(class LAMMPS *, int, char **);
+  ~FixFluidBuoyancy() override;
+  int setmask() override;
+  void init() override;
+  void setup(int) override;
+  void post_force(int) override;
+  double compute_vector(int) override;
+
+ private:
+  char *fluid_id, *gravity_id;
+  class FixFluid *fluid;
+  double *gravity;            // acceleration vector owned by the fix gravity
+  double totals[4];           // force on the group (3) and number of spheres in the fluid
+  double totals_all[4];
+  int totals_reduced;
+};
+
+}    // namespace LAMMPS_NS
+
+#endif
+#endif

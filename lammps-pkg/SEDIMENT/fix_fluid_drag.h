@@ -1,0 +1,57 @@
+/* ----------------------------------------------------------------------
+   SEDIMENT package: drag of a fluid on spheres (Newtonian or Bingham laws).
+   Applied explicitly in post_force, except on the atoms a drag-implicit
+   integrator (fix nve/sphere/fluid) advances: it reads the law from here.
+------------------------------------------------------------------------- */
+
+#ifdef FIX_CLASS
+// clang-format off
+FixStyle(fluid/drag,FixFluidDrag);
+// clang-format on
+#else
+
+#ifndef LMP_FIX_FLUID_DRAG_H
+#define LMP_FIX_FLUID_DRAG_H
+
+#include "fix.h"
+
+#include "sediment/integrator.hpp"
+
+#include <memory>
+
+namespace LAMMPS_NS {
+
+class FixFluidDrag : public Fix {
+ public:
+  FixFluidDrag(class LAMMPS *, int, char **);
+  ~FixFluidDrag() override;
+  int setmask() override;
+  void init() override;
+  void setup(int) override;
+  void post_force(int) override;
+  double compute_vector(int) override;
+
+  class FixFluid *fluid_fix() const { return fluid; }
+  // The drag on local atom i during this step (model nullptr if it is not in the group/fluid).
+  sediment::SphereDrag sphere_drag(int i) const;
+  // Linear rate of the rotational drag torque, torque = -rate * I * omega (0 if off).
+  double rotation_rate(int i, const sediment::SphereDrag &drag) const;
+
+ private:
+  char *fluid_id;
+  class FixFluid *fluid;
+  sediment::DragLaw law;
+  std::unique_ptr<sediment::DragModel> model;
+  int rotation;
+  int implicit_groupbit;    // atoms advanced by fix nve/sphere/fluid: no explicit drag
+  double totals[4];        // drag force on explicit atoms (3), spheres with dt > 2 tau
+  double totals_all[4];
+  int totals_reduced;
+
+  int count_unstable_explicit();
+};
+
+}    // namespace LAMMPS_NS
+
+#endif
+#endif

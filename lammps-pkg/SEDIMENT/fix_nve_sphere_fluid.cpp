@@ -1,0 +1,196 @@
+/* ----------------------------------------------------------------------
+   SEDIMENT package: fix nve/sphere/fluid
+   Velocity-Verlet split of the exponential (ETD2) drag step of sediment/integrator.hpp.
+------------------------------------------------------------------------- */
+
+#include "fix_nve_sphere_fluid.h"
+
+#include "fix_fluid.h"
+#include "fix_fluid_drag.h"
+
+#include "atom.h"
+#include "error.h"
+#include "force.h"
+#include "memory.h"
+#include "modify.h"
+#include "update.h"
+
+#include <cstring>
+#include <mpi.h>
+
+using namespace LAMMPS_NS;
+using namespace FixConst;
+
+static constexpr double INERTIA = 0.4;    // moment of inertia prefactor for a solid sphere
+
+FixNVESphereFluid::FixNVESphereFluid(LAMMPS *lmp, int narg, char **arg) :
+    Fix(lmp, narg, arg), weights(nullptr), counts_reduced(0)
+{
+  if (narg > 3)
+    error->all(FLERR, "Fix nve/sphere/fluid: unexpected argument '{}' (the style takes none)", arg[3]);
+  if (!atom->sphere_flag)
+    error->all(FLERR, "Fix nve/sphere/fluid requires atom_style sphere");
+
+  time_integrate = 1;
+  dynamic_group_allow = 1;
+  vector_flag = 1;
+  size_vector = 2;
+  global_freq = 1;
+  extvector = 1;
+  maxexchange = NCOLS;
+  counts[0] = counts[1] = counts_all[0] = counts_all[1] = 0.0;
+
+  grow_arrays(atom->nmax);
+  atom->add_callback(Atom::GROW);
+}
+
+FixNVESphereFluid::~FixNVESphereFluid()
+{
+  atom->delete_callback(id, Atom::GROW);
+  memory->destroy(weights);
+}
+
+int FixNVESphereFluid::setmask()
+{
+  return INITIAL_INTEGRATE | FINAL_INTEGRATE;
+}
+
+void FixNVESphereFluid::init()
+{
+  drags.clear();
+  for (int i = 0; i < modify->nfix; ++i)
+    if (strcmp(modify->fix[i]->style, "fluid/drag") == 0)
+      drags.push_back(static_cast<FixFluidDrag *>(modify->fix[i]));
+
+  double *radius = atom->radius;
+  int *mask = atom->mask;
+  for (int i = 0; i < atom->nlocal; ++i)
+    if ((mask[i] & groupbit) && radius[i] == 0.0)
+      error->one(FLERR, "Fix nve/sphere/fluid requires extended particles (radius > 0)");
+}
+
+void FixNVESphereFluid::initial_integrate(int /*vflag*/)
+{
+  double **x = atom->x;
+  double **v = atom->v;
+  double **f = atom->f;
+  double **omega = atom->omega;
+  double **torque = atom->torque;
+  double *radius = atom->radius;
+  double *rmass = atom->rmass;
+  int *mask = atom->mask;
+  const int nlocal = atom->nlocal;
+  const double dt = update->dt;
+  const double ftm2v = force->ftm2v;
+  static const double no_flow[3] = {0.0, 0.0, 0.0};
+
+  for (FixFluidDrag *drag : drags) drag->fluid_fix()->prepare();
+  counts[0] = counts[1] = 0.0;
+  counts_reduced = 0;
+
+  for (int i = 0; i < nlocal; ++i) {
+    if (!(mask[i] & groupbit)) continue;
+    sediment::SphereDrag sphere;
+    const double *flow = no_flow;
+    double spin_rate = 0.0;
+    for (FixFluidDrag *drag : drags) {
+      const sediment::SphereDrag candidate = drag->sphere_drag(i);
+      if (!candidate.model) continue;
+      if (sphere.model)
+        error->one(FLERR, "Fix nve/sphere/fluid: atom {} is in the fluid of two fluid/drag fixes",
+                   atom->tag[i]);
+      sphere = candidate;
+      flow = drag->fluid_fix()->velocity();
+      spin_rate = drag->rotation_rate(i, sphere);
+    }
+
+    const double mass = rmass[i];
+    const double a[3] = {ftm2v * f[i][0] / mass, ftm2v * f[i][1] / mass, ftm2v * f[i][2] / mass};
+    double dx[3];
+    const sediment::StepCorrection corr = sediment::drag_step_initial(sphere, mass, a, flow, dt, v[i], dx);
+    x[i][0] += dx[0];
+    x[i][1] += dx[1];
+    x[i][2] += dx[2];
+    if (corr.state == sediment::SlipState::Stuck) counts[0] += 1.0;
+    if (corr.state == sediment::SlipState::HeldAtJump) counts[1] += 1.0;
+
+    const double inertia = INERTIA * mass * radius[i] * radius[i];
+    const double alpha[3] = {ftm2v * torque[i][0] / inertia, ftm2v * torque[i][1] / inertia,
+                             ftm2v * torque[i][2] / inertia};
+    double *w = weights[i];
+    w[SPIN] = sediment::rotation_step_initial(spin_rate, alpha, dt, omega[i]);
+    w[ALONG] = corr.along;
+    w[ACROSS] = corr.across;
+    w[DIRX] = corr.dir[0];
+    w[DIRY] = corr.dir[1];
+    w[DIRZ] = corr.dir[2];
+  }
+}
+
+void FixNVESphereFluid::final_integrate()
+{
+  double **v = atom->v;
+  double **f = atom->f;
+  double **omega = atom->omega;
+  double **torque = atom->torque;
+  double *radius = atom->radius;
+  double *rmass = atom->rmass;
+  int *mask = atom->mask;
+  const int nlocal = atom->nlocal;
+  const double ftm2v = force->ftm2v;
+
+  for (int i = 0; i < nlocal; ++i) {
+    if (!(mask[i] & groupbit)) continue;
+    const double *w = weights[i];
+    const double mass = rmass[i];
+    sediment::StepCorrection corr;
+    corr.along = w[ALONG];
+    corr.across = w[ACROSS];
+    corr.dir[0] = w[DIRX];
+    corr.dir[1] = w[DIRY];
+    corr.dir[2] = w[DIRZ];
+    const double a[3] = {ftm2v * f[i][0] / mass, ftm2v * f[i][1] / mass, ftm2v * f[i][2] / mass};
+    sediment::drag_step_final(corr, a, v[i]);
+
+    const double spin = w[SPIN] * ftm2v / (INERTIA * mass * radius[i] * radius[i]);
+    omega[i][0] += spin * torque[i][0];
+    omega[i][1] += spin * torque[i][1];
+    omega[i][2] += spin * torque[i][2];
+  }
+}
+
+double FixNVESphereFluid::compute_vector(int n)
+{
+  if (!counts_reduced) {
+    MPI_Allreduce(counts, counts_all, 2, MPI_DOUBLE, MPI_SUM, world);
+    counts_reduced = 1;
+  }
+  return counts_all[n];
+}
+
+void FixNVESphereFluid::grow_arrays(int nmax)
+{
+  memory->grow(weights, nmax, NCOLS, "nve/sphere/fluid:weights");
+}
+
+void FixNVESphereFluid::copy_arrays(int i, int j, int /*delflag*/)
+{
+  for (int k = 0; k < NCOLS; ++k) weights[j][k] = weights[i][k];
+}
+
+int FixNVESphereFluid::pack_exchange(int i, double *buf)
+{
+  for (int k = 0; k < NCOLS; ++k) buf[k] = weights[i][k];
+  return NCOLS;
+}
+
+int FixNVESphereFluid::unpack_exchange(int nlocal, double *buf)
+{
+  for (int k = 0; k < NCOLS; ++k) weights[nlocal][k] = buf[k];
+  return NCOLS;
+}
+
+double FixNVESphereFluid::memory_usage()
+{
+  return static_cast<double>(atom->nmax) * NCOLS * sizeof(double);
+}

@@ -1,0 +1,51 @@
+/* ----------------------------------------------------------------------
+   SEDIMENT package: constant-NVE integration of finite-size spheres with the
+   fluid drag of fix fluid/drag treated implicitly (exponential integrator).
+------------------------------------------------------------------------- */
+
+#ifdef FIX_CLASS
+// clang-format off
+FixStyle(nve/sphere/fluid,FixNVESphereFluid);
+// clang-format on
+#else
+
+#ifndef LMP_FIX_NVE_SPHERE_FLUID_H
+#define LMP_FIX_NVE_SPHERE_FLUID_H
+
+#include "fix.h"
+
+#include <vector>
+
+namespace LAMMPS_NS {
+
+class FixNVESphereFluid : public Fix {
+ public:
+  FixNVESphereFluid(class LAMMPS *, int, char **);
+  ~FixNVESphereFluid() override;
+  int setmask() override;
+  void init() override;
+  void initial_integrate(int) override;
+  void final_integrate() override;
+  double compute_vector(int) override;
+
+  void grow_arrays(int) override;
+  void copy_arrays(int, int, int) override;
+  int pack_exchange(int, double *) override;
+  int unpack_exchange(int, double *) override;
+  double memory_usage() override;
+
+ private:
+  // Per atom, from the first half of the step to the second: weights of the new force along
+  // and across the slip, the slip direction, and the weight of the new torque.
+  enum { ALONG, ACROSS, DIRX, DIRY, DIRZ, SPIN, NCOLS };
+  double **weights;
+  std::vector<class FixFluidDrag *> drags;
+  double counts[2];    // spheres stuck by the yield stress, held at a Cd jump
+  double counts_all[2];
+  int counts_reduced;
+};
+
+}    // namespace LAMMPS_NS
+
+#endif
+#endif

@@ -1,0 +1,66 @@
+/* ----------------------------------------------------------------------
+   SEDIMENT package: style registration and the LAMMPS plugin entry point.
+------------------------------------------------------------------------- */
+
+#include "sediment_styles.h"
+
+#include "fix_fluid.h"
+#include "fix_fluid_buoyancy.h"
+#include "fix_fluid_drag.h"
+#include "fix_nve_sphere_fluid.h"
+
+#include "lammps.h"
+#include "lammpsplugin.h"
+#include "modify.h"
+#include "version.h"
+
+using namespace LAMMPS_NS;
+
+namespace {
+
+template <typename T> Fix *create_fix(LAMMPS *lmp, int narg, char **arg)
+{
+  return new T(lmp, narg, arg);
+}
+
+struct FixEntry {
+  const char *name;
+  const char *info;
+  Modify::FixCreator creator;
+};
+
+const FixEntry fix_styles[] = {
+    {"fluid", "fluid properties and geometry", &create_fix<FixFluid>},
+    {"fluid/buoyancy", "Archimedes buoyancy with partial submergence", &create_fix<FixFluidBuoyancy>},
+    {"fluid/drag", "Newtonian and Bingham drag laws", &create_fix<FixFluidDrag>},
+    {"nve/sphere/fluid", "drag-implicit sphere integrator", &create_fix<FixNVESphereFluid>},
+};
+
+}    // namespace
+
+void LAMMPS_NS::sediment_register_styles(LAMMPS *lmp)
+{
+  for (const FixEntry &style : fix_styles) (*lmp->modify->fix_map)[style.name] = style.creator;
+}
+
+extern "C" void sediment_register(void *lmp)
+{
+  sediment_register_styles(static_cast<LAMMPS *>(lmp));
+}
+
+// For LAMMPS builds with the PLUGIN package: `plugin load libsediment_lammps.so`.
+extern "C" void lammpsplugin_init(void *lmp, void *handle, void *regfunc)
+{
+  auto reg = reinterpret_cast<lammpsplugin_regfunc>(regfunc);
+  for (const FixEntry &style : fix_styles) {
+    lammpsplugin_t plugin;
+    plugin.version = LAMMPS_VERSION;
+    plugin.style = "fix";
+    plugin.name = style.name;
+    plugin.info = style.info;
+    plugin.author = "SEDIMENT developers";
+    plugin.creator.v2 = reinterpret_cast<lammpsplugin_factory2 *>(style.creator);
+    plugin.handle = handle;
+    (*reg)(&plugin, lmp);
+  }
+}

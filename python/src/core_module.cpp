@@ -1,0 +1,125 @@
+// sediment._core: the C++ physics core and the LAMMPS style registration, for Python.
+
+#include "sediment/drag.hpp"
+#include "sediment/geometry.hpp"
+#include "sediment/integrator.hpp"
+#include "sediment/terminal.hpp"
+#include "sediment_styles.h"
+
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <cstdint>
+#include <stdexcept>
+
+namespace py = pybind11;
+using namespace sediment;
+
+namespace {
+
+DragLaw parse_law(const std::string &name)
+{
+  const auto law = drag_law_from_name(name);
+  if (!law) throw py::value_error("unknown drag law '" + name + "' (expected one of " + drag_law_names() + ")");
+  return *law;
+}
+
+Fluid make_fluid(double density, double viscosity, double yield_stress)
+{
+  if (!(density > 0.0)) throw py::value_error("fluid density must be > 0");
+  if (!(viscosity > 0.0)) throw py::value_error("fluid viscosity must be > 0");
+  if (!(yield_stress >= 0.0)) throw py::value_error("yield stress must be >= 0");
+  return {density, viscosity, yield_stress};
+}
+
+const char *regime_name(TerminalRegime regime)
+{
+  switch (regime) {
+    case TerminalRegime::Moving: return "moving";
+    case TerminalRegime::AtRest: return "at_rest";
+    case TerminalRegime::AtJump: return "at_jump";
+  }
+  return "moving";
+}
+
+}    // namespace
+
+PYBIND11_MODULE(_core, m)
+{
+  m.doc() = "SEDIMENT physics core: drag laws, terminal velocities, submergence, time scales.";
+
+  m.def("drag_law_names", [] {
+    std::vector<std::string> names;
+    for (auto law : {DragLaw::Stokes, DragLaw::SchillerNaumann, DragLaw::Dallavalle, DragLaw::ZhangLi,
+                     DragLaw::ZhangLiSmooth})
+      names.emplace_back(drag_law_name(law));
+    return names;
+  }, "Names of the drag laws.");
+
+  m.def("drag_coefficient", [](const std::string &law, double re) {
+    if (!(re > 0.0)) throw py::value_error("Reynolds number must be > 0");
+    return drag_coefficient(parse_law(law), re);
+  }, py::arg("law"), py::arg("reynolds"), "Cd(Re) of a law (Re' for the Bingham laws).");
+
+  py::class_<DragModel>(m, "DragModel", "Resisting-force curve of a sphere under one drag law.")
+      .def(py::init([](const std::string &law, double density, double viscosity, double yield_stress) {
+             return DragModel(parse_law(law), make_fluid(density, viscosity, yield_stress));
+           }),
+           py::arg("law"), py::arg("density"), py::arg("viscosity"), py::arg("yield_stress") = 0.0)
+      .def("reynolds", &DragModel::reynolds, py::arg("d"), py::arg("speed"))
+      .def("force", [](const DragModel &model, double d, double speed) { return model.force(d, speed); },
+           py::arg("d"), py::arg("speed"), "Resisting force magnitude [N] at slip speed > 0.")
+      .def("tangent", [](const DragModel &model, double d, double speed) { return model.tangent(d, speed); },
+           py::arg("d"), py::arg("speed"), "dF/ds [N s/m].")
+      .def("static_force", [](const DragModel &model, double d) { return model.static_force(d); },
+           py::arg("d"), "Largest force a sphere at rest resists (yield) [N].");
+
+  m.def("terminal_velocity",
+        [](const std::string &law, double density, double viscosity, double yield_stress, double d,
+           double particle_density, double g) {
+          const DragModel model(parse_law(law), make_fluid(density, viscosity, yield_stress));
+          if (!(d > 0.0)) throw py::value_error("diameter must be > 0");
+          const TerminalState state = terminal_velocity(model, d, particle_density, g);
+          return py::make_tuple(state.speed, regime_name(state.regime));
+        },
+        py::arg("law"), py::arg("density"), py::arg("viscosity"), py::arg("yield_stress"), py::arg("d"),
+        py::arg("particle_density"), py::arg("g") = 9.81,
+        "Terminal speed [m/s] and regime ('moving', 'at_rest', 'at_jump').");
+
+  m.def("time_to_fraction",
+        [](const std::string &law, double density, double viscosity, double yield_stress, double d,
+           double particle_density, double g, double fraction) {
+          if (!(fraction > 0.0 && fraction < 1.0)) throw py::value_error("fraction must be in (0, 1)");
+          const DragModel model(parse_law(law), make_fluid(density, viscosity, yield_stress));
+          return time_to_fraction(model, d, particle_density, g, fraction);
+        },
+        py::arg("law"), py::arg("density"), py::arg("viscosity"), py::arg("yield_stress"), py::arg("d"),
+        py::arg("particle_density"), py::arg("g") = 9.81, py::arg("fraction") = 0.99,
+        "Time [s] for a sphere released at rest to reach a fraction of its terminal speed.");
+
+  m.def("relaxation_time",
+        [](const std::string &law, double density, double viscosity, double d, double particle_density) {
+          const DragModel model(parse_law(law), make_fluid(density, viscosity, 0.0));
+          return relaxation_time(model, d, particle_density);
+        },
+        py::arg("law"), py::arg("density"), py::arg("viscosity"), py::arg("d"), py::arg("particle_density"),
+        "Linear relaxation time m / F'(0) [s].");
+
+  m.def("critical_yield_number", [](const std::string &law) {
+    return critical_yield_number(DragModel(parse_law(law), Fluid{1.0, 1.0, 1.0}));
+  }, py::arg("law") = "zhang-li", "Y = tau_y / ((rho_p - rho_f) g d) at which a sphere stops.");
+
+  m.def("rayleigh_time", &rayleigh_time, py::arg("radius"), py::arg("density"), py::arg("youngs_modulus"),
+        py::arg("poisson_ratio"), "Rayleigh time [s].");
+
+  m.def("submergence", [](double radius, double centre_height) {
+    const Submergence sub = submergence(radius, centre_height);
+    return py::dict(py::arg("volume") = sub.volume, py::arg("area") = sub.area, py::arg("wetted") = sub.wetted);
+  }, py::arg("radius"), py::arg("centre_height"),
+     "Submerged volume, area and wetted fractions of a sphere whose centre is centre_height above the surface.");
+
+  m.def("register_styles", [](std::uintptr_t lmp) {
+    if (lmp == 0) throw py::value_error("null LAMMPS handle");
+    sediment_register(reinterpret_cast<void *>(lmp));
+  }, py::arg("lmp_handle"), "Register the SEDIMENT styles into a LAMMPS instance (its LAMMPS* as an integer).");
+}

@@ -1,0 +1,53 @@
+// Submergence below a free surface and the Rayleigh time (physics.md sections 1 and 6).
+#include "sediment/geometry.hpp"
+
+#include <gtest/gtest.h>
+
+using namespace sediment;
+
+TEST(Submergence, LimitsAndHalf)
+{
+  const double r = 0.5e-3;
+  EXPECT_EQ(submergence(r, 2 * r).volume, 0.0);
+  EXPECT_EQ(submergence(r, -2 * r).volume, 1.0);
+  const Submergence half = submergence(r, 0.0);
+  EXPECT_DOUBLE_EQ(half.volume, 0.5);
+  EXPECT_DOUBLE_EQ(half.area, 1.0);
+  EXPECT_DOUBLE_EQ(half.wetted, 0.5);
+}
+
+TEST(Submergence, CapVolumeFormula)
+{
+  const double r = 2.0;
+  for (double h : {0.1, 0.9, 1.7, 3.2}) {
+    const double cap = pi * h * h * (3 * r - h) / 3.0;
+    EXPECT_NEAR(submergence(r, r - h).volume * 4.0 / 3.0 * pi * r * r * r, cap, 1e-12 * cap);
+    EXPECT_NEAR(submergence(r, r - h).wetted, h / (2 * r), 1e-15);
+  }
+}
+
+TEST(Submergence, ContinuousAcrossTheSurface)
+{
+  const double r = 1.0;
+  for (double edge : {r, -r}) {
+    for (double eps : {1e-6, 1e-9}) {
+      const Submergence above = submergence(r, edge + eps), below = submergence(r, edge - eps);
+      EXPECT_NEAR(above.volume, below.volume, 10 * eps);
+      EXPECT_NEAR(above.wetted, below.wetted, 10 * eps);
+      EXPECT_NEAR(above.area, below.area, 10 * eps);
+    }
+  }
+  // Monotone in depth.
+  double last = 0.0;
+  for (int k = 0; k <= 1000; ++k) {
+    const double vol = submergence(r, r - 2.0 * r * k / 1000).volume;
+    EXPECT_GE(vol, last);
+    last = vol;
+  }
+}
+
+TEST(RayleighTime, ZhangLiExample)
+{
+  // d = 0.1 mm, rho = 2700, E = 30 GPa, nu = 0.25 -> 8.12e-8 s
+  EXPECT_NEAR(rayleigh_time(0.05e-3, 2700.0, 30e9, 0.25), 8.12e-8, 0.005e-8);
+}

@@ -1,0 +1,266 @@
+// The drag-implicit step (physics.md section 7): exactness, order, Verlet limit, yield, jumps.
+#include "sediment/geometry.hpp"
+#include "sediment/integrator.hpp"
+#include "sediment/terminal.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <functional>
+
+using namespace sediment;
+
+namespace {
+
+const double zero[3] = {0.0, 0.0, 0.0};
+
+struct State {
+  double x[3] = {0, 0, 0};
+  double v[3] = {0, 0, 0};
+};
+
+// Integrates with a_n = accel(x_n) as LAMMPS would: first half, new force, second half.
+void run(const SphereDrag &drag, double mass, const std::function<void(const double *, double *)> &accel,
+         double dt, int steps, State &s, const double *flow = zero)
+{
+  double a[3];
+  accel(s.x, a);
+  for (int n = 0; n < steps; ++n) {
+    double dx[3];
+    const StepCorrection corr = drag_step_initial(drag, mass, a, flow, dt, s.v, dx);
+    for (int k = 0; k < 3; ++k) s.x[k] += dx[k];
+    accel(s.x, a);
+    drag_step_final(corr, a, s.v);
+  }
+}
+
+// Case A: d = 0.1 mm quartz-like sphere in water, Stokes drag.
+const Fluid water{1000.0, 1.0e-3, 0.0};
+const double d_a = 1e-4, rho_a = 2700.0, g = 9.81;
+const double mass_a = rho_a * sphere_volume(d_a);
+const double tau_a = rho_a * d_a * d_a / (18.0 * 1e-3);
+const double vt_a = (rho_a - 1000.0) * g * d_a * d_a / (18.0 * 1e-3);
+void net_gravity(const double *, double *a) { a[0] = a[1] = 0.0; a[2] = -(rho_a - 1000.0) / rho_a * g; }
+
+}    // namespace
+
+TEST(Integrator, ExactForConstantForceAndLinearDragAtAnyStep)
+{
+  const DragModel stokes(DragLaw::Stokes, water);
+  const SphereDrag drag{&stokes, d_a, {}};
+  for (double dt : {1e-6, 1e-3, 0.1, 100 * tau_a}) {
+    State s;
+    const int steps = 7;
+    run(drag, mass_a, net_gravity, dt, steps, s);
+    const double t = dt * steps;
+    const double v_exact = -vt_a * (1.0 - std::exp(-t / tau_a));
+    const double z_exact = -vt_a * (t - tau_a * (1.0 - std::exp(-t / tau_a)));
+    EXPECT_NEAR(s.v[2], v_exact, 1e-12 * vt_a) << dt;
+    EXPECT_NEAR(s.x[2], z_exact, 1e-12 * std::abs(z_exact) + 1e-18) << dt;
+    EXPECT_EQ(s.v[0], 0.0);
+  }
+}
+
+TEST(Integrator, ExactWithUniformFlow)
+{
+  const DragModel stokes(DragLaw::Stokes, water);
+  const SphereDrag drag{&stokes, d_a, {}};
+  const double flow[3] = {0.01, 0.0, 0.0};
+  State s;
+  run(drag, mass_a, net_gravity, 0.05, 4, s, flow);
+  EXPECT_NEAR(s.v[0], 0.01 * (1 - std::exp(-0.2 / tau_a)), 1e-14);
+  EXPECT_NEAR(s.x[0], 0.01 * (0.2 - tau_a * (1 - std::exp(-0.2 / tau_a))), 1e-14);
+}
+
+TEST(Integrator, VelocityVerletWithoutDrag)
+{
+  auto spring = [](const double *x, double *a) { for (int k = 0; k < 3; ++k) a[k] = -4.0 * x[k]; };
+  State s, ref;
+  s.x[0] = ref.x[0] = 1.0;
+  s.v[1] = ref.v[1] = 0.5;
+  const double dt = 0.01;
+  run(SphereDrag{}, 1.0, spring, dt, 1000, s);
+  double a[3];
+  spring(ref.x, a);
+  for (int n = 0; n < 1000; ++n) {
+    for (int k = 0; k < 3; ++k) {
+      ref.v[k] += 0.5 * dt * a[k];
+      ref.x[k] += dt * ref.v[k];
+    }
+    spring(ref.x, a);
+    for (int k = 0; k < 3; ++k) ref.v[k] += 0.5 * dt * a[k];
+  }
+  for (int k = 0; k < 3; ++k) {
+    EXPECT_NEAR(s.x[k], ref.x[k], 1e-13);
+    EXPECT_NEAR(s.v[k], ref.v[k], 1e-13);
+  }
+}
+
+// Observed order of convergence for a smoothly varying force: spring + nonlinear drag in 3D.
+TEST(Integrator, SecondOrderForSmoothForces)
+{
+  const Fluid oil{900.0, 0.05, 0.0};
+  for (auto law : {DragLaw::Stokes, DragLaw::SchillerNaumann, DragLaw::Dallavalle}) {
+    const DragModel model(law, oil);
+    const double d = 5e-3, mass = 2500.0 * sphere_volume(d);
+    const SphereDrag drag{&model, d, {}};
+    auto force = [](const double *x, double *a) {
+      a[0] = -40.0 * x[0];
+      a[1] = -25.0 * x[1];
+      a[2] = -9.81 - 30.0 * x[2];
+    };
+    const double t_end = 1.0;
+    auto solve = [&](int steps) {
+      State s;
+      s.x[0] = 0.02;
+      s.v[1] = 0.3;
+      run(drag, mass, force, t_end / steps, steps, s);
+      return s;
+    };
+    const State ref = solve(64000);
+    double err_prev = 0.0;
+    for (int steps : {250, 500, 1000}) {
+      const State s = solve(steps);
+      double err = 0.0;
+      for (int k = 0; k < 3; ++k) err = std::max({err, std::abs(s.x[k] - ref.x[k]), 1e-2 * std::abs(s.v[k] - ref.v[k])});
+      if (err_prev > 0.0) {
+        const double order = std::log2(err_prev / err);
+        EXPECT_GT(order, 1.9) << drag_law_name(law) << " steps " << steps;
+        EXPECT_LT(order, 2.2) << drag_law_name(law) << " steps " << steps;
+      }
+      err_prev = err;
+    }
+  }
+}
+
+TEST(Integrator, NonlinearTerminalVelocityIsExactAtHugeSteps)
+{
+  for (auto law : {DragLaw::SchillerNaumann, DragLaw::Dallavalle}) {
+    const DragModel model(law, water);
+    const double d = 1e-3, rho = 2650.0, mass = rho * sphere_volume(d);
+    const double vt = terminal_velocity(model, d, rho, g).speed;
+    const double tau = relaxation_time(model, d, rho);
+    const SphereDrag drag{&model, d, {}};
+    State s;
+    auto accel = [&](const double *, double *a) { a[0] = a[1] = 0; a[2] = -(rho - 1000.0) / rho * g; };
+    run(drag, mass, accel, 100 * tau, 30, s);
+    EXPECT_NEAR(-s.v[2], vt, 1e-10 * vt) << drag_law_name(law);
+  }
+}
+
+class Bingham : public ::testing::Test {
+ protected:
+  const Fluid clay{1280.0, 0.0131, 30.5};
+  const DragModel model{DragLaw::ZhangLi, clay};
+  const double d = 0.02;
+  double density_for_yield_number(double y) const { return clay.density + clay.yield_stress / (y * g * d); }
+};
+
+TEST_F(Bingham, JustAboveTheCriterionStaysExactlyStill)
+{
+  const double rho = density_for_yield_number(critical_yield_number(model) * 1.0001);
+  const double mass = rho * sphere_volume(d);
+  const SphereDrag drag{&model, d, {}};
+  auto accel = [&](const double *, double *a) { a[0] = a[1] = 0; a[2] = -(rho - clay.density) / rho * g; };
+  State s;
+  for (double dt : {1e-6, 1e-3, 0.1}) {
+    run(drag, mass, accel, dt, 100000, s);
+    EXPECT_EQ(s.v[2], 0.0);
+    EXPECT_EQ(s.x[2], 0.0);
+  }
+}
+
+// Just below the criterion the Zhang-Li balance falls inside the Cd jump at Re' = 1 (the low
+// branch adds only 3 pi eta d v to the static force), so the law's terminal state is the jump
+// speed; the smooth variant has a true root there. Both must be reached at any step.
+TEST_F(Bingham, JustBelowTheCriterionSettlesAtTheLawsTerminalVelocity)
+{
+  const double rho = density_for_yield_number(critical_yield_number(model) * 0.99);
+  const double mass = rho * sphere_volume(d);
+  auto accel = [&](const double *, double *a) { a[0] = a[1] = 0; a[2] = -(rho - clay.density) / rho * g; };
+  for (auto law : {DragLaw::ZhangLi, DragLaw::ZhangLiSmooth}) {
+    const DragModel law_model(law, clay);
+    const TerminalState terminal = terminal_velocity(law_model, d, rho, g);
+    EXPECT_EQ(terminal.regime, law == DragLaw::ZhangLi ? TerminalRegime::AtJump : TerminalRegime::Moving);
+    const SphereDrag drag{&law_model, d, {}};
+    // The relaxation time m / (3 pi eta d) is about 8 s here: run 300 s.
+    for (double dt : {1e-3, 0.1, 1.0}) {
+      State s;
+      run(drag, mass, accel, dt, static_cast<int>(300.0 / dt), s);
+      EXPECT_NEAR(-s.v[2], terminal.speed, 1e-9 * terminal.speed) << drag_law_name(law) << " dt " << dt;
+    }
+  }
+}
+
+TEST_F(Bingham, SphereThrownUpwardStopsWithoutChattering)
+{
+  const double rho = density_for_yield_number(0.2);    // deeply stuck under gravity
+  const double mass = rho * sphere_volume(d);
+  const SphereDrag drag{&model, d, {}};
+  auto accel = [&](const double *, double *a) { a[0] = a[1] = 0; a[2] = -(rho - clay.density) / rho * g; };
+  State s;
+  s.v[2] = 0.5;
+  s.v[0] = 0.1;
+  run(drag, mass, accel, 1e-3, 2000, s);
+  for (double v : s.v) EXPECT_EQ(v, 0.0);
+  const double x_stop = s.x[2];
+  EXPECT_GT(x_stop, 0.0);
+  run(drag, mass, accel, 1e-3, 2000, s);
+  EXPECT_EQ(s.x[2], x_stop);
+}
+
+TEST_F(Bingham, BalanceInsideTheCdJumpStaysAtTheJumpForEveryStep)
+{
+  std::array<ForceJump, DragModel::max_jumps> jumps;
+  ASSERT_EQ(model.jumps(d, jumps), 2);
+  for (int j = 0; j < 2; ++j) {
+    const double drive = 0.5 * (jumps[j].force_below + jumps[j].force_above);
+    const double rho = clay.density + drive / (g * sphere_volume(d));
+    const double mass = rho * sphere_volume(d);
+    const SphereDrag drag{&model, d, {}};
+    auto accel = [&](const double *, double *a) { a[0] = a[1] = 0; a[2] = -(rho - clay.density) / rho * g; };
+    for (double dt : {1e-5, 1e-4, 1e-2, 1.0}) {
+      State s;
+      run(drag, mass, accel, dt, std::max(200, static_cast<int>(3.0 / dt)), s);
+      double vmax = 0.0;
+      for (int n = 0; n < 200; ++n) {
+        run(drag, mass, accel, dt, 1, s);
+        vmax = std::max(vmax, std::abs(-s.v[2] - jumps[j].speed));
+      }
+      EXPECT_LT(vmax, 1e-9 * jumps[j].speed) << "jump " << j << " dt " << dt;
+    }
+  }
+}
+
+TEST(Integrator, RotationDecaysExactly)
+{
+  const double alpha[3] = {0, 0, 0};
+  double omega[3] = {1.0, 0.0, -2.0};
+  const double rate = 50.0, dt = 0.3;
+  const double weight = rotation_step_initial(rate, alpha, dt, omega);
+  EXPECT_NEAR(omega[0], std::exp(-rate * dt), 1e-15);
+  EXPECT_NEAR(weight, dt * phi2(rate * dt), 1e-16);
+  EXPECT_DOUBLE_EQ(rotation_step_initial(0.0, alpha, dt, omega), 0.5 * dt);
+}
+
+TEST(Integrator, PhiFunctionsAreSmoothAcrossTheSeriesSwitch)
+{
+  // References in long double: the direct formulas where they do not cancel, else the series.
+  for (double z : {0.0, 1e-12, 1e-4, 9.99e-4, 1.001e-3, 0.1, 10.0, 1e6}) {
+    const long double x = z;
+    long double p1 = 0.0L, p2 = 0.0L, term1 = 1.0L, term2 = 0.5L;
+    if (z > 0.1) {
+      p1 = (1.0L - std::exp(-x)) / x;
+      p2 = (x - 1.0L + std::exp(-x)) / (x * x);
+    } else {
+      for (int n = 0; n < 12; ++n) {    // phi1 = sum (-z)^n/(n+1)!, phi2 = sum (-z)^n/(n+2)!
+        p1 += term1;
+        p2 += term2;
+        term1 *= -x / (n + 2);
+        term2 *= -x / (n + 3);
+      }
+    }
+    EXPECT_NEAR(phi1(z), static_cast<double>(p1), 1e-15) << z;
+    EXPECT_NEAR(phi2(z), static_cast<double>(p2), 4e-15) << z;
+  }
+}
