@@ -105,6 +105,16 @@ void FixNVESphereFluid::initial_integrate(int /*vflag*/)
     }
 
     const double mass = rmass[i];
+    double *w = weights[i];
+    w[IN_FLUID] = sphere.model ? 1.0 : 0.0;
+    if (!sphere.model) {
+      nve_sphere_half_step(i);
+      x[i][0] += dt * v[i][0];
+      x[i][1] += dt * v[i][1];
+      x[i][2] += dt * v[i][2];
+      continue;
+    }
+
     const double a[3] = {ftm2v * f[i][0] / mass, ftm2v * f[i][1] / mass, ftm2v * f[i][2] / mass};
     double dx[3];
     const sediment::StepCorrection corr = sediment::drag_step_initial(sphere, mass, a, flow, dt, v[i], dx);
@@ -117,7 +127,6 @@ void FixNVESphereFluid::initial_integrate(int /*vflag*/)
     const double inertia = INERTIA * mass * radius[i] * radius[i];
     const double alpha[3] = {ftm2v * torque[i][0] / inertia, ftm2v * torque[i][1] / inertia,
                              ftm2v * torque[i][2] / inertia};
-    double *w = weights[i];
     w[SPIN] = sediment::rotation_step_initial(spin_rate, alpha, dt, omega[i]);
     w[ALONG] = corr.along;
     w[ACROSS] = corr.across;
@@ -142,6 +151,10 @@ void FixNVESphereFluid::final_integrate()
   for (int i = 0; i < nlocal; ++i) {
     if (!(mask[i] & groupbit)) continue;
     const double *w = weights[i];
+    if (w[IN_FLUID] == 0.0) {
+      nve_sphere_half_step(i);
+      continue;
+    }
     const double mass = rmass[i];
     sediment::StepCorrection corr;
     corr.along = w[ALONG];
@@ -157,6 +170,27 @@ void FixNVESphereFluid::final_integrate()
     omega[i][1] += spin * torque[i][1];
     omega[i][2] += spin * torque[i][2];
   }
+}
+
+void FixNVESphereFluid::nve_sphere_half_step(int i)
+{
+  // The kick of fix nve/sphere, written as it does, so that a scene without fluid is bitwise
+  // the same as with fix nve/sphere.
+  const double dtf = 0.5 * update->dt * force->ftm2v;
+  const double dtfrotate = dtf / INERTIA;
+  const double dtfm = dtf / atom->rmass[i];
+  double *v = atom->v[i];
+  const double *f = atom->f[i];
+  v[0] += dtfm * f[0];
+  v[1] += dtfm * f[1];
+  v[2] += dtfm * f[2];
+  const double radius = atom->radius[i];
+  const double dtirotate = dtfrotate / (radius * radius * atom->rmass[i]);
+  double *omega = atom->omega[i];
+  const double *torque = atom->torque[i];
+  omega[0] += dtirotate * torque[0];
+  omega[1] += dtirotate * torque[1];
+  omega[2] += dtirotate * torque[2];
 }
 
 double FixNVESphereFluid::compute_vector(int n)

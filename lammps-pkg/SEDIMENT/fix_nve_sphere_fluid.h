@@ -36,10 +36,13 @@ class FixNVESphereFluid : public Fix {
 
  private:
   // Per atom, from the first half of the step to the second: weights of the new force along
-  // and across the slip, the slip direction, and the weight of the new torque.
-  enum { ALONG, ACROSS, DIRX, DIRY, DIRZ, SPIN, NCOLS };
+  // and across the slip, the slip direction, the weight of the new torque, and whether the
+  // atom was in a fluid (outside, the step is fix nve/sphere's, operation for operation).
+  enum { ALONG, ACROSS, DIRX, DIRY, DIRZ, SPIN, IN_FLUID, NCOLS };
   double **weights;
   std::vector<class FixFluidDrag *> drags;
+  void nve_sphere_half_step(int i);
+
   double counts[2];    // spheres stuck by the yield stress, held at a Cd jump
   double counts_all[2];
   int counts_reduced;

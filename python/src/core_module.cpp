@@ -72,7 +72,15 @@ PYBIND11_MODULE(_core, m)
       .def("tangent", [](const DragModel &model, double d, double speed) { return model.tangent(d, speed); },
            py::arg("d"), py::arg("speed"), "dF/ds [N s/m].")
       .def("static_force", [](const DragModel &model, double d) { return model.static_force(d); },
-           py::arg("d"), "Largest force a sphere at rest resists (yield) [N].");
+           py::arg("d"), "Largest force a sphere at rest resists (yield) [N].")
+      .def("jumps", [](const DragModel &model, double d) {
+             std::array<ForceJump, DragModel::max_jumps> jumps;
+             const int n = model.jumps(d, jumps);
+             py::list out;
+             for (int k = 0; k < n; ++k)
+               out.append(py::make_tuple(jumps[k].speed, jumps[k].force_below, jumps[k].force_above));
+             return out;
+           }, py::arg("d"), "Speeds where the force jumps, with the forces just below and above [(m/s, N, N)].");
 
   m.def("terminal_velocity",
         [](const std::string &law, double density, double viscosity, double yield_stress, double d,

@@ -1,0 +1,340 @@
+"""Deck tests of the SEDIMENT styles: `python3 checks.py NAME [--np N]` (run by ctest).
+
+Each check runs decks through lmp_sediment (serial or mpirun) and compares what they print with
+analytic references from the physics core. The numbers they print are the measured results.
+"""
+from __future__ import annotations
+
+import argparse
+import csv
+import math
+import tempfile
+from pathlib import Path
+
+import numpy as np
+
+from harness import HERE, report, run_deck
+from sediment import _core
+
+G = 9.81
+import os
+SHARED = Path(os.environ.get("SEDIMENT_SHARED", HERE.parents[2] / "shared"))    # ../shared beside the clone
+CHECKS = {}
+
+
+def check(fn):
+    CHECKS[fn.__name__] = fn
+    return fn
+
+
+def stokes_reference(d: float, rho_p: float, rho_f: float = 1000.0, mu: float = 1e-3):
+    vt = (rho_p - rho_f) * G * d * d / (18 * mu)
+    tau = rho_p * d * d / (18 * mu)
+    return vt, tau
+
+
+# ---- case A: single sphere in water (Zhang & Li 2024) ---------------------------------------
+def case_a_errors(dt: float, t_end: float, integrator: str, np_ranks: int):
+    steps = max(1, round(t_end / dt))
+    out = run_deck("single_sphere.lmp", {"dt": dt, "steps": steps, "integrator": integrator,
+                                         "every": max(1, steps // 200)}, np_ranks)
+    vt, tau = stokes_reference(1e-4, 2700.0)
+    t, z, vz = out.samples[:, 0], out.samples[:, 1], out.samples[:, 2]
+    v_exact = -vt * (1 - np.exp(-t / tau))
+    z_exact = -vt * (t - tau * (1 - np.exp(-t / tau)))
+    v_err = float(np.max(np.abs(vz - v_exact)) / vt)
+    z_err = float(np.max(np.abs(z - z_exact)) / (vt * t_end))
+    return v_err, z_err, out
+
+
+@check
+def case_a_implicit(np_ranks: int):
+    vt, tau = stokes_reference(1e-4, 2700.0)
+    for dt in (1e-3, 1e-1, 100 * tau):
+        v_err, z_err, _ = case_a_errors(dt, max(0.03, 10 * dt), "nve/sphere/fluid", np_ranks)
+        report(f"case A implicit dt={dt:.3g} s (dt/tau={dt / tau:.3g}): "
+               f"max|v-v_exact|/v_t={v_err:.2e}  max|z-z_exact|/(v_t T)={z_err:.2e}")
+        assert v_err < 1e-6 and z_err < 1e-6
+
+
+@check
+def case_a_explicit(np_ranks: int):
+    vt, tau = stokes_reference(1e-4, 2700.0)
+    for dt in (1e-5, 1e-4, 2.5e-3):
+        v_err, z_err, out = case_a_errors(dt, 0.03, "nve/sphere", np_ranks)
+        report(f"case A explicit dt={dt:.3g} s (dt/tau={dt / tau:.3g}): max|v-v_exact|/v_t={v_err:.2e}")
+        assert "dt > 2 tau" not in out.text
+        if dt <= 1e-4:
+            assert 0.05 * dt / tau < v_err < 0.5 * dt / tau    # first order in dt / tau
+        else:
+            assert 1e-2 < v_err < 1.0        # stable but oscillating below 2 tau
+    v_err, _, out = case_a_errors(3.5e-3, 0.1, "nve/sphere", np_ranks)
+    report(f"case A explicit dt=3.5e-3 s (dt/tau={3.5e-3 / tau:.3g}): max|v-v_exact|/v_t={v_err:.2e} (diverges)")
+    assert v_err > 10.0
+    assert "1 sphere(s) have dt > 2 tau under explicit drag" in out.text
+
+
+# ---- case B: terminal velocities of fine grains (Bravo et al. 2015) -------------------------
+@check
+def case_b(np_ranks: int):
+    # d [um], table time [1e-5 s], v_t [1e-5 m/s], fraction of v_t the table's time refers to
+    # (tau ln 100 for 70 um, tau ln 20 for the finer rows: see tests/core/test_terminal.cpp).
+    rows = [(70, 313.4, 400.5, 0.99), (50, 104.0, 204.3, 0.95), (25, 26.0, 51.09, 0.95),
+            (10, 4.16, 8.17, 0.95), (5, 1.04, 2.04, 0.95), (2.5, 0.26, 0.51, 0.95)]
+    for d_um, t_tab, vt_tab, fraction in rows:
+        t_table = t_tab * 1e-5
+        out = run_deck("single_sphere.lmp", {"d": d_um * 1e-6, "rho_p": 2500, "dt": t_table / 20,
+                                             "steps": 20 * 40, "every": 20}, np_ranks)
+        v_at_table_time = -out.samples[1, 2]
+        vt_sim = -out.samples[-1, 2]
+        reached = v_at_table_time / vt_sim
+        report(f"case B d={d_um} um: v_t={vt_sim / 1e-5:.4f}e-5 m/s (table {vt_tab}), "
+               f"v(t_table)/v_t={reached:.5f} (expected {fraction})")
+        assert abs(vt_sim / 1e-5 - vt_tab) <= 1e-3 * vt_tab + 0.005
+        assert abs(reached - fraction) <= 1e-3 * fraction
+
+
+# ---- case C: spheres in clay suspensions (Valentik & Whitmore 1965) -------------------------
+def case_c_deck(rows: list[dict], path: Path, law: str) -> None:
+    lines = ["units si", "atom_style sphere", "atom_modify map array", "boundary p p m",
+             f"region box block -1 {len(rows)} -1 1 -1 1", f"create_box {len(rows)} box",
+             "comm_modify cutoff 1.0", "fix grav all gravity 9.81 vector 0 0 -1"]
+    for i, row in enumerate(rows, start=1):
+        lines += [f"create_atoms {i} single {i - 0.5} 0 0",
+                  f"set atom {i} diameter {row['d']} density {row['rho_p']}",
+                  f"group s{i} type {i}",
+                  f"fix fluid{i} s{i} fluid density {row['rho_f']} bingham {row['tau_y']} {row['eta_B']}",
+                  f"fix buoy{i} s{i} fluid/buoyancy fluid{i}",
+                  f"fix drag{i} s{i} fluid/drag fluid{i} law {law}"]
+    lines += ["fix step all nve/sphere/fluid", "timestep 0.01", "thermo 0", "run 20000"]
+    lines += [f'print "RESULT v{i} $(vz[{i}]:%.17g)"' for i in range(1, len(rows) + 1)]
+    path.write_text("\n".join(lines) + "\n")
+
+
+@check
+def case_c(np_ranks: int):
+    with open(SHARED / "data" / "vw1965_dev.csv") as f:
+        rows = [{k: float(v) for k, v in r.items()} for r in csv.DictReader(f)]
+    for law in ("zhang-li", "zhang-li/smooth"):
+        with tempfile.TemporaryDirectory() as tmp:
+            deck = Path(tmp) / "case_c.lmp"
+            case_c_deck(rows, deck, law)
+            out = run_deck(deck, {}, np_ranks, cwd=Path(tmp))
+        worst = 0.0
+        for i, row in enumerate(rows, start=1):
+            speed, regime = _core.terminal_velocity(law, row["rho_f"], row["eta_B"], row["tau_y"],
+                                                    row["d"], row["rho_p"], G)
+            sim = -out.results[f"v{i}"]
+            dev = (sim - speed) / speed
+            worst = max(worst, abs(dev))
+            report(f"case C {law:16s} susp {int(row['suspension'])} d={row['d'] * 1e3:5.1f} mm "
+                   f"rho_p={row['rho_p']:.0f}: sim {sim:.5f} m/s, law {speed:.5f} ({regime}), "
+                   f"sim-law {dev:+.1e}, measured {row['v_ter_measured']:.3f} "
+                   f"(law vs measured {(speed - row['v_ter_measured']) / row['v_ter_measured']:+.1%})")
+            assert abs(dev) < 0.005
+        report(f"case C {law}: worst |sim - law| / law = {worst:.1e}")
+
+
+# ---- Bingham hard cases -----------------------------------------------------------------------
+CLAY = dict(rho_f=1280.0, eta=0.0131, tau_y=30.5)
+D_BALL = 0.02
+
+
+def bingham_vars(law: str, y_ratio: float, **extra) -> dict:
+    yc = _core.critical_yield_number(law)
+    rho_p = CLAY["rho_f"] + CLAY["tau_y"] / (yc * y_ratio * G * D_BALL)
+    return {"d": D_BALL, "rho_p": rho_p, "rho_f": CLAY["rho_f"], "law": law,
+            "rheology": f"bingham {CLAY['tau_y']} {CLAY['eta']}", **extra}
+
+
+@check
+def bingham_rest(np_ranks: int):
+    out = run_deck("single_sphere.lmp", bingham_vars("zhang-li", 1.0001, dt=1e-3, steps=100000, every=1000),
+                   np_ranks)
+    report(f"Bingham Y = 1.0001 Y_c: max |vz| over 1e5 steps = {np.max(np.abs(out.samples[:, 2])):.1e}, "
+           f"max |z| = {np.max(np.abs(out.samples[:, 1])):.1e}, stuck spheres = {out.results['stuck']:.0f}")
+    assert np.all(out.samples[:, 1:] == 0.0)
+    assert out.results["stuck"] == 1
+
+
+@check
+def bingham_settles(np_ranks: int):
+    for law in ("zhang-li", "zhang-li/smooth"):
+        for dt in (1e-3, 0.1):
+            out = run_deck("single_sphere.lmp", bingham_vars(law, 0.99, dt=dt, steps=round(300 / dt),
+                                                                 every=round(300 / dt)), np_ranks)
+            v = bingham_vars(law, 0.99)
+            speed, regime = _core.terminal_velocity(law, CLAY["rho_f"], CLAY["eta"], CLAY["tau_y"], D_BALL,
+                                                    v["rho_p"], G)
+            sim = -out.samples[-1, 2]
+            report(f"Bingham Y = 0.99 Y_c {law} dt={dt}: v={sim:.9f} m/s, law {speed:.9f} ({regime})")
+            assert abs(sim - speed) < 1e-8 * speed
+
+
+@check
+def bingham_jump(np_ranks: int):
+    model = _core.DragModel("zhang-li", CLAY["rho_f"], CLAY["eta"], CLAY["tau_y"])
+    volume = math.pi * D_BALL ** 3 / 6
+    for j, (speed, below, above) in enumerate(model.jumps(D_BALL)):
+        rho_p = CLAY["rho_f"] + 0.5 * (below + above) / (G * volume)
+        for dt in (1e-4, 1e-2, 1.0):
+            settle = max(200, round(5.0 / dt))
+            out = run_deck("single_sphere.lmp", {"d": D_BALL, "rho_p": rho_p, "rho_f": CLAY["rho_f"],
+                                                 "law": "zhang-li",
+                                                 "rheology": f"bingham {CLAY['tau_y']} {CLAY['eta']}",
+                                                 "dt": dt, "steps": settle + 100, "every": 1}, np_ranks)
+            tail = -out.samples[-100:, 2]
+            spread = float(np.max(np.abs(tail - speed)) / speed)
+            report(f"Cd jump {j} (v={speed:.5f} m/s) dt={dt}: max |v - v_jump|/v_jump over the last 100 "
+                   f"steps = {spread:.1e}, held = {out.results['at_jump']:.0f}")
+            assert spread < 1e-9 and out.results["at_jump"] == 1
+
+
+# ---- free surface -------------------------------------------------------------------------------
+@check
+def surface_crossing(np_ranks: int):
+    out = run_deck("surface_crossing.lmp", {}, np_ranks)
+    z, force = out.samples[:, 1], out.samples[:, 2]
+    r = 0.5e-3
+    volume = 4 / 3 * math.pi * r ** 3
+    expected = np.array([1000 * G * volume * _core.submergence(r, zc)["volume"] for zc in z])
+    err = float(np.max(np.abs(force - expected)) / (1000 * G * volume))
+    steps = np.abs(np.diff(force)) / (1000 * G * volume)
+    report(f"surface crossing: max |F_b - rho g V_cap| / (rho g V) = {err:.1e}; largest change between "
+           f"samples {steps.max():.3e} of the full buoyancy (sample spacing {abs(z[1] - z[0]) / (2 * r):.3f} d)")
+    assert err < 1e-12
+    assert steps.max() < 3 * abs(z[1] - z[0]) / (2 * r)    # slope of V_cap is at most 1.5 V / d
+
+
+@check
+def floating(np_ranks: int):
+    d, rho_p = 1e-3, 700.0
+    out = run_deck("single_sphere.lmp", {"d": d, "rho_p": rho_p, "extra": "surface z 0", "z0": -d,
+                                         "dt": 1e-3, "steps": 4000, "every": 4000}, np_ranks)
+    lo, hi = -d / 2, d / 2    # centre height where the submerged fraction equals rho_p / rho_f
+    for _ in range(200):
+        mid = 0.5 * (lo + hi)
+        lo, hi = (lo, mid) if _core.submergence(d / 2, mid)["volume"] < rho_p / 1000 else (mid, hi)
+    z_eq = 0.5 * (lo + hi)
+    z = out.samples[-1, 1]
+    report(f"floating sphere rho_p/rho_f=0.7: rest height {z / d:+.9f} d, Archimedes {z_eq / d:+.9f} d")
+    assert abs(z - z_eq) < 1e-6 * d and abs(out.samples[-1, 2]) < 1e-9
+
+
+# ---- integrator -----------------------------------------------------------------------------------
+@check
+def integrator_order(np_ranks: int):
+    base = {"d": 2e-3, "rho_p": 2500, "rheology": "viscosity 0.05", "law": "schiller-naumann",
+            "tether": 2.0, "vx0": 0.05}
+    t_end = 0.4
+
+    def trajectory(dt):    # z, vz, vx at 10 common times
+        steps = round(t_end / dt)
+        out = run_deck("single_sphere.lmp", {**base, "dt": dt, "steps": steps, "every": steps // 10}, np_ranks)
+        return out.samples[1:, 1:]
+
+    ref = trajectory(1e-3 / 64)
+    scale = np.max(np.abs(ref), axis=0)
+    errors = [float(np.max(np.abs(trajectory(dt) - ref) / scale)) for dt in (1e-3, 5e-4, 2.5e-4)]
+    orders = [math.log2(a / b) for a, b in zip(errors, errors[1:])]
+    report(f"integrator order (spring + Schiller-Naumann drag): errors {['%.2e' % e for e in errors]}, "
+           f"observed orders {['%.3f' % o for o in orders]}")
+    assert all(1.8 < o < 2.2 for o in orders)
+
+
+@check
+def verlet_limit(np_ranks: int):
+    with tempfile.TemporaryDirectory() as tmp:
+        finals = []
+        for integrator in ("nve/sphere", "nve/sphere/fluid"):
+            dump = Path(tmp) / f"{integrator.replace('/', '_')}.txt"
+            run_deck("granular_pile.lmp", {"integrator": integrator, "dump": dump}, np_ranks)
+            finals.append(np.loadtxt(dump, skiprows=9))
+    diff = float(np.max(np.abs(finals[0][:, 1:] - finals[1][:, 1:])))
+    scale = float(np.max(np.abs(finals[0][:, 1:])))
+    report(f"nve/sphere/fluid without a fluid vs nve/sphere, granular pile: max difference {diff:.1e} "
+           f"(state scale {scale:.1e})")
+    assert diff <= 1e-10 * scale
+
+
+@check
+def mpi_consistency(np_ranks: int):
+    rng = np.random.default_rng(4321)
+    n = 200
+    atoms = np.column_stack([np.arange(1, n + 1), np.ones(n), rng.uniform(5e-5, 1.5e-4, n), np.full(n, 2600.0),
+                             rng.uniform(0, 0.02, n), rng.uniform(0, 0.01, n), rng.uniform(0, 0.01, n)])
+    with tempfile.TemporaryDirectory() as tmp:
+        data = Path(tmp) / "settling.data"
+        with open(data, "w") as f:
+            f.write(f"settling spheres\n\n{n} atoms\n1 atom types\n\n0 0.02 xlo xhi\n0 0.01 ylo yhi\n"
+                    "0 0.01 zlo zhi\n\nAtoms # sphere\n\n")
+            np.savetxt(f, atoms, fmt=["%d", "%d", "%.17g", "%.17g", "%.17g", "%.17g", "%.17g"])
+        finals = []
+        for ranks in (1, 2):
+            dump = Path(tmp) / f"np{ranks}.txt"
+            run_deck("mpi_settling.lmp", {"data": data, "dump": dump}, ranks)
+            finals.append(np.loadtxt(dump, skiprows=9))
+    a, b = finals
+    rel = float(np.max(np.abs(a - b) / np.maximum(np.abs(a), 1e-30)))
+    report(f"1 vs 2 ranks, {len(a)} settling spheres crossing the rank boundary: max relative difference {rel:.1e}")
+    assert len(a) == len(b) and rel < 1e-10
+
+
+# ---- bad input ----------------------------------------------------------------------------------
+BAD_INPUT = [
+    ("fix f all fluid density -1 viscosity 1e-3", "density must be > 0"),
+    ("fix f all fluid density 1000 viscosity 0", "viscosity must be > 0"),
+    ("fix f all fluid density 1000", "give exactly one of 'viscosity MU' or 'bingham TAU_Y ETA_B'"),
+    ("fix f all fluid viscosity 1e-3", "keyword 'density' is required"),
+    ("fix f all fluid density 1000 viscosity 1e-3 colour red", "unknown keyword 'colour'"),
+    ("fix f all fluid density 1000 bingham -3 0.1", "bingham yield stress must be > 0"),
+    ("fix f all fluid density 1000 viscosity 1e-3 surface w 0", "surface axis must be x, y, z or plane"),
+    ("fix f all fluid density 1000 viscosity", "keyword 'viscosity' needs 1 value"),
+    ("fix f all fluid density abc viscosity 1e-3", "Expected floating point parameter"),
+    ("fix f all fluid density 1000 viscosity 1e-3 region nowhere\nrun 0", "region 'nowhere' does not exist"),
+    ("fix f all fluid density 1000 viscosity 1e-3\nfix d all fluid/drag f law stoke", "unknown law 'stoke'"),
+    ("fix d all fluid/drag nofluid law stokes\nrun 0", "fluid fix 'nofluid' does not exist"),
+    ("fix d all fluid/drag grav law stokes\nrun 0", "fix 'grav' is a fix gravity, not a fix fluid"),
+    ("fix f all fluid density 1000 viscosity 1e-3\nfix d all fluid/drag f", "expected 'fix ID group fluid/drag FLUID-ID law NAME'"),
+    ("fix f all fluid density 1000 viscosity 1e-3\nfix d all fluid/drag f rotation yes", "keyword 'law' is required"),
+    ("fix f all fluid density 1000 viscosity 1e-3\nfix d all fluid/drag f law stokes rotation maybe", "rotation must be yes or no"),
+    ("unfix grav\nfix f all fluid density 1000 viscosity 1e-3\nfix b all fluid/buoyancy f\nrun 0", "needs a fix gravity"),
+    ("fix f all fluid density 1000 viscosity 1e-3\nfix b all fluid/buoyancy f gravity f\nrun 0", "is a fix fluid, not a fix gravity"),
+    ("fix n all nve/sphere/fluid extra", "unexpected argument 'extra'"),
+]
+
+
+@check
+def bad_input(np_ranks: int):
+    with tempfile.TemporaryDirectory() as tmp:
+        for k, (lines, message) in enumerate(BAD_INPUT):
+            deck = Path(tmp) / f"bad{k}.lmp"
+            deck.write_text("units si\natom_style sphere\nregion box block 0 1 0 1 0 1\ncreate_box 1 box\n"
+                            "fix grav all gravity 9.81 vector 0 0 -1\n" + lines + "\n")
+            out = run_deck(deck, {}, np_ranks, expect_failure=True, cwd=Path(tmp))
+            assert "ERROR" in out.text and message in out.text, f"{lines!r}: {out.text[-600:]}"
+        for units in ("metal", "real"):
+            deck = Path(tmp) / "units.lmp"
+            deck.write_text(f"units {units}\natom_style sphere\nregion box block 0 1 0 1 0 1\ncreate_box 1 box\n"
+                            "fix f all fluid density 1 viscosity 1\nrun 0\n")
+            out = run_deck(deck, {}, np_ranks, expect_failure=True, cwd=Path(tmp))
+            assert f"requires coherent units (si, cgs, micro, nano or lj), not '{units}'" in out.text
+        deck = Path(tmp) / "atomic.lmp"
+        deck.write_text("units si\natom_style atomic\nregion box block 0 1 0 1 0 1\ncreate_box 1 box\n"
+                        "fix f all fluid density 1000 viscosity 1e-3\nfix d all fluid/drag f law stokes\n")
+        out = run_deck(deck, {}, np_ranks, expect_failure=True, cwd=Path(tmp))
+        assert "requires atom attributes radius and rmass" in out.text
+    report(f"bad input: {len(BAD_INPUT) + 3} malformed decks each stopped with the expected error message")
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__)
+    parser.add_argument("name", choices=sorted(CHECKS))
+    parser.add_argument("--np", type=int, default=1, help="MPI ranks")
+    args = parser.parse_args()
+    CHECKS[args.name](args.np)
+    print(f"PASS {args.name} np={args.np}")
+
+
+if __name__ == "__main__":
+    main()
