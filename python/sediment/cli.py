@@ -1,0 +1,77 @@
+"""The `sediment` command line."""
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+from . import _core
+
+
+def positive(text: str) -> float:
+    value = float(text)
+    if not value > 0:
+        raise argparse.ArgumentTypeError(f"must be > 0, got {text}")
+    return value
+
+
+def cmd_terminal(args: argparse.Namespace) -> int:
+    speed, regime = _core.terminal_velocity(args.law, args.fluid_density, args.viscosity, args.yield_stress,
+                                            args.diameter, args.particle_density, args.gravity)
+    print(f"terminal velocity: {speed:.6g} m/s ({regime})")
+    if args.yield_stress == 0:
+        tau = _core.relaxation_time(args.law, args.fluid_density, args.viscosity, args.diameter,
+                                    args.particle_density)
+        print(f"relaxation time tau = m / F'(0): {tau:.6g} s; explicit drag needs dt < {2 * tau:.3g} s")
+    if speed > 0:
+        t99 = _core.time_to_fraction(args.law, args.fluid_density, args.viscosity, args.yield_stress,
+                                     args.diameter, args.particle_density, args.gravity, 0.99)
+        print(f"time to 99 % of it from rest: {t99:.6g} s")
+    return 0
+
+
+def cmd_case_a(args: argparse.Namespace) -> int:
+    from .single_sphere import RELAXATION_TIME, case_a_study
+
+    runs = case_a_study(args.out)
+    print(f"{'integrator':10s} {'dt [s]':>9s} {'dt/tau':>8s} {'max err/v_t':>12s} {'wall [s]':>9s}")
+    for r in runs:
+        print(f"{r.integrator:10s} {r.dt:9.2g} {r.dt / RELAXATION_TIME:8.3g} {r.error:12.2e} {r.wall_seconds:9.3f}")
+    print(f"figure: {args.out / 'case_a_velocity.png'}\ntable:  {args.out / 'case_a_errors.csv'}")
+    return 0
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(prog="sediment", description="SEDIMENT: settling of DEM spheres in "
+                                     "fluids with LAMMPS, and sedimentation-test readouts.")
+    sub = parser.add_subparsers(dest="command", required=True)
+
+    terminal = sub.add_parser("terminal", help="terminal velocity of a sphere under a drag law")
+    terminal.add_argument("--law", default="stokes", choices=_core.drag_law_names())
+    terminal.add_argument("--diameter", type=positive, required=True, help="sphere diameter [m]")
+    terminal.add_argument("--particle-density", type=positive, required=True, help="[kg/m3]")
+    terminal.add_argument("--fluid-density", type=positive, default=998.2, help="[kg/m3] (water at 20 C)")
+    terminal.add_argument("--viscosity", type=positive, default=1.002e-3,
+                          help="viscosity, or plastic viscosity of a Bingham fluid [Pa s]")
+    terminal.add_argument("--yield-stress", type=float, default=0.0, help="Bingham yield stress [Pa]")
+    terminal.add_argument("--gravity", type=positive, default=9.81, help="[m/s2]")
+    terminal.set_defaults(func=cmd_terminal)
+
+    case_a = sub.add_parser("case-a", help="single-sphere validation (case A): velocity curves and "
+                            "error vs time step for the implicit and explicit integrators")
+    case_a.add_argument("--out", type=Path, default=Path("out/case_a"), help="output folder")
+    case_a.set_defaults(func=cmd_case_a)
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    args = build_parser().parse_args(argv)
+    try:
+        return args.func(args)
+    except (ValueError, FileNotFoundError, RuntimeError) as exc:
+        print(f"sediment {args.command}: error: {exc}", file=sys.stderr)
+        return 2
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,19 @@
+"""Where the built programs and the repository's decks are."""
+from __future__ import annotations
+
+import os
+import shutil
+from pathlib import Path
+
+PACKAGE_DIR = Path(__file__).resolve().parent
+REPO_DIR = PACKAGE_DIR.parents[1]
+
+
+def lmp_executable() -> str:
+    """lmp_sediment: $SEDIMENT_LMP, the repository's build, or the PATH."""
+    candidates = [os.environ.get("SEDIMENT_LMP"), str(REPO_DIR / "build" / "lmp_sediment"),
+                  shutil.which("lmp_sediment")]
+    for candidate in candidates:
+        if candidate and Path(candidate).is_file():
+            return candidate
+    raise FileNotFoundError("lmp_sediment not found: build it with `make build` or set SEDIMENT_LMP")

@@ -1,0 +1,7 @@
+import os
+import sys
+from pathlib import Path
+
+REPO = Path(__file__).resolve().parents[2]
+sys.path.insert(0, str(REPO / "python"))
+os.environ.setdefault("SEDIMENT_LMP", str(REPO / "build" / "lmp_sediment"))

@@ -1,0 +1,45 @@
+"""The sediment command line."""
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from sediment import cli
+from sediment.single_sphere import run_case_a
+
+REPO = Path(__file__).resolve().parents[2]
+
+
+def test_terminal_prints_velocity_tau_and_t99(capsys):
+    assert cli.main(["terminal", "--diameter", "1e-4", "--particle-density", "2700", "--fluid-density", "1000",
+                     "--viscosity", "1e-3"]) == 0
+    out = capsys.readouterr().out
+    assert "terminal velocity: 0.009265 m/s (moving)" in out
+    assert "tau = m / F'(0): 0.0015 s" in out
+
+
+def test_terminal_bingham_at_rest(capsys):
+    assert cli.main(["terminal", "--law", "zhang-li", "--diameter", "0.02", "--particle-density", "1500",
+                     "--fluid-density", "1280", "--viscosity", "0.0131", "--yield-stress", "30.5"]) == 0
+    assert "terminal velocity: 0 m/s (at_rest)" in capsys.readouterr().out
+
+
+def test_bad_arguments_are_refused_without_traceback():
+    for args in (["terminal", "--diameter", "-1", "--particle-density", "2700"],
+                 ["terminal", "--law", "newton", "--diameter", "1e-4", "--particle-density", "2700"]):
+        proc = subprocess.run([str(REPO / "bin" / "sediment"), *args], capture_output=True, text=True)
+        assert proc.returncode == 2
+        assert "Traceback" not in proc.stderr and "error:" in proc.stderr
+
+
+def test_help_lists_commands():
+    proc = subprocess.run([str(REPO / "bin" / "sediment"), "--help"], capture_output=True, text=True)
+    assert proc.returncode == 0 and "terminal" in proc.stdout and "case-a" in proc.stdout
+
+
+@pytest.mark.parametrize("integrator, bound", [("implicit", 1e-12), ("explicit", 0.2)])
+def test_case_a_runs_through_the_driver(integrator, bound):
+    run = run_case_a(integrator, 1e-3, t_end=0.01)
+    assert run.error < bound
+    assert len(run.time) == 11

@@ -1,0 +1,52 @@
+"""The physics core as Python sees it (the same code the LAMMPS styles run)."""
+import math
+
+import pytest
+
+import sediment
+
+
+def test_case_a_terminal_velocity_and_tau():
+    speed, regime = sediment.terminal_velocity("stokes", 1000.0, 1e-3, 0.0, 1e-4, 2700.0, 9.81)
+    assert regime == "moving"
+    assert speed == pytest.approx(1700 * 9.81 * 1e-8 / 18e-3, rel=1e-13)
+    assert sediment.relaxation_time("stokes", 1000.0, 1e-3, 1e-4, 2700.0) == pytest.approx(1.5e-3, rel=1e-13)
+    t99 = sediment.time_to_fraction("stokes", 1000.0, 1e-3, 0.0, 1e-4, 2700.0, 9.81, 0.99)
+    assert t99 == pytest.approx(1.5e-3 * math.log(100), rel=1e-10)
+
+
+def test_law_names_and_coefficients():
+    assert sediment.drag_law_names() == ["stokes", "schiller-naumann", "dallavalle", "zhang-li", "zhang-li/smooth"]
+    assert sediment.drag_coefficient("schiller-naumann", 10.0) == pytest.approx(2.4 * (1 + 0.15 * 10**0.687))
+    assert sediment.drag_coefficient("dallavalle", 4.0) == pytest.approx((0.63 + 2.4) ** 2)
+    assert sediment.drag_coefficient("zhang-li", 10.0) == pytest.approx(2.912 + 0.195)
+
+
+def test_bingham_rest_criterion_and_jumps():
+    assert sediment.critical_yield_number("zhang-li") == pytest.approx(0.0440, abs=5e-5)
+    model = sediment.DragModel("zhang-li", 1280.0, 0.0131, 30.5)
+    jumps = model.jumps(0.0254)
+    assert [round(model.reynolds(0.0254, v), 9) for v, _, _ in jumps] == [1.0, 150.0]
+    assert all(above > below for _, below, above in jumps)
+    assert model.static_force(0.02) == pytest.approx((math.pi**2 / 4 + 3 * math.pi) * 0.02**2 * 30.5)
+
+
+def test_submergence_half():
+    sub = sediment.submergence(1.0, 0.0)
+    assert sub == pytest.approx({"volume": 0.5, "area": 1.0, "wetted": 0.5})
+
+
+def test_rayleigh_time_example():
+    assert sediment.rayleigh_time(0.05e-3, 2700, 30e9, 0.25) == pytest.approx(8.12e-8, rel=1e-3)
+
+
+@pytest.mark.parametrize("call, message", [
+    (lambda: sediment.DragModel("stoke", 1000, 1e-3), "unknown drag law 'stoke'"),
+    (lambda: sediment.DragModel("stokes", -1, 1e-3), "density must be > 0"),
+    (lambda: sediment.DragModel("stokes", 1000, 0), "viscosity must be > 0"),
+    (lambda: sediment.terminal_velocity("stokes", 1000, 1e-3, 0, -1e-4, 2700), "diameter must be > 0"),
+    (lambda: sediment.time_to_fraction("stokes", 1000, 1e-3, 0, 1e-4, 2700, 9.81, 1.5), "fraction must be in"),
+])
+def test_bad_input_raises_clear_errors(call, message):
+    with pytest.raises(ValueError, match=message):
+        call()
