@@ -35,24 +35,26 @@ FixFluid::FixFluid(LAMMPS *lmp, int narg, char **arg) :
     if (strcmp(keyword, "density") == 0) {
       need(1, keyword);
       fluid.density = utils::numeric(FLERR, arg[iarg + 1], false, lmp);
-      if (!(fluid.density > 0.0)) error->all(FLERR, "Fix fluid: density must be > 0");
+      if (!(fluid.density > 0.0) || !std::isfinite(fluid.density))
+        error->all(FLERR, "Fix fluid: density must be finite and > 0");
       has_density = true;
       iarg += 2;
     } else if (strcmp(keyword, "viscosity") == 0) {
       need(1, keyword);
       fluid.viscosity = utils::numeric(FLERR, arg[iarg + 1], false, lmp);
-      if (!(fluid.viscosity > 0.0)) error->all(FLERR, "Fix fluid: viscosity must be > 0");
+      if (!(fluid.viscosity > 0.0) || !std::isfinite(fluid.viscosity))
+        error->all(FLERR, "Fix fluid: viscosity must be finite and > 0");
       has_viscosity = true;
       iarg += 2;
     } else if (strcmp(keyword, "bingham") == 0) {
       need(2, keyword);
       fluid.yield_stress = utils::numeric(FLERR, arg[iarg + 1], false, lmp);
       fluid.viscosity = utils::numeric(FLERR, arg[iarg + 2], false, lmp);
-      if (!(fluid.yield_stress > 0.0))
-        error->all(FLERR, "Fix fluid: bingham yield stress must be > 0 (use viscosity for a "
-                          "Newtonian fluid)");
-      if (!(fluid.viscosity > 0.0))
-        error->all(FLERR, "Fix fluid: bingham plastic viscosity must be > 0");
+      if (!(fluid.yield_stress > 0.0) || !std::isfinite(fluid.yield_stress))
+        error->all(FLERR, "Fix fluid: bingham yield stress must be finite and > 0 (use viscosity "
+                          "for a Newtonian fluid)");
+      if (!(fluid.viscosity > 0.0) || !std::isfinite(fluid.viscosity))
+        error->all(FLERR, "Fix fluid: bingham plastic viscosity must be finite and > 0");
       has_bingham = true;
       iarg += 3;
     } else if (strcmp(keyword, "surface") == 0) {
@@ -65,7 +67,8 @@ FixFluid::FixFluid(LAMMPS *lmp, int narg, char **arg) :
         for (int k = 0; k < 3; ++k) point[k] = utils::numeric(FLERR, arg[iarg + 2 + k], false, lmp);
         for (int k = 0; k < 3; ++k) normal[k] = utils::numeric(FLERR, arg[iarg + 5 + k], false, lmp);
         const double len = sqrt(normal[0] * normal[0] + normal[1] * normal[1] + normal[2] * normal[2]);
-        if (!(len > 0.0)) error->all(FLERR, "Fix fluid: surface plane normal must be non-zero");
+        if (!(len > 0.0) || !std::isfinite(len))
+          error->all(FLERR, "Fix fluid: surface plane normal must be finite and non-zero");
         surface_offset = 0.0;
         for (int k = 0; k < 3; ++k) {
           normal[k] /= len;

@@ -113,7 +113,11 @@ def case_c_deck(rows: list[dict], path: Path, law: str) -> None:
 
 @check
 def case_c(np_ranks: int):
-    with open(SHARED / "data" / "vw1965_dev.csv") as f:
+    data = SHARED / "data" / "vw1965_dev.csv"
+    if not data.is_file():
+        raise FileNotFoundError(f"{data} not found: the project's shared/ folder must sit beside the "
+                                "repository (or set SEDIMENT_SHARED)")
+    with open(data) as f:
         rows = [{k: float(v) for k, v in r.items()} for r in csv.DictReader(f)]
     for law in ("zhang-li", "zhang-li/smooth"):
         with tempfile.TemporaryDirectory() as tmp:
@@ -282,12 +286,17 @@ def mpi_consistency(np_ranks: int):
 
 # ---- bad input ----------------------------------------------------------------------------------
 BAD_INPUT = [
-    ("fix f all fluid density -1 viscosity 1e-3", "density must be > 0"),
-    ("fix f all fluid density 1000 viscosity 0", "viscosity must be > 0"),
+    ("fix f all fluid density -1 viscosity 1e-3", "density must be finite and > 0"),
+    ("fix f all fluid density 1e400 viscosity 1e-3", "density must be finite and > 0"),
+    ("fix f all fluid density 1000 viscosity 0", "viscosity must be finite and > 0"),
+    ("fix f all fluid density 1000 viscosity 1e999", "viscosity must be finite and > 0"),
+    ("fix f all fluid density 1000 viscosity nan", "Expected floating point parameter"),
+    ("fix f all fluid density 1000 viscosity 1e-3 surface plane 0 0 0 0 0 0", "normal must be finite and non-zero"),
     ("fix f all fluid density 1000", "give exactly one of 'viscosity MU' or 'bingham TAU_Y ETA_B'"),
     ("fix f all fluid viscosity 1e-3", "keyword 'density' is required"),
     ("fix f all fluid density 1000 viscosity 1e-3 colour red", "unknown keyword 'colour'"),
-    ("fix f all fluid density 1000 bingham -3 0.1", "bingham yield stress must be > 0"),
+    ("fix f all fluid density 1000 bingham -3 0.1", "bingham yield stress must be finite and > 0"),
+    ("fix f all fluid density 1000 bingham 3 -0.1", "bingham plastic viscosity must be finite and > 0"),
     ("fix f all fluid density 1000 viscosity 1e-3 surface w 0", "surface axis must be x, y, z or plane"),
     ("fix f all fluid density 1000 viscosity", "keyword 'viscosity' needs 1 value"),
     ("fix f all fluid density abc viscosity 1e-3", "Expected floating point parameter"),
