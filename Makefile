@@ -28,7 +28,7 @@ test-cpp: build
 	cd $(BUILD) && ctest -j $(JOBS) --output-on-failure
 
 test-python: build
-	PYTHONPATH=python SEDIMENT_LMP=$(BUILD)/lmp_sediment $(PYTHON) -m pytest -q tests/python
+	PYTHONPATH=python SEDIMENT_LMP=$(abspath $(BUILD))/lmp_sediment $(PYTHON) -m pytest -q tests/python
 
 test: test-cpp test-python
 

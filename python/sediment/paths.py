@@ -15,5 +15,5 @@ def lmp_executable() -> str:
                   shutil.which("lmp_sediment")]
     for candidate in candidates:
         if candidate and Path(candidate).is_file():
-            return candidate
+            return str(Path(candidate).resolve())
     raise FileNotFoundError("lmp_sediment not found: build it with `make build` or set SEDIMENT_LMP")
