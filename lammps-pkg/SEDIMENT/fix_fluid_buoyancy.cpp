@@ -13,14 +13,13 @@
 #include "update.h"
 
 #include <cstring>
-#include <mpi.h>
 
 using namespace LAMMPS_NS;
 using namespace FixConst;
 
 FixFluidBuoyancy::FixFluidBuoyancy(LAMMPS *lmp, int narg, char **arg) :
     Fix(lmp, narg, arg), fluid_id(nullptr), gravity_id(nullptr), fluid(nullptr),
-    gravity(nullptr), totals_reduced(0)
+    gravity(nullptr)
 {
   if (narg < 4) error->all(FLERR, "Fix fluid/buoyancy: expected 'fix ID group fluid/buoyancy FLUID-ID'");
   fluid_id = utils::strdup(arg[3]);
@@ -42,8 +41,6 @@ FixFluidBuoyancy::FixFluidBuoyancy(LAMMPS *lmp, int narg, char **arg) :
   size_vector = 4;
   global_freq = 1;
   extvector = 1;
-  for (double &t : totals) t = 0.0;
-  for (double &t : totals_all) t = 0.0;
 }
 
 FixFluidBuoyancy::~FixFluidBuoyancy()
@@ -101,8 +98,7 @@ void FixFluidBuoyancy::post_force(int /*vflag*/)
   const double rho = fluid->properties().density;
 
   fluid->prepare();
-  for (double &t : totals) t = 0.0;
-  totals_reduced = 0;
+  totals.clear();
   for (int i = 0; i < nlocal; ++i) {
     if (!(mask[i] & groupbit)) continue;
     const sediment::Submergence sub = fluid->immersion(x[i], radius[i]);
@@ -119,9 +115,5 @@ void FixFluidBuoyancy::post_force(int /*vflag*/)
 
 double FixFluidBuoyancy::compute_vector(int n)
 {
-  if (!totals_reduced) {
-    MPI_Allreduce(totals, totals_all, 4, MPI_DOUBLE, MPI_SUM, world);
-    totals_reduced = 1;
-  }
-  return totals_all[n];
+  return totals.total(n, world);
 }

@@ -12,6 +12,7 @@ FixStyle(fluid/buoyancy,FixFluidBuoyancy);
 #define LMP_FIX_FLUID_BUOYANCY_H
 
 #include "fix.h"
+#include "sediment_rank_sums.h"
 
 namespace LAMMPS_NS {
 
@@ -29,9 +30,7 @@ class FixFluidBuoyancy : public Fix {
   char *fluid_id, *gravity_id;
   class FixFluid *fluid;
   double *gravity;            // acceleration vector owned by the fix gravity
-  double totals[4];           // force on the group (3) and number of spheres in the fluid
-  double totals_all[4];
-  int totals_reduced;
+  RankSums<4> totals;         // force on the group (3) and number of spheres in the fluid
 };
 
 }    // namespace LAMMPS_NS

@@ -22,7 +22,7 @@ using namespace FixConst;
 
 FixFluidDrag::FixFluidDrag(LAMMPS *lmp, int narg, char **arg) :
     Fix(lmp, narg, arg), fluid_id(nullptr), fluid(nullptr), law(sediment::DragLaw::Stokes),
-    rotation(0), implicit_groupbit(0), totals_reduced(0)
+    rotation(0), implicit_groupbit(0)
 {
   if (narg < 6)
     error->all(FLERR, "Fix fluid/drag: expected 'fix ID group fluid/drag FLUID-ID law NAME'");
@@ -62,8 +62,6 @@ FixFluidDrag::FixFluidDrag(LAMMPS *lmp, int narg, char **arg) :
   size_vector = 4;
   global_freq = 1;
   extvector = 1;
-  for (double &t : totals) t = 0.0;
-  for (double &t : totals_all) t = 0.0;
 }
 
 FixFluidDrag::~FixFluidDrag()
@@ -127,8 +125,7 @@ void FixFluidDrag::post_force(int /*vflag*/)
   const double *u = fluid->velocity();
 
   fluid->prepare();
-  for (double &t : totals) t = 0.0;
-  totals_reduced = 0;
+  totals.clear();
   for (int i = 0; i < nlocal; ++i) {
     if (!(mask[i] & groupbit) || (mask[i] & implicit_groupbit)) continue;
     const sediment::SphereDrag drag = sphere_drag(i);
@@ -177,9 +174,5 @@ int FixFluidDrag::count_unstable_explicit()
 double FixFluidDrag::compute_vector(int n)
 {
   if (n == 3) return count_unstable_explicit();
-  if (!totals_reduced) {
-    MPI_Allreduce(totals, totals_all, 3, MPI_DOUBLE, MPI_SUM, world);
-    totals_reduced = 1;
-  }
-  return totals_all[n];
+  return totals.total(n, world);
 }

@@ -14,6 +14,7 @@ FixStyle(fluid/drag,FixFluidDrag);
 #define LMP_FIX_FLUID_DRAG_H
 
 #include "fix.h"
+#include "sediment_rank_sums.h"
 
 #include "sediment/integrator.hpp"
 
@@ -44,9 +45,7 @@ class FixFluidDrag : public Fix {
   std::unique_ptr<sediment::DragModel> model;
   int rotation;
   int implicit_groupbit;    // atoms advanced by fix nve/sphere/fluid: no explicit drag
-  double totals[4];        // drag force on explicit atoms (3), spheres with dt > 2 tau
-  double totals_all[4];
-  int totals_reduced;
+  RankSums<3> totals;      // drag force on the explicitly integrated atoms
 
   int count_unstable_explicit();
 };

@@ -16,7 +16,6 @@
 #include "update.h"
 
 #include <cstring>
-#include <mpi.h>
 
 using namespace LAMMPS_NS;
 using namespace FixConst;
@@ -24,7 +23,7 @@ using namespace FixConst;
 static constexpr double INERTIA = 0.4;    // moment of inertia prefactor for a solid sphere
 
 FixNVESphereFluid::FixNVESphereFluid(LAMMPS *lmp, int narg, char **arg) :
-    Fix(lmp, narg, arg), weights(nullptr), counts_reduced(0)
+    Fix(lmp, narg, arg), weights(nullptr)
 {
   if (narg > 3)
     error->all(FLERR, "Fix nve/sphere/fluid: unexpected argument '{}' (the style takes none)", arg[3]);
@@ -38,7 +37,6 @@ FixNVESphereFluid::FixNVESphereFluid(LAMMPS *lmp, int narg, char **arg) :
   global_freq = 1;
   extvector = 1;
   maxexchange = NCOLS;
-  counts[0] = counts[1] = counts_all[0] = counts_all[1] = 0.0;
 
   grow_arrays(atom->nmax);
   atom->add_callback(Atom::GROW);
@@ -85,8 +83,7 @@ void FixNVESphereFluid::initial_integrate(int /*vflag*/)
   static const double no_flow[3] = {0.0, 0.0, 0.0};
 
   for (FixFluidDrag *drag : drags) drag->fluid_fix()->prepare();
-  counts[0] = counts[1] = 0.0;
-  counts_reduced = 0;
+  counts.clear();
 
   for (int i = 0; i < nlocal; ++i) {
     if (!(mask[i] & groupbit)) continue;
@@ -195,11 +192,7 @@ void FixNVESphereFluid::nve_sphere_half_step(int i)
 
 double FixNVESphereFluid::compute_vector(int n)
 {
-  if (!counts_reduced) {
-    MPI_Allreduce(counts, counts_all, 2, MPI_DOUBLE, MPI_SUM, world);
-    counts_reduced = 1;
-  }
-  return counts_all[n];
+  return counts.total(n, world);
 }
 
 void FixNVESphereFluid::grow_arrays(int nmax)

@@ -13,6 +13,7 @@ FixStyle(nve/sphere/fluid,FixNVESphereFluid);
 #define LMP_FIX_NVE_SPHERE_FLUID_H
 
 #include "fix.h"
+#include "sediment_rank_sums.h"
 
 #include <vector>
 
@@ -43,9 +44,7 @@ class FixNVESphereFluid : public Fix {
   std::vector<class FixFluidDrag *> drags;
   void nve_sphere_half_step(int i);
 
-  double counts[2];    // spheres stuck by the yield stress, held at a Cd jump
-  double counts_all[2];
-  int counts_reduced;
+  RankSums<2> counts;    // spheres stuck by the yield stress, held at a Cd jump
 };
 
 }    // namespace LAMMPS_NS
