@@ -20,6 +20,7 @@ constexpr LawName law_names[] = {
     {DragLaw::Dallavalle, "dallavalle"},
     {DragLaw::ZhangLi, "zhang-li"},
     {DragLaw::ZhangLiSmooth, "zhang-li/smooth"},
+    {DragLaw::DiFelice, "difelice"},
 };
 
 // Reynolds numbers where the faithful laws switch branch.
@@ -64,7 +65,8 @@ DragCurve drag_curve(DragLaw law, double re)
         return {24.0 * (1.0 + p), re > 0.0 ? 24.0 * 0.687 * p / re : 0.0};
       }
       return {0.44 * re, 0.44};
-    case DragLaw::Dallavalle: {
+    case DragLaw::Dallavalle:
+    case DragLaw::DiFelice: {    // the single-sphere curve; hindrance is applied per sphere
       // Cd = (0.63 + 4.8 / sqrt(Re))^2  =>  Cd Re = (0.63 sqrt(Re) + 4.8)^2
       const double root = std::sqrt(re);
       const double inner = 0.63 * root + 4.8;
@@ -86,7 +88,30 @@ DragCurve drag_curve(DragLaw law, double re)
 
 double drag_coefficient(DragLaw law, double re) { return drag_curve(law, re).g / re; }
 
-DragModel::DragModel(DragLaw law, const Fluid &fluid) : law_(law), fluid_(fluid) {}
+Exponent di_felice_exponent(double re)
+{
+  if (!(re > 0.0)) return {3.7, 0.0};
+  const double t = 1.5 - std::log10(re);
+  const double bump = 0.65 * std::exp(-0.5 * t * t);
+  // d/dRe of -bump = -bump * t / (Re ln 10)
+  return {3.7 - bump, -bump * t / (re * std::log(10.0))};
+}
+
+DragModel::DragModel(DragLaw law, const Fluid &fluid, HindranceBuoyancy buoyancy) :
+    law_(law), fluid_(fluid), hindrance_offset_(buoyancy == HindranceBuoyancy::Plain ? 1.0 : 0.0)
+{
+}
+
+DragCurve DragModel::curve(double re, double voidage) const
+{
+  const DragCurve single = drag_curve(law_, re);
+  if (law_ != DragLaw::DiFelice || voidage >= 1.0) return single;
+  // G eps^-(chi(Re) + offset): the exponent depends on Re, so the slope has a second term.
+  const Exponent chi = di_felice_exponent(re);
+  const double log_eps = std::log(voidage);
+  const double factor = std::exp(-(chi.value + hindrance_offset_) * log_eps);
+  return {single.g * factor, (single.dg - single.g * log_eps * chi.slope) * factor};
+}
 
 double DragModel::viscous_scale(double d, double speed) const
 {
@@ -115,27 +140,27 @@ double DragModel::force_at(double d, double speed, double g, DragScale scale) co
 
 double DragModel::force(double d, double speed, DragScale scale) const
 {
-  return force_at(d, speed, drag_curve(law_, reynolds(d, speed)).g, scale);
+  return force_at(d, speed, curve(reynolds(d, speed), scale.voidage).g, scale);
 }
 
 double DragModel::static_force(double d, DragScale scale) const
 {
   if (fluid_.yield_stress <= 0.0) return 0.0;
-  return force_at(d, 0.0, drag_curve(law_, 0.0).g, scale);
+  return force_at(d, 0.0, curve(0.0, scale.voidage).g, scale);
 }
 
 double DragModel::tangent(double d, double speed, DragScale scale) const
 {
   const double re = reynolds(d, speed);
-  const DragCurve curve = drag_curve(law_, re);
+  const DragCurve g = curve(re, scale.voidage);
   const double visc = viscous_scale(d, speed);
-  double dforce = fluid_.viscosity / d * curve.g;
+  double dforce = fluid_.viscosity / d * g.g;
   if (speed > 0.0) {
     // dRe'/ds = rho s (2 tau_y + eta s / d) / (tau_y + eta s / d)^2
     const double dre =
         fluid_.density * speed * (2.0 * fluid_.yield_stress + fluid_.viscosity * speed / d) /
         (visc * visc);
-    dforce += visc * curve.dg * dre;
+    dforce += visc * g.dg * dre;
   }
   return scale.area * 0.5 * sphere_area(d) * dforce;
 }

@@ -17,6 +17,19 @@ using namespace sediment;
 
 namespace {
 
+HindranceBuoyancy parse_buoyancy(const std::string &name)
+{
+  if (name == "plain") return HindranceBuoyancy::Plain;
+  if (name == "mixture") return HindranceBuoyancy::Mixture;
+  throw py::value_error("buoyancy must be 'plain' or 'mixture', not '" + name + "'");
+}
+
+DragScale voidage_scale(double voidage)
+{
+  if (!(voidage > 0.0 && voidage <= 1.0)) throw py::value_error("voidage must be in (0, 1]");
+  return {1.0, 1.0, voidage};
+}
+
 DragLaw parse_law(const std::string &name)
 {
   const auto law = drag_law_from_name(name);
@@ -51,7 +64,7 @@ PYBIND11_MODULE(_core, m)
   m.def("drag_law_names", [] {
     std::vector<std::string> names;
     for (auto law : {DragLaw::Stokes, DragLaw::SchillerNaumann, DragLaw::Dallavalle, DragLaw::ZhangLi,
-                     DragLaw::ZhangLiSmooth})
+                     DragLaw::ZhangLiSmooth, DragLaw::DiFelice})
       names.emplace_back(drag_law_name(law));
     return names;
   }, "Names of the drag laws.");
@@ -62,15 +75,25 @@ PYBIND11_MODULE(_core, m)
   }, py::arg("law"), py::arg("reynolds"), "Cd(Re) of a law (Re' for the Bingham laws).");
 
   py::class_<DragModel>(m, "DragModel", "Resisting-force curve of a sphere under one drag law.")
-      .def(py::init([](const std::string &law, double density, double viscosity, double yield_stress) {
-             return DragModel(parse_law(law), make_fluid(density, viscosity, yield_stress));
+      .def(py::init([](const std::string &law, double density, double viscosity, double yield_stress,
+                       const std::string &buoyancy) {
+             return DragModel(parse_law(law), make_fluid(density, viscosity, yield_stress), parse_buoyancy(buoyancy));
            }),
-           py::arg("law"), py::arg("density"), py::arg("viscosity"), py::arg("yield_stress") = 0.0)
+           py::arg("law"), py::arg("density"), py::arg("viscosity"), py::arg("yield_stress") = 0.0,
+           py::arg("buoyancy") = "plain")
       .def("reynolds", &DragModel::reynolds, py::arg("d"), py::arg("speed"))
-      .def("force", [](const DragModel &model, double d, double speed) { return model.force(d, speed); },
-           py::arg("d"), py::arg("speed"), "Resisting force magnitude [N] at slip speed > 0.")
-      .def("tangent", [](const DragModel &model, double d, double speed) { return model.tangent(d, speed); },
-           py::arg("d"), py::arg("speed"), "dF/ds [N s/m].")
+      .def("force", [](const DragModel &model, double d, double speed, double voidage) {
+             return model.force(d, speed, voidage_scale(voidage));
+           }, py::arg("d"), py::arg("speed"), py::arg("voidage") = 1.0,
+           "Resisting force magnitude [N] at slip speed > 0 (voidage: local fluid fraction, difelice).")
+      .def("tangent", [](const DragModel &model, double d, double speed, double voidage) {
+             return model.tangent(d, speed, voidage_scale(voidage));
+           }, py::arg("d"), py::arg("speed"), py::arg("voidage") = 1.0, "dF/ds [N s/m].")
+      .def("steady_speed", [](const DragModel &model, double d, double driving_force, double voidage) {
+             const TerminalState state = steady_speed(model, d, driving_force, voidage_scale(voidage));
+             return py::make_tuple(state.speed, regime_name(state.regime));
+           }, py::arg("d"), py::arg("driving_force"), py::arg("voidage") = 1.0,
+           "Speed where the resisting force balances a driving force [N], and the regime.")
       .def("static_force", [](const DragModel &model, double d) { return model.static_force(d); },
            py::arg("d"), "Largest force a sphere at rest resists (yield) [N].")
       .def("jumps", [](const DragModel &model, double d) {

@@ -1,6 +1,7 @@
 // Drag laws against their closed forms (physics.md sections 2 and 4).
 #include "sediment/drag.hpp"
 #include "sediment/geometry.hpp"
+#include "sediment/terminal.hpp"
 
 #include <gtest/gtest.h>
 
@@ -18,7 +19,7 @@ double newtonian_force(double cd, double d, double v) { return 0.5 * water.densi
 TEST(DragLaw, NamesRoundTrip)
 {
   for (auto law : {DragLaw::Stokes, DragLaw::SchillerNaumann, DragLaw::Dallavalle, DragLaw::ZhangLi,
-                   DragLaw::ZhangLiSmooth})
+                   DragLaw::ZhangLiSmooth, DragLaw::DiFelice})
     EXPECT_EQ(drag_law_from_name(drag_law_name(law)), law);
   EXPECT_FALSE(drag_law_from_name("stokes2").has_value());
   EXPECT_NE(drag_law_names().find("schiller-naumann"), std::string::npos);
@@ -137,4 +138,54 @@ TEST(DragLaw, PartialSubmergenceScalesAreaAndYield)
   const DragScale half{0.5, 0.25};
   const double yield = pi * pi / 4.0 * d * d * clay.yield_stress;
   EXPECT_NEAR(model.force(d, v, half), 0.25 * yield + 0.5 * (model.force(d, v) - yield), 1e-12 * yield);
+}
+
+TEST(DiFelice, UnhinderedIsDallavalle)
+{
+  const DragModel felice(DragLaw::DiFelice, water), dalla(DragLaw::Dallavalle, water);
+  for (double v : {1e-6, 1e-3, 0.2}) {
+    EXPECT_EQ(felice.force(1e-4, v), dalla.force(1e-4, v));
+    EXPECT_EQ(felice.tangent(1e-4, v), dalla.tangent(1e-4, v));
+  }
+}
+
+TEST(DiFelice, ExponentAndItsSlope)
+{
+  EXPECT_NEAR(di_felice_exponent(std::pow(10.0, 1.5)).value, 3.05, 1e-12);    // dip at log10 Re = 1.5
+  EXPECT_NEAR(di_felice_exponent(1e-8).value, 3.7, 1e-12);
+  EXPECT_EQ(di_felice_exponent(0.0).value, 3.7);
+  for (double re : {0.01, 1.0, 30.0, 500.0}) {
+    const double h = 1e-6 * re;
+    const double fd = (di_felice_exponent(re + h).value - di_felice_exponent(re - h).value) / (2 * h);
+    EXPECT_NEAR(di_felice_exponent(re).slope, fd, 1e-7 * std::abs(fd) + 1e-14) << re;
+  }
+}
+
+TEST(DiFelice, HinderedTangentMatchesFiniteDifference)
+{
+  for (auto buoyancy : {HindranceBuoyancy::Plain, HindranceBuoyancy::Mixture}) {
+    const DragModel model(DragLaw::DiFelice, water, buoyancy);
+    const DragScale dense{1.0, 1.0, 0.65};
+    for (double v : {1e-4, 1e-2, 0.3}) {
+      const double d = 1e-3, h = 1e-4 * v;
+      const double fd = (model.force(d, v + h, dense) - model.force(d, v - h, dense)) / (2 * h);
+      EXPECT_NEAR(model.tangent(d, v, dense), fd, 1e-6 * fd) << v;
+    }
+  }
+}
+
+// Richardson & Zaki (1954): u / u_t = eps^4.65 at low Re; Di Felice with plain buoyancy gives
+// eps^(chi + 1) = eps^4.7 there, within 3 % up to phi = 0.4 (validation case G).
+TEST(DiFelice, LowReynoldsHinderedSettlingFollowsRichardsonZaki)
+{
+  const DragModel model(DragLaw::DiFelice, water);
+  const double d = 5e-6, weight = 1650.0 * 9.81 * sphere_volume(d);
+  const double single = steady_speed(model, d, weight).speed;
+  const double expected[] = {0.613, 0.354, 0.190, 0.093};
+  const double phis[] = {0.1, 0.2, 0.3, 0.4};
+  for (int k = 0; k < 4; ++k) {
+    const double hindered = steady_speed(model, d, weight, DragScale{1.0, 1.0, 1.0 - phis[k]}).speed;
+    EXPECT_NEAR(hindered / single, std::pow(1.0 - phis[k], 4.65), 0.03 * std::pow(1.0 - phis[k], 4.65)) << phis[k];
+    EXPECT_NEAR(hindered / single, expected[k], 0.03 * expected[k]) << phis[k];
+  }
 }

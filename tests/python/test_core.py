@@ -16,7 +16,8 @@ def test_case_a_terminal_velocity_and_tau():
 
 
 def test_law_names_and_coefficients():
-    assert sediment.drag_law_names() == ["stokes", "schiller-naumann", "dallavalle", "zhang-li", "zhang-li/smooth"]
+    assert sediment.drag_law_names() == ["stokes", "schiller-naumann", "dallavalle", "zhang-li", "zhang-li/smooth",
+                                         "difelice"]
     assert sediment.drag_coefficient("schiller-naumann", 10.0) == pytest.approx(2.4 * (1 + 0.15 * 10**0.687))
     assert sediment.drag_coefficient("dallavalle", 4.0) == pytest.approx((0.63 + 2.4) ** 2)
     assert sediment.drag_coefficient("zhang-li", 10.0) == pytest.approx(2.912 + 0.195)
@@ -50,3 +51,19 @@ def test_rayleigh_time_example():
 def test_bad_input_raises_clear_errors(call, message):
     with pytest.raises(ValueError, match=message):
         call()
+
+
+@pytest.mark.parametrize("phi, richardson_zaki", [(0.1, 0.613), (0.2, 0.354), (0.3, 0.190), (0.4, 0.093)])
+def test_difelice_hindered_settling_near_richardson_zaki(phi, richardson_zaki):
+    model = sediment.DragModel("difelice", 1000.0, 1e-3)
+    weight = 1650 * 9.81 * math.pi / 6 * (5e-6) ** 3
+    single, _ = model.steady_speed(5e-6, weight)
+    hindered, _ = model.steady_speed(5e-6, weight, voidage=1 - phi)
+    assert hindered / single == pytest.approx(richardson_zaki, rel=0.03)
+
+
+def test_voidage_and_buoyancy_are_validated():
+    with pytest.raises(ValueError, match="voidage must be in"):
+        sediment.DragModel("difelice", 1000, 1e-3).force(1e-4, 1e-3, voidage=0.0)
+    with pytest.raises(ValueError, match="buoyancy must be 'plain' or 'mixture'"):
+        sediment.DragModel("difelice", 1000, 1e-3, buoyancy="heavy")

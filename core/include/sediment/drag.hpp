@@ -15,7 +15,11 @@
 
 namespace sediment {
 
-enum class DragLaw { Stokes, SchillerNaumann, Dallavalle, ZhangLi, ZhangLiSmooth };
+enum class DragLaw { Stokes, SchillerNaumann, Dallavalle, ZhangLi, ZhangLiSmooth, DiFelice };
+
+// Which buoyancy the Di Felice hindrance goes with (physics.md 3.1): plain Archimedes buoyancy
+// (factor eps^-(chi+1)) or buoyancy from the mixture density (factor eps^-chi).
+enum class HindranceBuoyancy { Plain, Mixture };
 
 std::optional<DragLaw> drag_law_from_name(std::string_view name);
 const char *drag_law_name(DragLaw law);
@@ -43,17 +47,26 @@ struct ForceJump {
   double force_above;
 };
 
-// Projected-area and yield (wetted-surface) scale factors; both 1 for a fully immersed sphere.
+// Per-sphere surroundings: projected-area and yield (wetted-surface) scale factors, both 1 for a
+// fully immersed sphere, and the local fluid fraction eps = 1 - phi (used by the Di Felice law).
 struct DragScale {
   double area = 1.0;
   double wetted = 1.0;
+  double voidage = 1.0;
 };
+
+// Di Felice (1994) exponent chi(Re) = 3.7 - 0.65 exp(-(1.5 - log10 Re)^2 / 2) and d chi / d Re.
+struct Exponent {
+  double value;
+  double slope;
+};
+Exponent di_felice_exponent(double re);
 
 class DragModel {
  public:
   static constexpr int max_jumps = 2;
 
-  DragModel(DragLaw law, const Fluid &fluid);
+  DragModel(DragLaw law, const Fluid &fluid, HindranceBuoyancy buoyancy = HindranceBuoyancy::Plain);
 
   DragLaw law() const { return law_; }
   const Fluid &fluid() const { return fluid_; }
@@ -72,8 +85,11 @@ class DragModel {
   double viscous_scale(double d, double speed) const;    // tau_y + eta s / d
   double speed_at_reynolds(double d, double re) const;  // inverse of reynolds()
   double force_at(double d, double speed, double g, DragScale scale) const;
+  // Cd Re' of the law at this sphere, with the Di Felice hindrance when it applies.
+  DragCurve curve(double re, double voidage) const;
 
   DragLaw law_;
+  double hindrance_offset_;    // 1: eps^-(chi+1), 0: eps^-chi
   Fluid fluid_;
 };
 
