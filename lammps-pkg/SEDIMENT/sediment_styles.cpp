@@ -4,6 +4,7 @@
 
 #include "sediment_styles.h"
 
+#include "compute_concentration_grid.h"
 #include "fix_fluid.h"
 #include "fix_fluid_buoyancy.h"
 #include "fix_fluid_drag.h"
@@ -23,6 +24,11 @@ template <typename T> Fix *create_fix(LAMMPS *lmp, int narg, char **arg)
   return new T(lmp, narg, arg);
 }
 
+template <typename T> Compute *create_compute(LAMMPS *lmp, int narg, char **arg)
+{
+  return new T(lmp, narg, arg);
+}
+
 struct FixEntry {
   const char *name;
   const char *info;
@@ -36,11 +42,22 @@ const FixEntry fix_styles[] = {
     {"nve/sphere/fluid", "drag-implicit sphere integrator", &create_fix<FixNVESphereFluid>},
 };
 
+struct ComputeEntry {
+  const char *name;
+  const char *info;
+  Modify::ComputeCreator creator;
+};
+
+const ComputeEntry compute_styles[] = {
+    {"concentration/grid", "solid fraction per layer, size class and type", &create_compute<ComputeConcentrationGrid>},
+};
+
 }    // namespace
 
 void LAMMPS_NS::sediment_register_styles(LAMMPS *lmp)
 {
   for (const FixEntry &style : fix_styles) (*lmp->modify->fix_map)[style.name] = style.creator;
+  for (const ComputeEntry &style : compute_styles) (*lmp->modify->compute_map)[style.name] = style.creator;
 }
 
 extern "C" void sediment_register(void *lmp)
@@ -52,15 +69,19 @@ extern "C" void sediment_register(void *lmp)
 extern "C" void lammpsplugin_init(void *lmp, void *handle, void *regfunc)
 {
   auto reg = reinterpret_cast<lammpsplugin_regfunc>(regfunc);
-  for (const FixEntry &style : fix_styles) {
+  auto add = [&](const char *kind, const char *name, const char *info, void *creator) {
     lammpsplugin_t plugin;
     plugin.version = LAMMPS_VERSION;
-    plugin.style = "fix";
-    plugin.name = style.name;
-    plugin.info = style.info;
+    plugin.style = kind;
+    plugin.name = name;
+    plugin.info = info;
     plugin.author = "SEDIMENT developers";
-    plugin.creator.v2 = reinterpret_cast<lammpsplugin_factory2 *>(style.creator);
+    plugin.creator.v2 = reinterpret_cast<lammpsplugin_factory2 *>(creator);
     plugin.handle = handle;
     (*reg)(&plugin, lmp);
-  }
+  };
+  for (const FixEntry &style : fix_styles)
+    add("fix", style.name, style.info, reinterpret_cast<void *>(style.creator));
+  for (const ComputeEntry &style : compute_styles)
+    add("compute", style.name, style.info, reinterpret_cast<void *>(style.creator));
 }

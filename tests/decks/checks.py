@@ -284,6 +284,31 @@ def mpi_consistency(np_ranks: int):
     assert len(a) == len(b) and rel < 1e-10
 
 
+# ---- concentration grid ------------------------------------------------------------------------
+@check
+def concentration_grid(np_ranks: int):
+    with tempfile.TemporaryDirectory() as tmp:
+        profile, peratom = Path(tmp) / "profile.txt", Path(tmp) / "peratom.txt"
+        run_deck("concentration_grid.lmp", {"profile": profile, "peratom": peratom}, np_ranks)
+        table = np.loadtxt(profile, comments="#", skiprows=4)[:, 1:]    # drop the row index
+        atoms = np.loadtxt(peratom, skiprows=9)
+    z, total, classes, types = table[:, 0], table[:, 1], table[:, 2:5], table[:, 5:7]
+    cell = 0.01 * 0.01 * (0.02 / 80)
+    solid = float(np.sum(4 / 3 * np.pi * atoms[:, 2] ** 3))
+    conserved = abs(total.sum() * cell - solid) / solid
+    report(f"concentration grid: {len(atoms)} spheres, 80 layers; solid volume conserved to {conserved:.1e}; "
+           f"classes sum to total within {np.max(np.abs(classes.sum(axis=1) - total)):.1e}, "
+           f"types within {np.max(np.abs(types.sum(axis=1) - total)):.1e}; mean fraction {total.mean():.5f}")
+    assert conserved < 1e-12
+    assert np.allclose(classes.sum(axis=1), total, rtol=0, atol=1e-14)
+    assert np.allclose(types.sum(axis=1), total, rtol=0, atol=1e-14)
+    # type 2 holds a quarter of the spheres; per-atom values interpolate the total profile
+    assert 0.15 < types[:, 1].sum() / total.sum() < 0.35
+    interp = np.interp(atoms[:, 1], z, total)
+    inside = (atoms[:, 1] > z[0]) & (atoms[:, 1] < z[-1])
+    assert np.allclose(atoms[inside, 3], interp[inside], rtol=1e-12, atol=0)
+
+
 # ---- bad input ----------------------------------------------------------------------------------
 BAD_INPUT = [
     ("fix f all fluid density -1 viscosity 1e-3", "density must be finite and > 0"),
@@ -310,6 +335,14 @@ BAD_INPUT = [
     ("unfix grav\nfix f all fluid density 1000 viscosity 1e-3\nfix b all fluid/buoyancy f\nrun 0", "needs a fix gravity"),
     ("fix f all fluid density 1000 viscosity 1e-3\nfix b all fluid/buoyancy f gravity f\nrun 0", "is a fix fluid, not a fix gravity"),
     ("fix n all nve/sphere/fluid extra", "unexpected argument 'extra'"),
+    ("compute c all concentration/grid", "keyword 'layers AXIS N' is required"),
+    ("compute c all concentration/grid layers w 10", "layer axis must be x, y or z"),
+    ("compute c all concentration/grid layers z 0", "number of layers must be >= 1"),
+    ("compute c all concentration/grid layers z 10 bounds 1 0", "bounds need LO < HI"),
+    ("compute c all concentration/grid layers z 10 classes 2 1", "positive and increasing"),
+    ("compute c all concentration/grid layers z 10 thickness 1", "'thickness' is for 2d simulations only"),
+    ("compute c all concentration/grid layers z 10 smooth -1", "smooth width must be > 0"),
+    ("compute c all concentration/grid layers z 10 sieve 3", "unknown keyword 'sieve'"),
 ]
 
 

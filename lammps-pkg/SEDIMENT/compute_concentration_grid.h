@@ -1,0 +1,59 @@
+/* ----------------------------------------------------------------------
+   SEDIMENT package: solid volume fraction of spheres in layers along one
+   axis (exact sphere-slab volumes), optionally by size class and atom type.
+------------------------------------------------------------------------- */
+
+#ifdef COMPUTE_CLASS
+// clang-format off
+ComputeStyle(concentration/grid,ComputeConcentrationGrid);
+// clang-format on
+#else
+
+#ifndef LMP_COMPUTE_CONCENTRATION_GRID_H
+#define LMP_COMPUTE_CONCENTRATION_GRID_H
+
+#include "compute.h"
+
+#include "sediment/concentration.hpp"
+
+#include <vector>
+
+namespace LAMMPS_NS {
+
+class ComputeConcentrationGrid : public Compute {
+ public:
+  ComputeConcentrationGrid(class LAMMPS *, int, char **);
+  ~ComputeConcentrationGrid() override;
+  void init() override;
+  void compute_array() override;
+  void compute_peratom() override;
+  double memory_usage() override;
+
+  // The layers and the total solid-fraction profile of the last evaluation (for other styles).
+  const sediment::Layers &layer_geometry() const { return layers; }
+
+ private:
+  int axis;                           // 0, 1, 2 = x, y, z
+  int nlayers;
+  int has_bounds;
+  double bound_lo, bound_hi;
+  std::vector<double> class_edges;    // diameters separating the size classes
+  int by_type;
+  double thickness;                   // 2d: slab thickness converting areas to volumes
+  double smooth_width;                // 0: no smoothing
+  int ncols;                          // fraction columns: total, classes, types
+
+  sediment::Layers layers;
+  std::vector<double> local, fractions, scratch;
+  bigint profiled_step;
+  int nmax;
+
+  void profile();
+  int size_class(double diameter) const;
+  double cross_section() const;
+};
+
+}    // namespace LAMMPS_NS
+
+#endif
+#endif
