@@ -7,6 +7,7 @@
 #include "fix_fluid.h"
 
 #include "atom.h"
+#include "compute.h"
 #include "comm.h"
 #include "error.h"
 #include "modify.h"
@@ -22,7 +23,8 @@ using namespace FixConst;
 
 FixFluidDrag::FixFluidDrag(LAMMPS *lmp, int narg, char **arg) :
     Fix(lmp, narg, arg), fluid_id(nullptr), fluid(nullptr), law(sediment::DragLaw::Stokes),
-    rotation(0), implicit_groupbit(0)
+    hindrance_buoyancy(sediment::HindranceBuoyancy::Plain), concentration_id(nullptr),
+    concentration(nullptr), max_fraction(0.64), rotation(0), implicit_groupbit(0)
 {
   if (narg < 6)
     error->all(FLERR, "Fix fluid/drag: expected 'fix ID group fluid/drag FLUID-ID law NAME'");
@@ -48,11 +50,38 @@ FixFluidDrag::FixFluidDrag(LAMMPS *lmp, int narg, char **arg) :
       else
         error->all(FLERR, "Fix fluid/drag: rotation must be yes or no, not '{}'", arg[iarg + 1]);
       iarg += 2;
+    } else if (strcmp(arg[iarg], "concentration") == 0) {
+      if (iarg + 1 >= narg) error->all(FLERR, "Fix fluid/drag: keyword 'concentration' needs a compute ID");
+      const char *name = strncmp(arg[iarg + 1], "c_", 2) == 0 ? arg[iarg + 1] + 2 : arg[iarg + 1];
+      delete[] concentration_id;
+      concentration_id = utils::strdup(name);
+      iarg += 2;
+    } else if (strcmp(arg[iarg], "buoyancy") == 0) {
+      if (iarg + 1 >= narg) error->all(FLERR, "Fix fluid/drag: keyword 'buoyancy' needs plain or mixture");
+      if (strcmp(arg[iarg + 1], "plain") == 0)
+        hindrance_buoyancy = sediment::HindranceBuoyancy::Plain;
+      else if (strcmp(arg[iarg + 1], "mixture") == 0)
+        hindrance_buoyancy = sediment::HindranceBuoyancy::Mixture;
+      else
+        error->all(FLERR, "Fix fluid/drag: buoyancy must be plain or mixture, not '{}'", arg[iarg + 1]);
+      iarg += 2;
+    } else if (strcmp(arg[iarg], "max_fraction") == 0) {
+      if (iarg + 1 >= narg) error->all(FLERR, "Fix fluid/drag: keyword 'max_fraction' needs a value");
+      max_fraction = utils::numeric(FLERR, arg[iarg + 1], false, lmp);
+      if (!(max_fraction > 0.0 && max_fraction < 1.0))
+        error->all(FLERR, "Fix fluid/drag: max_fraction must be in (0, 1)");
+      iarg += 2;
     } else {
-      error->all(FLERR, "Fix fluid/drag: unknown keyword '{}' (expected law or rotation)", arg[iarg]);
+      error->all(FLERR, "Fix fluid/drag: unknown keyword '{}' (expected law, rotation, concentration, "
+                        "buoyancy or max_fraction)", arg[iarg]);
     }
   }
   if (!has_law) error->all(FLERR, "Fix fluid/drag: keyword 'law' is required");
+  if (law == sediment::DragLaw::DiFelice && !concentration_id)
+    error->all(FLERR, "Fix fluid/drag: law difelice needs keyword 'concentration c_ID' (a compute "
+                      "concentration/grid)");
+  if (law != sediment::DragLaw::DiFelice && concentration_id)
+    error->all(FLERR, "Fix fluid/drag: keyword 'concentration' applies to law difelice only");
   if (!atom->radius_flag || !atom->rmass_flag)
     error->all(FLERR, "Fix fluid/drag requires atom attributes radius and rmass (atom_style sphere)");
   if (rotation && (!atom->omega_flag || !atom->torque_flag))
@@ -67,6 +96,7 @@ FixFluidDrag::FixFluidDrag(LAMMPS *lmp, int narg, char **arg) :
 FixFluidDrag::~FixFluidDrag()
 {
   delete[] fluid_id;
+  delete[] concentration_id;
 }
 
 int FixFluidDrag::setmask()
@@ -77,7 +107,16 @@ int FixFluidDrag::setmask()
 void FixFluidDrag::init()
 {
   fluid = FixFluid::find(lmp, fluid_id, "fluid/drag");
-  model = std::make_unique<sediment::DragModel>(law, fluid->properties());
+  model = std::make_unique<sediment::DragModel>(law, fluid->properties(), hindrance_buoyancy);
+  concentration = nullptr;
+  if (concentration_id) {
+    const int icompute = modify->find_compute(concentration_id);
+    if (icompute < 0) error->all(FLERR, "Fix fluid/drag: compute '{}' does not exist", concentration_id);
+    concentration = modify->compute[icompute];
+    if (!concentration->peratom_flag || concentration->size_peratom_cols != 0)
+      error->all(FLERR, "Fix fluid/drag: compute '{}' does not give a per-atom vector of solid "
+                        "fractions (use compute concentration/grid)", concentration_id);
+  }
   implicit_groupbit = 0;
   for (int i = 0; i < modify->nfix; ++i)
     if (strcmp(modify->fix[i]->style, "nve/sphere/fluid") == 0)
@@ -94,6 +133,12 @@ void FixFluidDrag::setup(int vflag)
                    unstable);
 }
 
+void FixFluidDrag::prepare_step()
+{
+  fluid->prepare();
+  if (concentration && concentration->invoked_peratom != update->ntimestep) concentration->compute_peratom();
+}
+
 sediment::SphereDrag FixFluidDrag::sphere_drag(int i) const
 {
   sediment::SphereDrag drag;
@@ -104,6 +149,7 @@ sediment::SphereDrag FixFluidDrag::sphere_drag(int i) const
   drag.model = model.get();
   drag.diameter = 2.0 * radius;
   drag.scale = sub.drag_scale();
+  if (concentration) drag.scale.voidage = 1.0 - std::clamp(concentration->vector_atom[i], 0.0, max_fraction);
   return drag;
 }
 
@@ -124,7 +170,7 @@ void FixFluidDrag::post_force(int /*vflag*/)
   const int nlocal = atom->nlocal;
   const double *u = fluid->velocity();
 
-  fluid->prepare();
+  prepare_step();
   totals.clear();
   for (int i = 0; i < nlocal; ++i) {
     if (!(mask[i] & groupbit) || (mask[i] & implicit_groupbit)) continue;
@@ -154,7 +200,7 @@ int FixFluidDrag::count_unstable_explicit()
   double **v = atom->v;
   int *mask = atom->mask;
   const double *u = fluid->velocity();
-  fluid->prepare();
+  prepare_step();
   int count = 0;
   for (int i = 0; i < atom->nlocal; ++i) {
     if (!(mask[i] & groupbit) || (mask[i] & implicit_groupbit)) continue;

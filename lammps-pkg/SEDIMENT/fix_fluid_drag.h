@@ -33,6 +33,8 @@ class FixFluidDrag : public Fix {
   double compute_vector(int) override;
 
   class FixFluid *fluid_fix() const { return fluid; }
+  // Call once per step before sphere_drag(): refreshes the fluid region and the local fractions.
+  void prepare_step();
   // The drag on local atom i during this step (model nullptr if it is not in the group/fluid).
   sediment::SphereDrag sphere_drag(int i) const;
   // Linear rate of the rotational drag torque, torque = -rate * I * omega (0 if off).
@@ -42,7 +44,11 @@ class FixFluidDrag : public Fix {
   char *fluid_id;
   class FixFluid *fluid;
   sediment::DragLaw law;
+  sediment::HindranceBuoyancy hindrance_buoyancy;
   std::unique_ptr<sediment::DragModel> model;
+  char *concentration_id;
+  class Compute *concentration;    // per-atom local solid fraction (law difelice)
+  double max_fraction;             // local fractions are capped here
   int rotation;
   int implicit_groupbit;    // atoms advanced by fix nve/sphere/fluid: no explicit drag
   RankSums<3> totals;      // drag force on the explicitly integrated atoms

@@ -82,7 +82,7 @@ void FixNVESphereFluid::initial_integrate(int /*vflag*/)
   const double ftm2v = force->ftm2v;
   static const double no_flow[3] = {0.0, 0.0, 0.0};
 
-  for (FixFluidDrag *drag : drags) drag->fluid_fix()->prepare();
+  for (FixFluidDrag *drag : drags) drag->prepare_step();
   counts.clear();
 
   for (int i = 0; i < nlocal; ++i) {

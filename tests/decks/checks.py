@@ -309,6 +309,19 @@ def concentration_grid(np_ranks: int):
     assert np.allclose(atoms[inside, 3], interp[inside], rtol=1e-12, atol=0)
 
 
+@check
+def hindered_settling(np_ranks: int):
+    # Validation case G: Richardson & Zaki (1954), u / u_t = (1 - phi)^4.65 at low Re.
+    for phi, table in ((0.1, 0.613), (0.2, 0.354), (0.3, 0.190), (0.4, 0.093)):
+        out = run_deck("hindered_settling.lmp", {"phi": phi}, np_ranks)
+        ratio = out.results["hindered"] / out.results["single"]
+        rz = (1 - phi) ** 4.65
+        report(f"case G phi={phi}: u/u_t = {ratio:.4f}, Richardson-Zaki {rz:.4f} (table {table}), "
+               f"deviation {ratio / rz - 1:+.2%}; grid fraction {out.results['phi']:.6f}")
+        assert abs(out.results["phi"] - phi) < 1e-9
+        assert abs(ratio / rz - 1) < 0.05
+
+
 # ---- bad input ----------------------------------------------------------------------------------
 BAD_INPUT = [
     ("fix f all fluid density -1 viscosity 1e-3", "density must be finite and > 0"),
@@ -343,6 +356,11 @@ BAD_INPUT = [
     ("compute c all concentration/grid layers z 10 thickness 1", "'thickness' is for 2d simulations only"),
     ("compute c all concentration/grid layers z 10 smooth -1", "smooth width must be > 0"),
     ("compute c all concentration/grid layers z 10 sieve 3", "unknown keyword 'sieve'"),
+    ("fix f all fluid density 1000 viscosity 1e-3\nfix d all fluid/drag f law difelice", "law difelice needs keyword 'concentration c_ID'"),
+    ("fix f all fluid density 1000 viscosity 1e-3\nfix d all fluid/drag f law stokes concentration c_x", "applies to law difelice only"),
+    ("fix f all fluid density 1000 viscosity 1e-3\nfix d all fluid/drag f law difelice concentration c_x\nrun 0", "compute 'x' does not exist"),
+    ("fix f all fluid density 1000 viscosity 1e-3\nfix d all fluid/drag f law difelice concentration c_x buoyancy heavy", "buoyancy must be plain or mixture"),
+    ("fix f all fluid density 1000 viscosity 1e-3\nfix d all fluid/drag f law difelice concentration c_x max_fraction 1.2", "max_fraction must be in (0, 1)"),
 ]
 
 
