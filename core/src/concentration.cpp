@@ -53,20 +53,27 @@ double profile_at(const Layers &layers, const double *values, double x, int stri
 
 void smooth_profile(const Layers &layers, const double *values, double width, double *out)
 {
+  // Each layer's content is spread over its neighbours with Gaussian weights that sum to one;
+  // what would leave through an end is reflected back in (mirror ends). So the total is
+  // conserved exactly and a uniform profile stays uniform.
+  const int n = layers.count;
   const int reach = static_cast<int>(std::ceil(4.0 * width / layers.thickness));
   std::vector<double> kernel(reach + 1);
-  for (int j = 0; j <= reach; ++j) {
-    const double x = j * layers.thickness / width;
-    kernel[j] = std::exp(-0.5 * x * x);
+  double norm = 0.0;
+  for (int m = 0; m <= reach; ++m) {
+    const double x = m * layers.thickness / width;
+    kernel[m] = std::exp(-0.5 * x * x);
+    norm += m == 0 ? kernel[m] : 2.0 * kernel[m];
   }
-  for (int k = 0; k < layers.count; ++k) {
-    double sum = 0.0, weight = 0.0;
-    for (int j = std::max(0, k - reach); j <= std::min(layers.count - 1, k + reach); ++j) {
-      const double w = kernel[std::abs(j - k)];
-      sum += w * values[j];
-      weight += w;
-    }
-    out[k] = sum / weight;
+  auto fold = [n](int t) {
+    while (t < 0 || t >= n) t = t < 0 ? -t - 1 : 2 * n - t - 1;
+    return t;
+  };
+  std::fill(out, out + n, 0.0);
+  for (int j = 0; j < n; ++j) {
+    if (values[j] == 0.0) continue;
+    const double share = values[j] / norm;
+    for (int m = -reach; m <= reach; ++m) out[fold(j + m)] += share * kernel[std::abs(m)];
   }
 }
 

@@ -114,6 +114,16 @@ double ComputeConcentrationGrid::cross_section() const
   return domain->prd[(axis + 1) % 3] * domain->prd[(axis + 2) % 3];
 }
 
+std::vector<std::string> ComputeConcentrationGrid::column_names() const
+{
+  std::vector<std::string> names{"total"};
+  if (!class_edges.empty())
+    for (size_t k = 0; k <= class_edges.size(); ++k) names.push_back("class_" + std::to_string(k));
+  if (by_type)
+    for (int t = 1; t <= atom->ntypes; ++t) names.push_back("type_" + std::to_string(t));
+  return names;
+}
+
 int ComputeConcentrationGrid::size_class(double diameter) const
 {
   return static_cast<int>(std::upper_bound(class_edges.begin(), class_edges.end(), diameter) - class_edges.begin());

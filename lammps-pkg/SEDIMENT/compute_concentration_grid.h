@@ -16,6 +16,7 @@ ComputeStyle(concentration/grid,ComputeConcentrationGrid);
 
 #include "sediment/concentration.hpp"
 
+#include <string>
 #include <vector>
 
 namespace LAMMPS_NS {
@@ -29,8 +30,13 @@ class ComputeConcentrationGrid : public Compute {
   void compute_peratom() override;
   double memory_usage() override;
 
-  // The layers and the total solid-fraction profile of the last evaluation (for other styles).
+  // For fix layers/hdf5: the layers, the names of the fraction columns, the class edges.
   const sediment::Layers &layer_geometry() const { return layers; }
+  std::vector<std::string> column_names() const;
+  const std::vector<double> &class_diameters() const { return class_edges; }
+  int layer_axis() const { return axis; }
+  double slab_thickness() const { return thickness; }
+  double cross_section() const;
 
  private:
   int axis;                           // 0, 1, 2 = x, y, z
@@ -50,7 +56,6 @@ class ComputeConcentrationGrid : public Compute {
 
   void profile();
   int size_class(double diameter) const;
-  double cross_section() const;
 };
 
 }    // namespace LAMMPS_NS

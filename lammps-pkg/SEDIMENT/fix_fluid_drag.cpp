@@ -136,6 +136,13 @@ void FixFluidDrag::setup(int vflag)
 void FixFluidDrag::prepare_step()
 {
   fluid->prepare();
+}
+
+void FixFluidDrag::refresh_concentration()
+{
+  // Evaluated once positions are final for this step (post_force), never in initial_integrate:
+  // the implicit integrator of the next step reads these values, for the positions it starts
+  // from, and atoms are not reordered in between.
   if (concentration && concentration->invoked_peratom != update->ntimestep) concentration->compute_peratom();
 }
 
@@ -171,6 +178,7 @@ void FixFluidDrag::post_force(int /*vflag*/)
   const double *u = fluid->velocity();
 
   prepare_step();
+  refresh_concentration();
   totals.clear();
   for (int i = 0; i < nlocal; ++i) {
     if (!(mask[i] & groupbit) || (mask[i] & implicit_groupbit)) continue;

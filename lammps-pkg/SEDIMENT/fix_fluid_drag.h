@@ -33,7 +33,7 @@ class FixFluidDrag : public Fix {
   double compute_vector(int) override;
 
   class FixFluid *fluid_fix() const { return fluid; }
-  // Call once per step before sphere_drag(): refreshes the fluid region and the local fractions.
+  // Call once per step before sphere_drag(): refreshes the fluid region.
   void prepare_step();
   // The drag on local atom i during this step (model nullptr if it is not in the group/fluid).
   sediment::SphereDrag sphere_drag(int i) const;
@@ -54,6 +54,7 @@ class FixFluidDrag : public Fix {
   RankSums<3> totals;      // drag force on the explicitly integrated atoms
 
   int count_unstable_explicit();
+  void refresh_concentration();
 };
 
 }    // namespace LAMMPS_NS

@@ -8,6 +8,7 @@
 #include "fix_fluid.h"
 #include "fix_fluid_buoyancy.h"
 #include "fix_fluid_drag.h"
+#include "fix_layers_hdf5.h"
 #include "fix_nve_sphere_fluid.h"
 
 #include "lammps.h"
@@ -40,6 +41,7 @@ const FixEntry fix_styles[] = {
     {"fluid/buoyancy", "Archimedes buoyancy with partial submergence", &create_fix<FixFluidBuoyancy>},
     {"fluid/drag", "Newtonian and Bingham drag laws", &create_fix<FixFluidDrag>},
     {"nve/sphere/fluid", "drag-implicit sphere integrator", &create_fix<FixNVESphereFluid>},
+    {"layers/hdf5", "layer profiles to HDF5", &create_fix<FixLayersHDF5>},
 };
 
 struct ComputeEntry {

@@ -66,7 +66,7 @@ TEST(Layers, ProfileInterpolatesBetweenCentres)
   EXPECT_DOUBLE_EQ(profile_at(layers, values, 9.0), 7.0);
 }
 
-TEST(Layers, SmoothingKeepsUniformProfilesAndSpreadsASpike)
+TEST(Layers, SmoothingKeepsUniformProfilesConservesAndSpreadsASpike)
 {
   const Layers layers{0.0, 1.0, 50};
   std::vector<double> flat(50, 0.3), out(50);
@@ -76,4 +76,18 @@ TEST(Layers, SmoothingKeepsUniformProfilesAndSpreadsASpike)
   spike[25] = 1.0;
   smooth_profile(layers, spike.data(), 2.0, out.data());
   EXPECT_NEAR(out[25] / out[27], std::exp(0.5), 1e-12);
+  // A deposit against an end keeps its total (what would leave is reflected back).
+  std::vector<double> deposit(50, 0.0);
+  deposit[0] = 0.6;
+  deposit[1] = 0.2;
+  smooth_profile(layers, deposit.data(), 3.0, out.data());
+  double total = 0.0;
+  for (double v : out) total += v;
+  EXPECT_NEAR(total, 0.8, 1e-15);
+  // Wider than the whole profile: still conservative and uniform-preserving.
+  const Layers few{0.0, 1.0, 3};
+  const double three[3] = {1.0, 0.0, 0.0};
+  double smoothed[3];
+  smooth_profile(few, three, 5.0, smoothed);
+  EXPECT_NEAR(smoothed[0] + smoothed[1] + smoothed[2], 1.0, 1e-15);
 }

@@ -8,16 +8,19 @@ from __future__ import annotations
 import argparse
 import csv
 import math
+import os
+import sys
 import tempfile
 from pathlib import Path
 
 import numpy as np
 
 from harness import HERE, report, run_deck
-from sediment import _core
+
+sys.path.insert(0, str(HERE.parents[1] / "python"))
+from sediment import _core  # noqa: E402
 
 G = 9.81
-import os
 SHARED = Path(os.environ.get("SEDIMENT_SHARED", HERE.parents[2] / "shared"))    # ../shared beside the clone
 CHECKS = {}
 
@@ -322,6 +325,43 @@ def hindered_settling(np_ranks: int):
         assert abs(ratio / rz - 1) < 0.05
 
 
+# ---- layer files -------------------------------------------------------------------------------
+EXAMPLES = HERE.parents[1] / "examples"
+
+
+@check
+def layers_hdf5(np_ranks: int):
+    from sediment.layers import read_layers
+
+    deck = EXAMPLES / "polydisperse" / "in.polydisperse"
+    with tempfile.TemporaryDirectory() as tmp:
+        tmp = Path(tmp)
+        solid = run_deck(deck, {"tend": 2.0, "file": tmp / "whole.h5"}, np_ranks, cwd=tmp).results["solid_volume"]
+        run_deck(deck, {"tend": 1.0, "file": tmp / "split.h5", "restart": 1,
+                                    "restart_file": tmp / "poly.restart"}, np_ranks, cwd=tmp)
+        run_deck("layers_restart.lmp", {"restart": tmp / "poly.restart", "file": tmp / "split.h5"}, np_ranks, cwd=tmp)
+        whole, split = read_layers(tmp / "whole.h5"), read_layers(tmp / "split.h5")
+        serial = None
+        if np_ranks > 1:
+            run_deck(deck, {"tend": 2.0, "file": tmp / "serial.h5"}, 1, cwd=tmp)
+            serial = read_layers(tmp / "serial.h5")
+    conservation = float(np.max(np.abs(whole.solid_volume() / solid - 1)))
+    classes = whole.fraction[:, :, 1:].sum(axis=2)
+    report(f"layers/hdf5: {len(whole.time)} frames at t = {whole.time.tolist()}; solid volume conserved to "
+           f"{conservation:.1e}; split run (restart at 1 s) frames {split.step.tolist()}")
+    assert whole.step.tolist() == [0, 50, 100, 150, 200]
+    assert conservation < 1e-12
+    assert np.allclose(classes, whole.total, rtol=0, atol=1e-12)
+    assert split.step.tolist() == whole.step.tolist()
+    diff = float(np.max(np.abs(split.fraction - whole.fraction)))
+    report(f"restart: split run vs whole run max difference of the layer fractions {diff:.1e}")
+    assert diff < 1e-12
+    if serial is not None:
+        rank_diff = float(np.max(np.abs(serial.fraction - whole.fraction)))
+        report(f"1 vs {np_ranks} ranks: max difference of the layer fractions {rank_diff:.1e}")
+        assert rank_diff < 1e-12
+
+
 # ---- bad input ----------------------------------------------------------------------------------
 BAD_INPUT = [
     ("fix f all fluid density -1 viscosity 1e-3", "density must be finite and > 0"),
@@ -356,6 +396,12 @@ BAD_INPUT = [
     ("compute c all concentration/grid layers z 10 thickness 1", "'thickness' is for 2d simulations only"),
     ("compute c all concentration/grid layers z 10 smooth -1", "smooth width must be > 0"),
     ("compute c all concentration/grid layers z 10 sieve 3", "unknown keyword 'sieve'"),
+    ("fix l all layers/hdf5 0 a.h5 c_c", "N must be > 0"),
+    ("fix l all layers/hdf5 10 a.h5 conc", "expected a compute reference c_ID"),
+    ("fix l all layers/hdf5 10 a.h5 c_nothing\nrun 0", "compute 'nothing' does not exist"),
+    ("compute t all temp\nfix l all layers/hdf5 10 a.h5 c_t\nrun 0", "not a compute concentration/grid"),
+    ("fix l all layers/hdf5 10 a.h5 c_c colour 1", "unknown keyword 'colour'"),
+    ("compute c all concentration/grid layers z 10\nshell echo not hdf5 > notes.h5\nfix l all layers/hdf5 10 notes.h5 c_c\nrun 0", "exists but is not an HDF5 file; not overwriting it"),
     ("fix f all fluid density 1000 viscosity 1e-3\nfix d all fluid/drag f law difelice", "law difelice needs keyword 'concentration c_ID'"),
     ("fix f all fluid density 1000 viscosity 1e-3\nfix d all fluid/drag f law stokes concentration c_x", "applies to law difelice only"),
     ("fix f all fluid density 1000 viscosity 1e-3\nfix d all fluid/drag f law difelice concentration c_x\nrun 0", "compute 'x' does not exist"),

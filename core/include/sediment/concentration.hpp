@@ -22,8 +22,8 @@ double add_sphere_to_layers(const Layers &layers, double centre, double radius, 
 // The piecewise-linear profile through the layer centres at x (flat beyond the outer centres).
 double profile_at(const Layers &layers, const double *values, double x, int stride = 1);
 
-// Gaussian smoothing (standard deviation `width`, truncated at 4 widths, renormalised at the
-// ends so a uniform profile stays uniform) of n values into out.
+// Gaussian smoothing (standard deviation `width`, truncated at 4 widths) of the layer values into
+// out, with mirror ends: conserves the total exactly and keeps a uniform profile uniform.
 void smooth_profile(const Layers &layers, const double *values, double width, double *out);
 
 }    // namespace sediment

@@ -1,0 +1,51 @@
+/* ----------------------------------------------------------------------
+   SEDIMENT package: writes the layer profiles of compute concentration/grid
+   to an HDF5 file every N steps (schema: doc/fix_layers_hdf5.rst).
+------------------------------------------------------------------------- */
+
+#ifdef FIX_CLASS
+// clang-format off
+FixStyle(layers/hdf5,FixLayersHDF5);
+// clang-format on
+#else
+
+#ifndef LMP_FIX_LAYERS_HDF5_H
+#define LMP_FIX_LAYERS_HDF5_H
+
+#include "fix.h"
+
+#include <string>
+
+namespace LAMMPS_NS {
+
+class FixLayersHDF5 : public Fix {
+ public:
+  FixLayersHDF5(class LAMMPS *, int, char **);
+  ~FixLayersHDF5() override;
+  int setmask() override;
+  void init() override;
+  void setup(int) override;
+  void end_of_step() override;
+  void post_run() override;
+  double compute_scalar() override;
+
+ private:
+  std::string path;
+  char *compute_id, *fluid_id;
+  double particle_density;
+  class ComputeConcentrationGrid *grid;
+  class FixFluid *fluid;
+  long long file;       // hid_t of the open file (rank 0), -1 when closed
+  long long frames;     // frames in the file
+
+  void open_file();
+  void write_frame();
+  void close_file();
+  // Runs `action` on rank 0 and stops every rank with its message if it failed.
+  template <typename Action> void on_rank0(Action action);
+};
+
+}    // namespace LAMMPS_NS
+
+#endif
+#endif

@@ -1,0 +1,99 @@
+"""Reader of the layer files written by the LAMMPS fix layers/hdf5.
+
+Schema (version 1; lammps-pkg/SEDIMENT/doc/fix_layers_hdf5.rst): root attributes `schema`
+("sediment-layers"), `schema_version`, `units`, `axis`, `dimension`, `cross_section`,
+`layer_lo`, `layer_thickness`, `columns` (comma-separated), optional `slab_thickness`,
+`particle_density`, `fluid_density`, `fluid_viscosity`, `fluid_yield_stress`; datasets
+`layer_centre` [layers], `class_edges` [classes - 1], and per frame `time` [frames],
+`step` [frames], `fraction` [frames, layers, columns] (solid volume fractions).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+SCHEMA = "sediment-layers"
+SCHEMA_VERSION = 1
+
+
+class LayerFileError(ValueError):
+    """A layer file that is missing, unreadable or of another schema."""
+
+
+@dataclass
+class LayerFile:
+    path: Path
+    units: str
+    axis: str
+    dimension: int
+    cross_section: float            # area normal to the layers [length^2]
+    layer_lo: float
+    layer_thickness: float
+    centres: np.ndarray             # layer centres [length]
+    columns: list[str]              # "total", "class_k", "type_t"
+    class_edges: np.ndarray         # diameters separating the size classes [length]
+    time: np.ndarray                # [time] per frame
+    step: np.ndarray
+    fraction: np.ndarray            # [frames, layers, columns] solid volume fraction
+    attributes: dict[str, float] = field(default_factory=dict)    # fluid/particle properties
+
+    def column(self, name: str) -> np.ndarray:
+        """Solid fraction of one column, [frames, layers]."""
+        if name not in self.columns:
+            raise KeyError(f"{self.path}: no column '{name}' (columns: {', '.join(self.columns)})")
+        return self.fraction[:, :, self.columns.index(name)]
+
+    @property
+    def total(self) -> np.ndarray:
+        return self.column("total")
+
+    def solid_volume(self) -> np.ndarray:
+        """Solid volume inside the layers per frame [length^3]."""
+        return self.total.sum(axis=1) * self.layer_thickness * self.cross_section
+
+
+def _text(value) -> str:
+    return value.decode() if isinstance(value, bytes) else str(value)
+
+
+def read_layers(path: str | Path) -> LayerFile:
+    import h5py
+
+    path = Path(path)
+    if not path.is_file():
+        raise LayerFileError(f"{path}: no such layer file")
+    try:
+        handle = h5py.File(path, "r")
+    except OSError as exc:
+        raise LayerFileError(f"{path}: not a readable HDF5 file (truncated or corrupt?): {exc}") from None
+    with handle as f:
+        schema = _text(f.attrs.get("schema", ""))
+        if schema != SCHEMA:
+            raise LayerFileError(f"{path}: not a SEDIMENT layer file (schema '{schema}', expected '{SCHEMA}')")
+        version = int(f.attrs.get("schema_version", -1))
+        if version != SCHEMA_VERSION:
+            raise LayerFileError(f"{path}: layer schema version {version}; this reader understands "
+                                 f"version {SCHEMA_VERSION}")
+        try:
+            # A run killed between the datasets of a frame leaves them of different lengths:
+            # the frames present in all three are the complete ones.
+            frames = min(len(f["time"]), len(f["step"]), len(f["fraction"]))
+            columns = _text(f.attrs["columns"]).split(",")
+            fraction = np.asarray(f["fraction"][:frames])
+            if fraction.shape[1:] != (len(f["layer_centre"]), len(columns)):
+                raise LayerFileError(f"{path}: fraction has shape {fraction.shape[1:]}, expected "
+                                     f"({len(f['layer_centre'])}, {len(columns)})")
+            extra = {k: float(f.attrs[k]) for k in ("slab_thickness", "particle_density", "fluid_density",
+                                                     "fluid_viscosity", "fluid_yield_stress") if k in f.attrs}
+            return LayerFile(path=path, units=_text(f.attrs["units"]), axis=_text(f.attrs["axis"]),
+                             dimension=int(f.attrs["dimension"]), cross_section=float(f.attrs["cross_section"]),
+                             layer_lo=float(f.attrs["layer_lo"]), layer_thickness=float(f.attrs["layer_thickness"]),
+                             centres=np.asarray(f["layer_centre"]), columns=columns,
+                             class_edges=np.asarray(f["class_edges"]), time=np.asarray(f["time"][:frames]),
+                             step=np.asarray(f["step"][:frames]), fraction=fraction, attributes=extra)
+        except KeyError as exc:
+            raise LayerFileError(f"{path}: layer file lacks {exc}") from None
+        except OSError as exc:
+            raise LayerFileError(f"{path}: unreadable layer data (truncated or corrupt?): {exc}") from None

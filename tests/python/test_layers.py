@@ -1,0 +1,69 @@
+"""sediment.layers: the reader of fix layers/hdf5 files, on good and bad files."""
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+h5py = pytest.importorskip("h5py")
+
+from sediment.layers import LayerFileError, read_layers  # noqa: E402
+
+
+def write_layer_file(path: Path, frames: int = 3, version: int = 1, schema: str = "sediment-layers",
+                     cut_last_fraction: bool = False) -> None:
+    n, columns = 10, ["total", "class_0", "class_1"]
+    with h5py.File(path, "w") as f:
+        f.attrs.update(schema=schema, schema_version=version, units="si", axis="z", dimension=3,
+                       cross_section=1e-6, layer_lo=0.0, layer_thickness=1e-3, columns=",".join(columns),
+                       particle_density=2650.0, fluid_density=998.2, fluid_viscosity=1.002e-3)
+        f["layer_centre"] = (np.arange(n) + 0.5) * 1e-3
+        f["class_edges"] = np.array([2e-5])
+        f["time"] = np.arange(frames) * 0.5
+        f["step"] = np.arange(frames) * 50
+        fraction = np.zeros((frames, n, len(columns)))
+        fraction[:, :, 0] = 0.02
+        fraction[:, :, 1] = 0.015
+        fraction[:, :, 2] = 0.005
+        f["fraction"] = fraction[:-1] if cut_last_fraction else fraction
+
+
+def test_reads_a_layer_file(tmp_path):
+    write_layer_file(tmp_path / "a.h5")
+    layers = read_layers(tmp_path / "a.h5")
+    assert layers.columns == ["total", "class_0", "class_1"]
+    assert layers.fraction.shape == (3, 10, 3)
+    assert layers.step.tolist() == [0, 50, 100]
+    np.testing.assert_allclose(layers.solid_volume(), 0.02 * 10 * 1e-3 * 1e-6)
+    assert layers.attributes["particle_density"] == 2650.0
+    np.testing.assert_allclose(layers.column("class_0"), 0.015)
+    with pytest.raises(KeyError, match="no column 'class_9'"):
+        layers.column("class_9")
+
+
+def test_frame_cut_short_by_a_killed_run_is_left_out(tmp_path):
+    write_layer_file(tmp_path / "killed.h5", cut_last_fraction=True)
+    layers = read_layers(tmp_path / "killed.h5")
+    assert len(layers.time) == len(layers.step) == len(layers.fraction) == 2
+
+
+@pytest.mark.parametrize("kwargs, message", [
+    ({"version": 2}, "layer schema version 2; this reader understands version 1"),
+    ({"schema": "something-else"}, "not a SEDIMENT layer file"),
+])
+def test_other_schemas_are_refused(tmp_path, kwargs, message):
+    write_layer_file(tmp_path / "other.h5", **kwargs)
+    with pytest.raises(LayerFileError, match=message):
+        read_layers(tmp_path / "other.h5")
+
+
+def test_truncated_and_foreign_files_give_clear_errors(tmp_path):
+    write_layer_file(tmp_path / "good.h5", frames=50)
+    data = (tmp_path / "good.h5").read_bytes()
+    (tmp_path / "truncated.h5").write_bytes(data[: len(data) // 3])
+    with pytest.raises(LayerFileError, match="truncated or corrupt"):
+        read_layers(tmp_path / "truncated.h5")
+    (tmp_path / "notes.h5").write_text("not hdf5\n")
+    with pytest.raises(LayerFileError, match="not a readable HDF5 file"):
+        read_layers(tmp_path / "notes.h5")
+    with pytest.raises(LayerFileError, match="no such layer file"):
+        read_layers(tmp_path / "missing.h5")
