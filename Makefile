@@ -9,7 +9,7 @@ export OMPI_ALLOW_RUN_AS_ROOT := 1
 export OMPI_ALLOW_RUN_AS_ROOT_CONFIRM := 1
 export OMP_NUM_THREADS := 1
 
-.PHONY: deps build demo test test-cpp test-python clean
+.PHONY: deps build demo test test-cpp test-python bench clean
 
 deps:
 	@scripts/install-deps.sh
@@ -31,6 +31,10 @@ test-python: build
 	PYTHONPATH=python SEDIMENT_LMP=$(abspath $(BUILD))/lmp_sediment $(PYTHON) -m pytest -q tests/python
 
 test: test-cpp test-python
+
+# Cost of each effect per particle-step, as ratios measured in one run (not part of make test).
+bench: build
+	$(PYTHON) benchmarks/cost.py
 
 clean:
 	rm -rf $(BUILD) $(OUT) python/sediment/_core*.so

@@ -165,6 +165,12 @@ double DragModel::tangent(double d, double speed, DragScale scale) const
   return scale.area * 0.5 * sphere_area(d) * dforce;
 }
 
+double DragModel::linear_coefficient(double d, DragScale scale) const
+{
+  if (law_ != DragLaw::Stokes || fluid_.yield_stress > 0.0) return 0.0;
+  return scale.area * 3.0 * pi * fluid_.viscosity * d;
+}
+
 int DragModel::jumps(double d, std::array<ForceJump, max_jumps> &out, DragScale scale) const
 {
   double switches[max_jumps];

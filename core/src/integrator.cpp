@@ -6,23 +6,46 @@
 
 namespace sediment {
 
-double phi1(double z)
+namespace {
+
+// Taylor coefficients (-1)^n / (n + 1)! and (-1)^n / (n + 2)! for n = 0 .. 17: with |z| < 0.5 the
+// truncated series are exact to round-off, where the direct forms lose digits to cancellation.
+struct SeriesCoefficients {
+  double phi1[18];
+  double phi2[18];
+  constexpr SeriesCoefficients() : phi1(), phi2()
+  {
+    double factorial = 1.0;    // (n + 1)!
+    for (int n = 0; n < 18; ++n) {
+      factorial *= (n + 1);
+      const double sign = n % 2 ? -1.0 : 1.0;
+      phi1[n] = sign / factorial;
+      phi2[n] = sign / (factorial * (n + 2));
+    }
+  }
+};
+constexpr SeriesCoefficients series;
+
+}    // namespace
+
+Phi phis(double z)
 {
-  if (z == 0.0) return 1.0;
-  return -std::expm1(-z) / z;
+  if (z == 0.0) return {1.0, 1.0, 0.5};
+  if (std::abs(z) < 0.5) {
+    double p1 = series.phi1[17], p2 = series.phi2[17];
+    for (int n = 16; n >= 0; --n) {
+      p1 = p1 * z + series.phi1[n];
+      p2 = p2 * z + series.phi2[n];
+    }
+    return {1.0 - z * p1, p1, p2};
+  }
+  const double decay = std::exp(-z);
+  return {decay, (1.0 - decay) / z, (z - 1.0 + decay) / (z * z)};
 }
 
-double phi2(double z)
-{
-  // The direct form loses digits to cancellation for small z: use the series sum (-z)^n/(n+2)!,
-  // whose 11 terms are exact to round-off for |z| < 0.1.
-  if (std::abs(z) < 0.1) {
-    double nested = 1.0;    // 1 - z/3 (1 - z/4 (1 - z/5 (...)))
-    for (int n = 12; n >= 3; --n) nested = 1.0 - z / n * nested;
-    return 0.5 * nested;
-  }
-  return (z + std::expm1(-z)) / (z * z);
-}
+double phi1(double z) { return phis(z).phi1; }
+
+double phi2(double z) { return phis(z).phi2; }
 
 namespace {
 
@@ -34,9 +57,8 @@ struct Segment {
 
 Segment advance(double s0, double c, double k, double t)
 {
-  const double z = k * t;
-  const double p1 = phi1(z);
-  return {s0 * std::exp(-z) + c * t * p1, s0 * t * p1 + c * t * t * phi2(z)};
+  const Phi p = phis(k * t);
+  return {s0 * p.decay + c * t * p.phi1, s0 * t * p.phi1 + c * t * t * p.phi2};
 }
 
 // Time for ds/dt = c - k s to go from s0 to `target`, which lies between s0 and the asymptote.
@@ -134,6 +156,20 @@ StepCorrection drag_step_initial(const SphereDrag &drag, double mass, const doub
   }
 
   double w[3] = {v[0] - u[0], v[1] - u[1], v[2] - u[2]};
+
+  // Drag linear in the slip: the same step with equal rates along and across the slip and no
+  // set-valued points, in closed form.
+  const double linear = drag.model->linear_coefficient(drag.diameter, drag.scale);
+  if (linear > 0.0) {
+    const Phi p = phis(linear / mass * dt);
+    for (int k = 0; k < 3; ++k) {
+      v[k] = u[k] + w[k] * p.decay + dt * (p.phi1 - p.phi2) * a[k];
+      dx[k] = dt * (u[k] + p.phi1 * w[k] + dt * p.phi2 * a[k]);
+    }
+    corr.along = corr.across = dt * p.phi2;
+    return corr;
+  }
+
   const double s = std::sqrt(dot(w, w));
   const double a_norm = std::sqrt(dot(a, a));
   double *dir = corr.dir;
@@ -162,9 +198,9 @@ StepCorrection drag_step_initial(const SphereDrag &drag, double mass, const doub
   // Across the slip the force turns with the slip: secant rate F(s) / s.
   const double rate_across = s > 0.0 ? drag.model->force(drag.diameter, s, drag.scale) / (s * mass)
                                      : drag.model->tangent(drag.diameter, 0.0, drag.scale) / mass;
-  const double z_across = rate_across * dt;
-  const double p1 = phi1(z_across);
-  const double p2 = phi2(z_across);
+  const Phi across = phis(rate_across * dt);
+  const double p1 = across.phi1;
+  const double p2 = across.phi2;
   corr.along = along.state == SlipState::Free ? dt * phi2(along.rate * dt) : 0.0;
   corr.across = dt * p2;
   for (int k = 0; k < 3; ++k) {
@@ -185,12 +221,10 @@ void drag_step_final(const StepCorrection &corr, const double a[3], double v[3])
 
 double rotation_step_initial(double rate, const double alpha[3], double dt, double omega[3])
 {
-  const double z = rate * dt;
-  const double decay = std::exp(-z);
-  const double p2 = phi2(z);
-  const double weight_now = dt * (phi1(z) - p2);
-  for (int k = 0; k < 3; ++k) omega[k] = omega[k] * decay + weight_now * alpha[k];
-  return dt * p2;
+  const Phi p = phis(rate * dt);
+  const double weight_now = dt * (p.phi1 - p.phi2);
+  for (int k = 0; k < 3; ++k) omega[k] = omega[k] * p.decay + weight_now * alpha[k];
+  return dt * p.phi2;
 }
 
 }    // namespace sediment

@@ -246,14 +246,14 @@ TEST(Integrator, RotationDecaysExactly)
 TEST(Integrator, PhiFunctionsAreSmoothAcrossTheSeriesSwitch)
 {
   // References in long double: the direct formulas where they do not cancel, else the series.
-  for (double z : {0.0, 1e-12, 1e-4, 9.99e-4, 1.001e-3, 0.1, 10.0, 1e6}) {
+  for (double z : {0.0, 1e-12, 1e-4, 9.99e-4, 0.1, 0.4999, 0.5001, 2.0, 10.0, 1e6}) {
     const long double x = z;
     long double p1 = 0.0L, p2 = 0.0L, term1 = 1.0L, term2 = 0.5L;
-    if (z > 0.1) {
+    if (z > 1.0) {
       p1 = (1.0L - std::exp(-x)) / x;
       p2 = (x - 1.0L + std::exp(-x)) / (x * x);
     } else {
-      for (int n = 0; n < 12; ++n) {    // phi1 = sum (-z)^n/(n+1)!, phi2 = sum (-z)^n/(n+2)!
+      for (int n = 0; n < 30; ++n) {    // phi1 = sum (-z)^n/(n+1)!, phi2 = sum (-z)^n/(n+2)!
         p1 += term1;
         p2 += term2;
         term1 *= -x / (n + 2);

@@ -78,6 +78,8 @@ class DragModel {
   double tangent(double d, double speed, DragScale scale = {}) const;
   // F(0+): the largest force a sphere at rest resists (zero for a Newtonian fluid).
   double static_force(double d, DragScale scale = {}) const;
+  // c when F(s) = c s exactly (Stokes in a Newtonian fluid), else 0.
+  double linear_coefficient(double d, DragScale scale = {}) const;
   // Jumps of F in increasing speed; returns how many were written.
   int jumps(double d, std::array<ForceJump, max_jumps> &out, DragScale scale = {}) const;
 

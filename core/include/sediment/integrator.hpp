@@ -22,6 +22,14 @@ namespace sediment {
 double phi1(double z);
 double phi2(double z);
 
+// e^{-z}, phi1(z) and phi2(z) from one exponential.
+struct Phi {
+  double decay;
+  double phi1;
+  double phi2;
+};
+Phi phis(double z);
+
 // The drag seen by one sphere during a step.
 struct SphereDrag {
   const DragModel *model = nullptr;    // nullptr: no drag (plain velocity Verlet)

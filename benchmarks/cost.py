@@ -1,0 +1,51 @@
+"""Cost per particle-step of the SEDIMENT effects, as ratios measured in one run on this machine.
+
+    /usr/bin/python3 benchmarks/cost.py [--particles 20000] [--steps 2000] [--repeats 3]
+
+Each scene runs `repeats` times; the best loop time is kept. LAMMPS reports the loop time,
+which excludes start-up.
+"""
+from __future__ import annotations
+
+import argparse
+import re
+import subprocess
+import sys
+from pathlib import Path
+
+HERE = Path(__file__).resolve().parent
+sys.path.insert(0, str(HERE.parent / "python"))
+from sediment.paths import lmp_executable  # noqa: E402
+
+SCENES = {"plain": "nve/sphere + gravity (reference)",
+          "drag": "nve/sphere/fluid + buoyancy + stokes drag",
+          "nonlinear": "as drag with dallavalle (general Newton step)",
+          "hindered": "as nonlinear + concentration/grid (400 layers) + difelice"}
+
+
+def loop_time(scene: str, particles: int, steps: int) -> float:
+    out = subprocess.run([lmp_executable(), "-in", str(HERE / "in.cost"), "-log", "none", "-nocite",
+                          "-var", "scene", scene, "-var", "n", str(particles), "-var", "steps", str(steps)],
+                         capture_output=True, text=True, check=True).stdout
+    return float(re.search(r"Loop time of ([0-9.eE+-]+)", out).group(1))
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--particles", type=int, default=20000)
+    parser.add_argument("--steps", type=int, default=2000)
+    parser.add_argument("--repeats", type=int, default=3)
+    args = parser.parse_args()
+    times = {s: min(loop_time(s, args.particles, args.steps) for _ in range(args.repeats)) for s in SCENES}
+    per = {s: t / (args.particles * args.steps) * 1e9 for s, t in times.items()}
+    print(f"{args.particles} particles x {args.steps} steps, best of {args.repeats}, 1 rank")
+    print(f"{'scene':10s} {'ns/particle-step':>17s} {'ratio to plain':>15s}  what")
+    for s, what in SCENES.items():
+        print(f"{s:10s} {per[s]:17.2f} {per[s] / per['plain']:15.2f}  {what}")
+    grid = per["hindered"] - per["nonlinear"]
+    print(f"grid + Di Felice hindrance on top of the nonlinear step: {grid:.1f} ns/particle-step "
+          f"({grid / per['plain']:.2f}x the plain step)")
+
+
+if __name__ == "__main__":
+    main()
