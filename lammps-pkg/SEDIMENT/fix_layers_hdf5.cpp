@@ -128,7 +128,7 @@ void put_frame(hid_t file, const char *name, hid_t type, hsize_t frames, const v
 
 FixLayersHDF5::FixLayersHDF5(LAMMPS *lmp, int narg, char **arg) :
     Fix(lmp, narg, arg), compute_id(nullptr), fluid_id(nullptr), particle_density(0.0), grid(nullptr),
-    fluid(nullptr), file(-1), frames(0)
+    fluid(nullptr), file(-1), is_open(false), frames(0)
 {
   if (narg < 6)
     error->all(FLERR, "Fix layers/hdf5: expected 'fix ID group layers/hdf5 N FILE.h5 c_ID [keyword value ...]'");
@@ -201,7 +201,7 @@ void FixLayersHDF5::init()
 
 void FixLayersHDF5::setup(int /*vflag*/)
 {
-  if (file < 0) open_file();
+  if (!is_open) open_file();
   if (update->ntimestep % nevery == 0) write_frame();
 }
 
@@ -283,6 +283,7 @@ void FixLayersHDF5::open_file()
     create_frames(file, "fraction", H5T_NATIVE_DOUBLE, 3, shape);
     check(H5Fflush(file, H5F_SCOPE_GLOBAL), "flush");
   });
+  is_open = true;
 }
 
 void FixLayersHDF5::write_frame()
@@ -310,6 +311,7 @@ void FixLayersHDF5::close_file()
     if (file >= 0) H5Fclose(file);
     file = -1;
   });
+  is_open = false;
 }
 
 double FixLayersHDF5::compute_scalar()

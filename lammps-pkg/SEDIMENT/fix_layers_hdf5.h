@@ -36,6 +36,7 @@ class FixLayersHDF5 : public Fix {
   class ComputeConcentrationGrid *grid;
   class FixFluid *fluid;
   long long file;       // hid_t of the open file (rank 0), -1 when closed
+  bool is_open;         // the same on every rank (file is only meaningful on rank 0)
   long long frames;     // frames in the file
 
   void open_file();
