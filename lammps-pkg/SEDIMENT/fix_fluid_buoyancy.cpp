@@ -8,6 +8,7 @@
 #include "fix_fluid.h"
 
 #include "atom.h"
+#include "compute.h"
 #include "error.h"
 #include "modify.h"
 #include "update.h"
@@ -18,8 +19,8 @@ using namespace LAMMPS_NS;
 using namespace FixConst;
 
 FixFluidBuoyancy::FixFluidBuoyancy(LAMMPS *lmp, int narg, char **arg) :
-    Fix(lmp, narg, arg), fluid_id(nullptr), gravity_id(nullptr), fluid(nullptr),
-    gravity(nullptr)
+    Fix(lmp, narg, arg), fluid_id(nullptr), gravity_id(nullptr), mixture_id(nullptr), mixture(nullptr),
+    solid_density(0.0), fluid(nullptr), gravity(nullptr)
 {
   if (narg < 4) error->all(FLERR, "Fix fluid/buoyancy: expected 'fix ID group fluid/buoyancy FLUID-ID'");
   fluid_id = utils::strdup(arg[3]);
@@ -30,8 +31,17 @@ FixFluidBuoyancy::FixFluidBuoyancy(LAMMPS *lmp, int narg, char **arg) :
       delete[] gravity_id;
       gravity_id = utils::strdup(arg[iarg + 1]);
       iarg += 2;
+    } else if (strcmp(arg[iarg], "mixture") == 0) {
+      if (iarg + 2 >= narg)
+        error->all(FLERR, "Fix fluid/buoyancy: keyword 'mixture' needs c_ID and the solid density");
+      const char *name = strncmp(arg[iarg + 1], "c_", 2) == 0 ? arg[iarg + 1] + 2 : arg[iarg + 1];
+      delete[] mixture_id;
+      mixture_id = utils::strdup(name);
+      solid_density = utils::numeric(FLERR, arg[iarg + 2], false, lmp);
+      if (!(solid_density > 0.0)) error->all(FLERR, "Fix fluid/buoyancy: mixture solid density must be > 0");
+      iarg += 3;
     } else {
-      error->all(FLERR, "Fix fluid/buoyancy: unknown keyword '{}' (expected gravity)", arg[iarg]);
+      error->all(FLERR, "Fix fluid/buoyancy: unknown keyword '{}' (expected gravity or mixture)", arg[iarg]);
     }
   }
   if (!atom->radius_flag)
@@ -47,6 +57,7 @@ FixFluidBuoyancy::~FixFluidBuoyancy()
 {
   delete[] fluid_id;
   delete[] gravity_id;
+  delete[] mixture_id;
 }
 
 int FixFluidBuoyancy::setmask()
@@ -78,6 +89,15 @@ void FixFluidBuoyancy::init()
       error->all(FLERR, "Fix fluid/buoyancy needs a fix gravity to know the direction and "
                         "strength of gravity");
   }
+  mixture = nullptr;
+  if (mixture_id) {
+    const int icompute = modify->find_compute(mixture_id);
+    if (icompute < 0) error->all(FLERR, "Fix fluid/buoyancy: compute '{}' does not exist", mixture_id);
+    mixture = modify->compute[icompute];
+    if (!mixture->peratom_flag || mixture->size_peratom_cols != 0)
+      error->all(FLERR, "Fix fluid/buoyancy: compute '{}' does not give a per-atom vector of solid "
+                        "fractions (use compute concentration/grid)", mixture_id);
+  }
   int dim = 0;
   gravity = static_cast<double *>(gravity_fix->extract("gvec", dim));
   if (!gravity) error->all(FLERR, "Fix fluid/buoyancy: fix gravity does not expose its vector");
@@ -98,12 +118,15 @@ void FixFluidBuoyancy::post_force(int /*vflag*/)
   const double rho = fluid->properties().density;
 
   fluid->prepare();
+  if (mixture && mixture->invoked_peratom != update->ntimestep) mixture->compute_peratom();
   totals.clear();
   for (int i = 0; i < nlocal; ++i) {
     if (!(mask[i] & groupbit)) continue;
     const sediment::Submergence sub = fluid->immersion(x[i], radius[i]);
     if (!sub.any()) continue;
-    const double displaced = rho * sub.volume * sediment::sphere_volume(2.0 * radius[i]);
+    // Suspension density rho_f + (rho_s - rho_f) phi around the sphere, or the clear fluid's.
+    const double density = mixture ? rho + (solid_density - rho) * mixture->vector_atom[i] : rho;
+    const double displaced = density * sub.volume * sediment::sphere_volume(2.0 * radius[i]);
     for (int k = 0; k < 3; ++k) {
       const double fb = -displaced * gravity[k];
       f[i][k] += fb;

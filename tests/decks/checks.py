@@ -323,6 +323,12 @@ def hindered_settling(np_ranks: int):
                f"deviation {ratio / rz - 1:+.2%}; grid fraction {out.results['phi']:.6f}")
         assert abs(out.results["phi"] - phi) < 1e-9
         assert abs(ratio / rz - 1) < 0.05
+        # Mixture-density buoyancy (eps times the net weight) with the eps^-chi drag must give the
+        # same settling velocity as plain buoyancy with eps^-(chi+1).
+        mixed = run_deck("hindered_settling.lmp", {"phi": phi, "buoyancy": "mixture"}, np_ranks)
+        rel = abs(mixed.results["hindered"] / out.results["hindered"] - 1)
+        report(f"case G phi={phi}: mixture buoyancy + eps^-chi vs plain + eps^-(chi+1): relative difference {rel:.1e}")
+        assert rel < 1e-10
 
 
 # ---- layer files -------------------------------------------------------------------------------
@@ -388,6 +394,9 @@ BAD_INPUT = [
     ("unfix grav\nfix f all fluid density 1000 viscosity 1e-3\nfix b all fluid/buoyancy f\nrun 0", "needs a fix gravity"),
     ("fix f all fluid density 1000 viscosity 1e-3\nfix b all fluid/buoyancy f gravity f\nrun 0", "is a fix fluid, not a fix gravity"),
     ("fix n all nve/sphere/fluid extra", "unexpected argument 'extra'"),
+    ("fix f all fluid density 1000 viscosity 1e-3\nfix b all fluid/buoyancy f mixture c_c", "'mixture' needs c_ID and the solid density"),
+    ("fix f all fluid density 1000 viscosity 1e-3\nfix b all fluid/buoyancy f mixture c_c -5", "mixture solid density must be > 0"),
+    ("fix f all fluid density 1000 viscosity 1e-3\nfix b all fluid/buoyancy f mixture c_c 2650\nrun 0", "compute 'c' does not exist"),
     ("compute c all concentration/grid", "keyword 'layers AXIS N' is required"),
     ("compute c all concentration/grid layers w 10", "layer axis must be x, y or z"),
     ("compute c all concentration/grid layers z 0", "number of layers must be >= 1"),
