@@ -8,6 +8,7 @@
 #include "domain.h"
 #include "error.h"
 #include "memory.h"
+#include "modify.h"
 #include "update.h"
 
 #include <algorithm>
@@ -112,6 +113,18 @@ double ComputeConcentrationGrid::cross_section() const
 {
   if (domain->dimension == 2) return domain->prd[1 - axis] * thickness;
   return domain->prd[(axis + 1) % 3] * domain->prd[(axis + 2) % 3];
+}
+
+Compute *ComputeConcentrationGrid::find_fraction(LAMMPS *lmp, const char *reference, const char *caller)
+{
+  const char *name = strncmp(reference, "c_", 2) == 0 ? reference + 2 : reference;
+  const int icompute = lmp->modify->find_compute(name);
+  if (icompute < 0) lmp->error->all(FLERR, "Fix {}: compute '{}' does not exist", caller, name);
+  Compute *compute = lmp->modify->compute[icompute];
+  if (!compute->peratom_flag || compute->size_peratom_cols != 0)
+    lmp->error->all(FLERR, "Fix {}: compute '{}' does not give a per-atom vector of solid fractions "
+                           "(use compute concentration/grid)", caller, name);
+  return compute;
 }
 
 std::vector<std::string> ComputeConcentrationGrid::column_names() const

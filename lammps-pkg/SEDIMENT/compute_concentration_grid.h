@@ -30,6 +30,10 @@ class ComputeConcentrationGrid : public Compute {
   void compute_peratom() override;
   double memory_usage() override;
 
+  // The compute `reference` (c_ID or ID) giving a per-atom vector of solid fractions, checked;
+  // errors name the style asking.
+  static Compute *find_fraction(class LAMMPS *lmp, const char *reference, const char *caller);
+
   // For fix layers/hdf5: the layers, the names of the fraction columns, the class edges.
   const sediment::Layers &layer_geometry() const { return layers; }
   std::vector<std::string> column_names() const;

@@ -5,6 +5,7 @@
 
 #include "fix_fluid_buoyancy.h"
 
+#include "compute_concentration_grid.h"
 #include "fix_fluid.h"
 
 #include "atom.h"
@@ -34,9 +35,8 @@ FixFluidBuoyancy::FixFluidBuoyancy(LAMMPS *lmp, int narg, char **arg) :
     } else if (strcmp(arg[iarg], "mixture") == 0) {
       if (iarg + 2 >= narg)
         error->all(FLERR, "Fix fluid/buoyancy: keyword 'mixture' needs c_ID and the solid density");
-      const char *name = strncmp(arg[iarg + 1], "c_", 2) == 0 ? arg[iarg + 1] + 2 : arg[iarg + 1];
       delete[] mixture_id;
-      mixture_id = utils::strdup(name);
+      mixture_id = utils::strdup(arg[iarg + 1]);
       solid_density = utils::numeric(FLERR, arg[iarg + 2], false, lmp);
       if (!(solid_density > 0.0)) error->all(FLERR, "Fix fluid/buoyancy: mixture solid density must be > 0");
       iarg += 3;
@@ -89,15 +89,7 @@ void FixFluidBuoyancy::init()
       error->all(FLERR, "Fix fluid/buoyancy needs a fix gravity to know the direction and "
                         "strength of gravity");
   }
-  mixture = nullptr;
-  if (mixture_id) {
-    const int icompute = modify->find_compute(mixture_id);
-    if (icompute < 0) error->all(FLERR, "Fix fluid/buoyancy: compute '{}' does not exist", mixture_id);
-    mixture = modify->compute[icompute];
-    if (!mixture->peratom_flag || mixture->size_peratom_cols != 0)
-      error->all(FLERR, "Fix fluid/buoyancy: compute '{}' does not give a per-atom vector of solid "
-                        "fractions (use compute concentration/grid)", mixture_id);
-  }
+  mixture = mixture_id ? ComputeConcentrationGrid::find_fraction(lmp, mixture_id, "fluid/buoyancy") : nullptr;
   int dim = 0;
   gravity = static_cast<double *>(gravity_fix->extract("gvec", dim));
   if (!gravity) error->all(FLERR, "Fix fluid/buoyancy: fix gravity does not expose its vector");

@@ -4,6 +4,7 @@
 
 #include "fix_fluid_drag.h"
 
+#include "compute_concentration_grid.h"
 #include "fix_fluid.h"
 
 #include "atom.h"
@@ -52,9 +53,8 @@ FixFluidDrag::FixFluidDrag(LAMMPS *lmp, int narg, char **arg) :
       iarg += 2;
     } else if (strcmp(arg[iarg], "concentration") == 0) {
       if (iarg + 1 >= narg) error->all(FLERR, "Fix fluid/drag: keyword 'concentration' needs a compute ID");
-      const char *name = strncmp(arg[iarg + 1], "c_", 2) == 0 ? arg[iarg + 1] + 2 : arg[iarg + 1];
       delete[] concentration_id;
-      concentration_id = utils::strdup(name);
+      concentration_id = utils::strdup(arg[iarg + 1]);
       iarg += 2;
     } else if (strcmp(arg[iarg], "buoyancy") == 0) {
       if (iarg + 1 >= narg) error->all(FLERR, "Fix fluid/drag: keyword 'buoyancy' needs plain or mixture");
@@ -108,15 +108,8 @@ void FixFluidDrag::init()
 {
   fluid = FixFluid::find(lmp, fluid_id, "fluid/drag");
   model = std::make_unique<sediment::DragModel>(law, fluid->properties(), hindrance_buoyancy);
-  concentration = nullptr;
-  if (concentration_id) {
-    const int icompute = modify->find_compute(concentration_id);
-    if (icompute < 0) error->all(FLERR, "Fix fluid/drag: compute '{}' does not exist", concentration_id);
-    concentration = modify->compute[icompute];
-    if (!concentration->peratom_flag || concentration->size_peratom_cols != 0)
-      error->all(FLERR, "Fix fluid/drag: compute '{}' does not give a per-atom vector of solid "
-                        "fractions (use compute concentration/grid)", concentration_id);
-  }
+  concentration =
+      concentration_id ? ComputeConcentrationGrid::find_fraction(lmp, concentration_id, "fluid/drag") : nullptr;
   implicit_groupbit = 0;
   for (int i = 0; i < modify->nfix; ++i)
     if (strcmp(modify->fix[i]->style, "nve/sphere/fluid") == 0)
