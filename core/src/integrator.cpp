@@ -76,12 +76,12 @@ struct AlongSlip {
 };
 
 // Advances the slip speed s >= 0 along a fixed direction over dt, under the acceleration a_par
-// along it, stopping at the points where the force curve is set-valued.
-AlongSlip advance_along(const SphereDrag &drag, double mass, double s, double a_par, double dt)
+// along it, stopping at the points where the force curve is set-valued (static_force = F(0+)).
+AlongSlip advance_along(const SphereDrag &drag, double mass, double s, double a_par, double dt,
+                        double static_force)
 {
   const DragModel &model = *drag.model;
   const double d = drag.diameter;
-  const double static_force = model.static_force(d, drag.scale);
   std::array<ForceJump, DragModel::max_jumps> jumps;
   const int njumps = model.jumps(d, jumps, drag.scale);
   const double drive = mass * a_par;
@@ -184,7 +184,7 @@ StepCorrection drag_step_initial(const SphereDrag &drag, double mass, const doub
   const double static_force = drag.model->static_force(drag.diameter, drag.scale);
   const bool stays_at_rest = s == 0.0 && static_force > 0.0 && mass * a_norm <= static_force;
   const AlongSlip along = stays_at_rest ? AlongSlip{0.0, 0.0, 0.0, SlipState::Stuck}
-                                        : advance_along(drag, mass, s, a_par, dt);
+                                        : advance_along(drag, mass, s, a_par, dt, static_force);
   corr.state = along.state;
   if (along.state == SlipState::Stuck) {
     for (int k = 0; k < 3; ++k) {

@@ -20,46 +20,35 @@ using namespace LAMMPS_NS;
 
 namespace {
 
-template <typename T> Fix *create_fix(LAMMPS *lmp, int narg, char **arg)
+template <typename Base, typename Style> Base *create(LAMMPS *lmp, int narg, char **arg)
 {
-  return new T(lmp, narg, arg);
+  return new Style(lmp, narg, arg);
 }
 
-template <typename T> Compute *create_compute(LAMMPS *lmp, int narg, char **arg)
-{
-  return new T(lmp, narg, arg);
-}
-
-struct FixEntry {
+template <typename Creator> struct StyleEntry {
   const char *name;
   const char *info;
-  Modify::FixCreator creator;
+  Creator creator;
 };
 
-const FixEntry fix_styles[] = {
-    {"fluid", "fluid properties and geometry", &create_fix<FixFluid>},
-    {"fluid/buoyancy", "Archimedes buoyancy with partial submergence", &create_fix<FixFluidBuoyancy>},
-    {"fluid/drag", "Newtonian and Bingham drag laws", &create_fix<FixFluidDrag>},
-    {"nve/sphere/fluid", "drag-implicit sphere integrator", &create_fix<FixNVESphereFluid>},
-    {"layers/hdf5", "layer profiles to HDF5", &create_fix<FixLayersHDF5>},
+const StyleEntry<Modify::FixCreator> fix_styles[] = {
+    {"fluid", "fluid properties and geometry", &create<Fix, FixFluid>},
+    {"fluid/buoyancy", "Archimedes buoyancy with partial submergence", &create<Fix, FixFluidBuoyancy>},
+    {"fluid/drag", "Newtonian and Bingham drag laws", &create<Fix, FixFluidDrag>},
+    {"nve/sphere/fluid", "drag-implicit sphere integrator", &create<Fix, FixNVESphereFluid>},
+    {"layers/hdf5", "layer profiles to HDF5", &create<Fix, FixLayersHDF5>},
 };
 
-struct ComputeEntry {
-  const char *name;
-  const char *info;
-  Modify::ComputeCreator creator;
-};
-
-const ComputeEntry compute_styles[] = {
-    {"concentration/grid", "solid fraction per layer, size class and type", &create_compute<ComputeConcentrationGrid>},
+const StyleEntry<Modify::ComputeCreator> compute_styles[] = {
+    {"concentration/grid", "solid fraction per layer, size class and type", &create<Compute, ComputeConcentrationGrid>},
 };
 
 }    // namespace
 
 void LAMMPS_NS::sediment_register_styles(LAMMPS *lmp)
 {
-  for (const FixEntry &style : fix_styles) (*lmp->modify->fix_map)[style.name] = style.creator;
-  for (const ComputeEntry &style : compute_styles) (*lmp->modify->compute_map)[style.name] = style.creator;
+  for (const auto &style : fix_styles) (*lmp->modify->fix_map)[style.name] = style.creator;
+  for (const auto &style : compute_styles) (*lmp->modify->compute_map)[style.name] = style.creator;
 }
 
 extern "C" void sediment_register(void *lmp)
@@ -82,8 +71,8 @@ extern "C" void lammpsplugin_init(void *lmp, void *handle, void *regfunc)
     plugin.handle = handle;
     (*reg)(&plugin, lmp);
   };
-  for (const FixEntry &style : fix_styles)
+  for (const auto &style : fix_styles)
     add("fix", style.name, style.info, reinterpret_cast<void *>(style.creator));
-  for (const ComputeEntry &style : compute_styles)
+  for (const auto &style : compute_styles)
     add("compute", style.name, style.info, reinterpret_cast<void *>(style.creator));
 }
