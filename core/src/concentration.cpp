@@ -17,6 +17,159 @@ double below(double radius, double u)
   return pi * (radius * radius * v - v * v * v / 3.0);
 }
 
+int wrap(int k, int n)
+{
+  k %= n;
+  return k < 0 ? k + n : k;
+}
+
+// The cell of an axis holding unwrapped index k: wrapped when periodic, -1 when outside.
+int cell_of(const Layers &axis, int k)
+{
+  if (axis.periodic) return wrap(k, axis.count);
+  return k >= 0 && k < axis.count ? k : -1;
+}
+
+// Unwrapped indices of the first and last layer that the interval [lo, hi] touches, clamped to
+// the axis unless it is periodic; first > last when it misses a bounded axis.
+void touched(const Layers &axis, double lo, double hi, int &first, int &last)
+{
+  first = static_cast<int>(std::floor((lo - axis.lo) / axis.thickness));
+  last = static_cast<int>(std::floor((hi - axis.lo) / axis.thickness));
+  if (!axis.periodic) {
+    first = std::max(first, 0);
+    last = std::min(last, axis.count - 1);
+  }
+}
+
+// Calls visit(cell, volume) for the slices of the sphere in the layers it touches.
+template <class Visit> void for_each_slice(const Layers &axis, double centre, double radius, Visit visit)
+{
+  int first, last;
+  touched(axis, centre - radius, centre + radius, first, last);
+  double lower = below(radius, axis.lo + first * axis.thickness - centre);
+  for (int k = first; k <= last; ++k) {
+    const double upper = below(radius, axis.lo + (k + 1) * axis.thickness - centre);
+    visit(cell_of(axis, k), upper - lower);
+    lower = upper;
+  }
+}
+
+struct Bracket {
+  int k0, k1;
+  double w;    // weight of k1
+};
+
+// The two layer centres around x and the linear weight between them.
+Bracket bracket(const Layers &axis, double x)
+{
+  const double s = (x - axis.lo) / axis.thickness - 0.5;    // in layers from the first centre
+  if (axis.periodic) {
+    const double k = std::floor(s);
+    const int k0 = static_cast<int>(k);
+    return {wrap(k0, axis.count), wrap(k0 + 1, axis.count), s - k};
+  }
+  if (s <= 0.0) return {0, 0, 0.0};
+  if (s >= axis.count - 1) return {axis.count - 1, axis.count - 1, 0.0};
+  const int k = static_cast<int>(s);
+  return {k, k + 1, s - k};
+}
+
+// Volumes of the sphere of radius r about the origin cut by planes normal to x, y and z. A slice at
+// height u along x is a disc of radius rho = sqrt(r^2 - u^2); the part of it with y >= e is the
+// segment rho^2 acos(e / rho) - e sqrt(rho^2 - e^2), the part with y >= Y and z >= Z (Y, Z >= 0,
+// corner inside the disc) is half of each segment minus a quarter disc plus Y Z. Both integrate
+// in closed form along u; atan2 instead of acos/asin keeps the ends (s = 0) accurate.
+class SphereCuts {
+ public:
+  explicit SphereCuts(double radius) : r(radius), r2(radius * radius) {}
+
+  // Volume with x <= u, y >= y0 and z >= z0.
+  double corner(double u, double y0, double z0) const
+  {
+    u = std::clamp(u, -r, r);
+    if (z0 < 0.0) return half(u, y0) - corner(u, y0, -z0);    // mirror the part below z0
+    if (y0 < 0.0) return half(u, z0) - corner(u, -y0, z0);
+    const double q = r2 - y0 * y0 - z0 * z0;
+    if (q <= 0.0) return 0.0;
+    const double uc = std::sqrt(q);
+    if (u <= -uc) return 0.0;
+    const double b = std::min(u, uc);
+    return 0.5 * (segment(b, y0) - segment(-uc, y0) + segment(b, z0) - segment(-uc, z0)) -
+        0.25 * pi * (disc(b) - disc(-uc)) + y0 * z0 * (b + uc);
+  }
+
+ private:
+  double r, r2;
+
+  // Integral of rho^2 along u.
+  double disc(double u) const { return r2 * u - u * u * u / 3.0; }
+
+  // Volume with x <= u and y >= e.
+  double half(double u, double e) const
+  {
+    if (e < 0.0) return pi * (disc(u) - disc(-r)) - half(u, -e);
+    const double k2 = r2 - e * e;
+    if (k2 <= 0.0) return 0.0;
+    const double k = std::sqrt(k2);
+    if (u <= -k) return 0.0;
+    return segment(std::min(u, k), e) - segment(-k, e);
+  }
+
+  // Antiderivative along u of the segment area with y >= e >= 0, for |u| <= sqrt(r^2 - e^2):
+  // by parts on rho^2 acos(e / rho), the rest in asin and atan.
+  double segment(double u, double e) const
+  {
+    const double k2 = r2 - e * e;
+    const double s = std::sqrt(std::max(0.0, k2 - u * u));    // sqrt(rho^2 - e^2)
+    const double angle = e == 0.0 ? 0.5 * pi : std::atan2(s, e);    // acos(e / rho)
+    const double arc = std::atan2(u, s);                            // asin(u / k)
+    return disc(u) * angle + e * (k2 * arc - u * s) / 6.0 - e * 2.0 / 3.0 * r2 * arc +
+        2.0 / 3.0 * r2 * r * std::atan2(u * e, r * s) - 0.5 * e * (u * s + k2 * arc);
+  }
+};
+
+// Spreads the sphere over the cells it crosses along two or three axes: each cell's volume is the
+// inclusion-exclusion of SphereCuts::corner at its eight vertices, so the cells telescope to the
+// whole sphere. Along an axis not crossed the one cell spans [-r, r].
+double spread_over_cells(const Grid &grid, const double centre[3], double radius, const int first[3],
+                         const int last[3], const bool crossing[3], double *values, int stride)
+{
+  std::vector<double> edges[3];
+  std::vector<int> cells[3];
+  for (int d = 0; d < 3; ++d) {
+    if (!crossing[d]) {
+      edges[d] = {-radius, radius};
+      cells[d] = {grid.resolved[d] ? cell_of(grid.axes[d], first[d]) : 0};
+      continue;
+    }
+    const Layers &axis = grid.axes[d];
+    for (int k = first[d]; k <= last[d] + 1; ++k) edges[d].push_back(axis.lo + k * axis.thickness - centre[d]);
+    for (int k = first[d]; k <= last[d]; ++k) cells[d].push_back(cell_of(axis, k));
+  }
+  const int n[3] = {static_cast<int>(cells[0].size()), static_cast<int>(cells[1].size()),
+                    static_cast<int>(cells[2].size())};
+  const SphereCuts cuts(radius);
+  std::vector<double> vertex((n[0] + 1) * (n[1] + 1) * (n[2] + 1));
+  auto at = [&](int i, int j, int k) -> double & { return vertex[i + (n[0] + 1) * (j + (n[1] + 1) * k)]; };
+  for (int k = 0; k <= n[2]; ++k)
+    for (int j = 0; j <= n[1]; ++j)
+      for (int i = 0; i <= n[0]; ++i) at(i, j, k) = cuts.corner(edges[0][i], edges[1][j], edges[2][k]);
+
+  const int nx = grid.axes[0].count, ny = grid.axes[1].count;
+  double inside = 0.0;
+  for (int k = 0; k < n[2]; ++k)
+    for (int j = 0; j < n[1]; ++j)
+      for (int i = 0; i < n[0]; ++i) {
+        if (cells[0][i] < 0 || cells[1][j] < 0 || cells[2][k] < 0) continue;
+        const double volume = at(i + 1, j, k) - at(i, j, k) - at(i + 1, j + 1, k) + at(i, j + 1, k) -
+            at(i + 1, j, k + 1) + at(i, j, k + 1) + at(i + 1, j + 1, k + 1) - at(i, j + 1, k + 1);
+        values[(cells[0][i] + nx * (cells[1][j] + ny * cells[2][k])) * stride] += volume;
+        inside += volume;
+      }
+  return inside;
+}
+
 }    // namespace
 
 double sphere_slab_volume(double centre, double radius, double a, double b)
@@ -26,36 +179,26 @@ double sphere_slab_volume(double centre, double radius, double a, double b)
 
 double add_sphere_to_layers(const Layers &layers, double centre, double radius, double *values, int stride)
 {
-  const double total = 4.0 / 3.0 * pi * radius * radius * radius;
-  const int first = std::max(0, static_cast<int>(std::floor((centre - radius - layers.lo) / layers.thickness)));
-  const int last = std::min(layers.count - 1,
-                            static_cast<int>(std::floor((centre + radius - layers.lo) / layers.thickness)));
-  if (first > last) return total;
-  double lower = below(radius, layers.lo + first * layers.thickness - centre);
-  const double start = lower;
-  for (int k = first; k <= last; ++k) {
-    const double upper = below(radius, layers.lo + (k + 1) * layers.thickness - centre);
-    values[k * stride] += upper - lower;
-    lower = upper;
-  }
-  return total - (lower - start);
+  double inside = 0.0;
+  for_each_slice(layers, centre, radius, [&](int k, double volume) {
+    if (k < 0) return;
+    values[k * stride] += volume;
+    inside += volume;
+  });
+  return 4.0 / 3.0 * pi * radius * radius * radius - inside;
 }
 
 double profile_at(const Layers &layers, const double *values, double x, int stride)
 {
-  const double s = (x - layers.lo) / layers.thickness - 0.5;    // in units of layers from centre 0
-  if (s <= 0.0) return values[0];
-  if (s >= layers.count - 1) return values[(layers.count - 1) * stride];
-  const int k = static_cast<int>(s);
-  const double w = s - k;
-  return (1.0 - w) * values[k * stride] + w * values[(k + 1) * stride];
+  const Bracket at = bracket(layers, x);
+  return (1.0 - at.w) * values[at.k0 * stride] + at.w * values[at.k1 * stride];
 }
 
-void smooth_profile(const Layers &layers, const double *values, double width, double *out)
+void smooth_profile(const Layers &layers, const double *values, double width, double *out, int stride)
 {
   // Each layer's content is spread over its neighbours with Gaussian weights that sum to one;
-  // what would leave through an end is reflected back in (mirror ends). So the total is
-  // conserved exactly and a uniform profile stays uniform.
+  // what would leave through an end is reflected back in (mirror ends) or comes in at the other
+  // (periodic). So the total is conserved exactly and a uniform profile stays uniform.
   const int n = layers.count;
   const int reach = static_cast<int>(std::ceil(4.0 * width / layers.thickness));
   std::vector<double> kernel(reach + 1);
@@ -65,15 +208,94 @@ void smooth_profile(const Layers &layers, const double *values, double width, do
     kernel[m] = std::exp(-0.5 * x * x);
     norm += m == 0 ? kernel[m] : 2.0 * kernel[m];
   }
-  auto fold = [n](int t) {
+  const bool periodic = layers.periodic;
+  auto fold = [n, periodic](int t) {
+    if (periodic) return wrap(t, n);
     while (t < 0 || t >= n) t = t < 0 ? -t - 1 : 2 * n - t - 1;
     return t;
   };
   std::fill(out, out + n, 0.0);
   for (int j = 0; j < n; ++j) {
-    if (values[j] == 0.0) continue;
-    const double share = values[j] / norm;
+    const double value = values[j * stride];
+    if (value == 0.0) continue;
+    const double share = value / norm;
     for (int m = -reach; m <= reach; ++m) out[fold(j + m)] += share * kernel[std::abs(m)];
+  }
+}
+
+double add_sphere_to_grid(const Grid &grid, const double centre[3], double radius, double *values, int stride)
+{
+  const double total = 4.0 / 3.0 * pi * radius * radius * radius;
+  int first[3], last[3], crossing[3], ncrossing = 0;
+  bool crosses[3] = {false, false, false};
+  for (int d = 0; d < 3; ++d) {
+    first[d] = last[d] = 0;
+    if (!grid.resolved[d]) continue;
+    const Layers &axis = grid.axes[d];
+    // A sphere crossing a face (an outer one too) is split along d; the range is clamped after.
+    if (std::floor((centre[d] - radius - axis.lo) / axis.thickness) !=
+        std::floor((centre[d] + radius - axis.lo) / axis.thickness))
+      crosses[d] = true, crossing[ncrossing++] = d;
+    touched(axis, centre[d] - radius, centre[d] + radius, first[d], last[d]);
+    if (first[d] > last[d]) return total;
+  }
+
+  const int nx = grid.axes[0].count, ny = grid.axes[1].count;
+  if (ncrossing <= 1) {    // exact: whole, or slices along the one crossing axis
+    int cell[3];
+    for (int d = 0; d < 3; ++d) cell[d] = grid.resolved[d] ? cell_of(grid.axes[d], first[d]) : 0;
+    if (ncrossing == 0) {
+      if (cell[0] < 0 || cell[1] < 0 || cell[2] < 0) return total;
+      values[(cell[0] + nx * (cell[1] + ny * cell[2])) * stride] += total;
+      return 0.0;
+    }
+    const int a = crossing[0];
+    for (int d = 0; d < 3; ++d)
+      if (d != a && cell[d] < 0) return total;
+    double inside = 0.0;
+    for_each_slice(grid.axes[a], centre[a], radius, [&](int k, double volume) {
+      if (k < 0) return;
+      cell[a] = k;
+      values[(cell[0] + nx * (cell[1] + ny * cell[2])) * stride] += volume;
+      inside += volume;
+    });
+    return total - inside;
+  }
+  return total - spread_over_cells(grid, centre, radius, first, last, crosses, values, stride);
+}
+
+double grid_value_at(const Grid &grid, const double *values, const double point[3], int stride)
+{
+  Bracket at[3];
+  for (int d = 0; d < 3; ++d) at[d] = grid.resolved[d] ? bracket(grid.axes[d], point[d]) : Bracket{0, 0, 0.0};
+  const int nx = grid.axes[0].count, ny = grid.axes[1].count;
+  double sum = 0.0;
+  for (int corner = 0; corner < 8; ++corner) {
+    double weight = 1.0;
+    int cell[3];
+    for (int d = 0; d < 3; ++d) {
+      const bool upper = corner >> d & 1;
+      weight *= upper ? at[d].w : 1.0 - at[d].w;
+      cell[d] = upper ? at[d].k1 : at[d].k0;
+    }
+    if (weight != 0.0) sum += weight * values[(cell[0] + nx * (cell[1] + ny * cell[2])) * stride];
+  }
+  return sum;
+}
+
+void smooth_grid(const Grid &grid, double *values, double width, double *scratch, int stride)
+{
+  const int count[3] = {grid.axes[0].count, grid.axes[1].count, grid.axes[2].count};
+  const int step[3] = {1, count[0], count[0] * count[1]};
+  for (int d = 0; d < 3; ++d) {
+    if (!grid.resolved[d] || count[d] < 2) continue;
+    const int b = (d + 1) % 3, c = (d + 2) % 3;
+    for (int j = 0; j < count[b]; ++j)
+      for (int k = 0; k < count[c]; ++k) {
+        double *line = values + (j * step[b] + k * step[c]) * stride;
+        smooth_profile(grid.axes[d], line, width, scratch, step[d] * stride);
+        for (int m = 0; m < count[d]; ++m) line[m * step[d] * stride] = scratch[m];
+      }
   }
 }
 

@@ -19,28 +19,41 @@
 using namespace LAMMPS_NS;
 
 ComputeConcentrationGrid::ComputeConcentrationGrid(LAMMPS *lmp, int narg, char **arg) :
-    Compute(lmp, narg, arg), axis(-1), nlayers(0), has_bounds(0), bound_lo(0.0), bound_hi(0.0),
-    by_type(0), thickness(0.0), smooth_width(0.0), ncols(1), layers{0.0, 1.0, 1}, profiled_step(-1),
-    nmax(0)
+    Compute(lmp, narg, arg), axis(-1), counts{0, 0, 0}, has_bounds(0), bounds{}, ncentres(0), by_type(0),
+    thickness(0.0), smooth_width(0.0), ncols(1), grid{}, cell_volume(1.0), profiled_step(-1), nmax(0)
 {
+  const int dimension = domain->dimension;
+  int nbounds = 0;
   int iarg = 3;
   while (iarg < narg) {
     const char *keyword = arg[iarg];
-    if (strcmp(keyword, "layers") == 0) {
-      if (iarg + 2 >= narg) error->all(FLERR, "Compute concentration/grid: 'layers' needs an axis and a count");
-      const char *dim = arg[iarg + 1];
-      axis = strcmp(dim, "x") == 0 ? 0 : strcmp(dim, "y") == 0 ? 1 : strcmp(dim, "z") == 0 ? 2 : -1;
-      if (axis < 0) error->all(FLERR, "Compute concentration/grid: layer axis must be x, y or z, not '{}'", dim);
-      nlayers = utils::inumeric(FLERR, arg[iarg + 2], false, lmp);
-      if (nlayers < 1) error->all(FLERR, "Compute concentration/grid: number of layers must be >= 1");
-      iarg += 3;
+    if (strcmp(keyword, "layers") == 0 || strcmp(keyword, "cells") == 0) {
+      if (counts[0] > 0) error->all(FLERR, "Compute concentration/grid: give either 'layers' or 'cells', once");
+      if (keyword[0] == 'l') {
+        if (iarg + 2 >= narg) error->all(FLERR, "Compute concentration/grid: 'layers' needs an axis and a count");
+        const char *dim = arg[iarg + 1];
+        axis = strcmp(dim, "x") == 0 ? 0 : strcmp(dim, "y") == 0 ? 1 : strcmp(dim, "z") == 0 ? 2 : -1;
+        if (axis < 0) error->all(FLERR, "Compute concentration/grid: layer axis must be x, y or z, not '{}'", dim);
+        counts[0] = counts[1] = counts[2] = 1;
+        counts[axis] = utils::inumeric(FLERR, arg[iarg + 2], false, lmp);
+        iarg += 3;
+      } else {
+        if (iarg + dimension >= narg)
+          error->all(FLERR, "Compute concentration/grid: 'cells' needs {} counts in a {}d simulation", dimension, dimension);
+        counts[2] = 1;
+        for (int d = 0; d < dimension; ++d) counts[d] = utils::inumeric(FLERR, arg[iarg + 1 + d], false, lmp);
+        iarg += 1 + dimension;
+      }
+      for (int d = 0; d < 3; ++d)
+        if (counts[d] < 1) error->all(FLERR, "Compute concentration/grid: numbers of layers or cells must be >= 1");
     } else if (strcmp(keyword, "bounds") == 0) {
-      if (iarg + 2 >= narg) error->all(FLERR, "Compute concentration/grid: 'bounds' needs LO and HI");
-      bound_lo = utils::numeric(FLERR, arg[iarg + 1], false, lmp);
-      bound_hi = utils::numeric(FLERR, arg[iarg + 2], false, lmp);
-      if (!(bound_hi > bound_lo)) error->all(FLERR, "Compute concentration/grid: bounds need LO < HI");
+      // LO HI along the layer axis, or xlo xhi ylo yhi [zlo zhi] for cells; read after the grid.
+      while (iarg + 1 + nbounds < narg && utils::is_double(arg[iarg + 1 + nbounds]) && nbounds < 2 * dimension) {
+        bounds[nbounds / 2][nbounds % 2] = utils::numeric(FLERR, arg[iarg + 1 + nbounds], false, lmp);
+        ++nbounds;
+      }
       has_bounds = 1;
-      iarg += 3;
+      iarg += 1 + nbounds;
     } else if (strcmp(keyword, "classes") == 0) {
       ++iarg;
       while (iarg < narg && utils::is_double(arg[iarg]))
@@ -67,13 +80,25 @@ ComputeConcentrationGrid::ComputeConcentrationGrid(LAMMPS *lmp, int narg, char *
       if (!(smooth_width > 0.0)) error->all(FLERR, "Compute concentration/grid: smooth width must be > 0");
       iarg += 2;
     } else {
-      error->all(FLERR, "Compute concentration/grid: unknown keyword '{}' (expected layers, bounds, "
+      error->all(FLERR, "Compute concentration/grid: unknown keyword '{}' (expected layers, cells, bounds, "
                         "classes, types, thickness or smooth)", keyword);
     }
   }
-  if (axis < 0) error->all(FLERR, "Compute concentration/grid: keyword 'layers AXIS N' is required");
+  if (counts[0] == 0)
+    error->all(FLERR, "Compute concentration/grid: the grid is required: 'layers AXIS N' or 'cells NX NY{}'",
+               dimension == 3 ? " NZ" : "");
   if (!atom->radius_flag) error->all(FLERR, "Compute concentration/grid requires atom attribute radius");
-  if (domain->dimension == 2) {
+  if (has_bounds) {
+    const int expected = axis >= 0 ? 2 : 2 * dimension;
+    if (nbounds != expected)
+      error->all(FLERR, "Compute concentration/grid: 'bounds' needs {} values ({})", expected,
+                 axis >= 0 ? "LO HI along the layer axis" : dimension == 3 ? "xlo xhi ylo yhi zlo zhi" : "xlo xhi ylo yhi");
+    if (axis >= 0) std::swap(bounds[0], bounds[axis]);
+    for (int d = 0; d < 3; ++d)
+      if ((axis < 0 ? d < dimension : d == axis) && !(bounds[d][1] > bounds[d][0]))
+        error->all(FLERR, "Compute concentration/grid: bounds need LO < HI along {}", "xyz"[d]);
+  }
+  if (dimension == 2) {
     if (axis == 2) error->all(FLERR, "Compute concentration/grid: layers along z in a 2d simulation");
     if (thickness == 0.0)
       error->all(FLERR, "Compute concentration/grid: a 2d simulation needs 'thickness T' (the slab the "
@@ -82,17 +107,20 @@ ComputeConcentrationGrid::ComputeConcentrationGrid(LAMMPS *lmp, int narg, char *
     error->all(FLERR, "Compute concentration/grid: 'thickness' is for 2d simulations only");
   }
 
+  for (int d = 0; d < 3; ++d) grid.resolved[d] = axis >= 0 ? d == axis : d < dimension;
+  ncentres = axis >= 0 ? 1 : dimension;
+  const int ncells = counts[0] * counts[1] * counts[2];
   ncols = 1 + (class_edges.empty() ? 0 : static_cast<int>(class_edges.size()) + 1) + (by_type ? atom->ntypes : 0);
   array_flag = 1;
-  size_array_rows = nlayers;
-  size_array_cols = 1 + ncols;
+  size_array_rows = ncells;
+  size_array_cols = ncentres + ncols;
   extarray = 0;
   peratom_flag = 1;
   size_peratom_cols = 0;
-  local.assign(static_cast<size_t>(nlayers) * ncols, 0.0);
+  local.assign(static_cast<size_t>(ncells) * ncols, 0.0);
   fractions = local;
-  scratch.assign(nlayers, 0.0);
-  memory->create(array, nlayers, 1 + ncols, "concentration/grid:array");
+  scratch.assign(*std::max_element(counts, counts + 3), 0.0);
+  memory->create(array, ncells, ncentres + ncols, "concentration/grid:array");
 }
 
 ComputeConcentrationGrid::~ComputeConcentrationGrid()
@@ -103,16 +131,27 @@ ComputeConcentrationGrid::~ComputeConcentrationGrid()
 
 void ComputeConcentrationGrid::init()
 {
-  const double lo = has_bounds ? bound_lo : domain->boxlo[axis];
-  const double hi = has_bounds ? bound_hi : domain->boxhi[axis];
-  layers = {lo, (hi - lo) / nlayers, nlayers};
+  // The grid spans the bounds or the box; it wraps along a periodic dimension it spans whole.
+  cell_volume = 1.0;
+  for (int d = 0; d < 3; ++d) {
+    const bool own_bounds = has_bounds && grid.resolved[d];
+    const double lo = own_bounds ? bounds[d][0] : domain->boxlo[d];
+    const double hi = own_bounds ? bounds[d][1] : domain->boxhi[d];
+    grid.axes[d] = {lo, (hi - lo) / counts[d], counts[d], domain->periodicity[d] && !own_bounds};
+    cell_volume *= grid.resolved[d] ? grid.axes[d].thickness : extent(d);
+  }
   profiled_step = -1;
+}
+
+// Extent of the cells along an axis the grid does not resolve: the box, or the 2d slab thickness.
+double ComputeConcentrationGrid::extent(int dim) const
+{
+  return dim == 2 && domain->dimension == 2 ? thickness : domain->prd[dim];
 }
 
 double ComputeConcentrationGrid::cross_section() const
 {
-  if (domain->dimension == 2) return domain->prd[1 - axis] * thickness;
-  return domain->prd[(axis + 1) % 3] * domain->prd[(axis + 2) % 3];
+  return axis < 0 ? 0.0 : extent((axis + 1) % 3) * extent((axis + 2) % 3);
 }
 
 Compute *ComputeConcentrationGrid::find_fraction(LAMMPS *lmp, const char *reference, const char *caller)
@@ -154,48 +193,35 @@ void ComputeConcentrationGrid::profile()
   int *type = atom->type;
   const int class_col = 1;
   const int type_col = 1 + (class_edges.empty() ? 0 : static_cast<int>(class_edges.size()) + 1);
-  const bool periodic = domain->periodicity[axis] && !has_bounds;
-  const double period = domain->prd[axis];
 
   for (int i = 0; i < atom->nlocal; ++i) {
     if (!(mask[i] & groupbit)) continue;
     int columns[3] = {0, -1, -1};
     if (!class_edges.empty()) columns[1] = class_col + size_class(2.0 * radius[i]);
     if (by_type) columns[2] = type_col + type[i] - 1;
-    for (int c : columns) {
-      if (c < 0) continue;
-      double *column = local.data() + c;
-      const double centre = x[i][axis];
-      sediment::add_sphere_to_layers(layers, centre, radius[i], column, ncols);
-      if (periodic) {    // the parts that stick out of one end belong at the other
-        if (centre - radius[i] < layers.lo) sediment::add_sphere_to_layers(layers, centre + period, radius[i], column, ncols);
-        if (centre + radius[i] > layers.hi()) sediment::add_sphere_to_layers(layers, centre - period, radius[i], column, ncols);
-      }
-    }
+    for (int c : columns)
+      if (c >= 0) sediment::add_sphere_to_grid(grid, x[i], radius[i], local.data() + c, ncols);
   }
   MPI_Allreduce(local.data(), fractions.data(), static_cast<int>(local.size()), MPI_DOUBLE, MPI_SUM, world);
 
-  // Solid volume per layer -> solid fraction (a 2d disc of radius r stands for a sphere whose
+  // Solid volume per cell -> solid fraction (in 2d a disc of radius r stands for a sphere whose
   // volume is spread over the slab thickness), then optional smoothing column by column.
-  const double cell = layers.thickness * cross_section();
-  for (double &v : fractions) v /= cell;
-  if (smooth_width > 0.0) {
-    std::vector<double> column(nlayers);
-    for (int c = 0; c < ncols; ++c) {
-      for (int k = 0; k < nlayers; ++k) column[k] = fractions[k * ncols + c];
-      sediment::smooth_profile(layers, column.data(), smooth_width, scratch.data());
-      for (int k = 0; k < nlayers; ++k) fractions[k * ncols + c] = scratch[k];
-    }
-  }
+  for (double &v : fractions) v /= cell_volume;
+  if (smooth_width > 0.0)
+    for (int c = 0; c < ncols; ++c) sediment::smooth_grid(grid, fractions.data() + c, smooth_width, scratch.data(), ncols);
 }
 
 void ComputeConcentrationGrid::compute_array()
 {
   invoked_array = update->ntimestep;
   profile();
-  for (int k = 0; k < nlayers; ++k) {
-    array[k][0] = layers.lo + (k + 0.5) * layers.thickness;
-    for (int c = 0; c < ncols; ++c) array[k][1 + c] = fractions[k * ncols + c];
+  const int ncells = size_array_rows;
+  for (int cell = 0; cell < ncells; ++cell) {
+    const int index[3] = {cell % counts[0], cell / counts[0] % counts[1], cell / (counts[0] * counts[1])};
+    int col = 0;
+    for (int d = 0; d < 3; ++d)
+      if (grid.resolved[d]) array[cell][col++] = grid.axes[d].lo + (index[d] + 0.5) * grid.axes[d].thickness;
+    for (int c = 0; c < ncols; ++c) array[cell][ncentres + c] = fractions[cell * ncols + c];
   }
 }
 
@@ -211,10 +237,10 @@ void ComputeConcentrationGrid::compute_peratom()
   double **x = atom->x;
   int *mask = atom->mask;
   for (int i = 0; i < atom->nlocal; ++i)
-    vector_atom[i] = (mask[i] & groupbit) ? sediment::profile_at(layers, fractions.data(), x[i][axis], ncols) : 0.0;
+    vector_atom[i] = (mask[i] & groupbit) ? sediment::grid_value_at(grid, fractions.data(), x[i], ncols) : 0.0;
 }
 
 double ComputeConcentrationGrid::memory_usage()
 {
-  return (3.0 * local.size() + nlayers * (1.0 + ncols) + nmax) * sizeof(double);
+  return (3.0 * local.size() + static_cast<double>(size_array_rows) * size_array_cols + nmax) * sizeof(double);
 }

@@ -1,6 +1,7 @@
 /* ----------------------------------------------------------------------
    SEDIMENT package: solid volume fraction of spheres in layers along one
-   axis (exact sphere-slab volumes), optionally by size class and atom type.
+   axis or in 3d cells (exact sphere-cell volumes), optionally by size class
+   and atom type.
 ------------------------------------------------------------------------- */
 
 #ifdef COMPUTE_CLASS
@@ -34,8 +35,10 @@ class ComputeConcentrationGrid : public Compute {
   // errors name the style asking.
   static Compute *find_fraction(class LAMMPS *lmp, const char *reference, const char *caller);
 
-  // For fix layers/hdf5: the layers, the names of the fraction columns, the class edges.
-  const sediment::Layers &layer_geometry() const { return layers; }
+  // For fix layers/hdf5: the layers (when the grid is layers), the names of the fraction
+  // columns, the class edges.
+  bool is_layers() const { return axis >= 0; }
+  const sediment::Layers &layer_geometry() const { return grid.axes[axis]; }
   std::vector<std::string> column_names() const;
   const std::vector<double> &class_diameters() const { return class_edges; }
   int layer_axis() const { return axis; }
@@ -43,23 +46,26 @@ class ComputeConcentrationGrid : public Compute {
   double cross_section() const;
 
  private:
-  int axis;                           // 0, 1, 2 = x, y, z
-  int nlayers;
+  int axis;                           // layers: 0, 1, 2 = x, y, z; cells: -1
+  int counts[3];                      // cells along x, y, z (1 where not resolved)
   int has_bounds;
-  double bound_lo, bound_hi;
+  double bounds[3][2];
+  int ncentres;                       // array columns before the fractions: cell centre coordinates
   std::vector<double> class_edges;    // diameters separating the size classes
   int by_type;
   double thickness;                   // 2d: slab thickness converting areas to volumes
   double smooth_width;                // 0: no smoothing
   int ncols;                          // fraction columns: total, classes, types
 
-  sediment::Layers layers;
+  sediment::Grid grid;
+  double cell_volume;
   std::vector<double> local, fractions, scratch;
   bigint profiled_step;
   int nmax;
 
   void profile();
   int size_class(double diameter) const;
+  double extent(int dim) const;
 };
 
 }    // namespace LAMMPS_NS

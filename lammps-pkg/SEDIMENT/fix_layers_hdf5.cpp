@@ -196,6 +196,8 @@ void FixLayersHDF5::init()
   if (!grid)
     error->all(FLERR, "Fix layers/hdf5: compute '{}' is a compute {}, not a compute concentration/grid",
                compute_id, modify->compute[icompute]->style);
+  if (!grid->is_layers())
+    error->all(FLERR, "Fix layers/hdf5: compute '{}' bins into 3d cells; layer files need 'layers AXIS N'", compute_id);
   fluid = fluid_id ? FixFluid::find(lmp, fluid_id, "layers/hdf5") : nullptr;
 }
 

@@ -291,9 +291,10 @@ def mpi_consistency(np_ranks: int):
 @check
 def concentration_grid(np_ranks: int):
     with tempfile.TemporaryDirectory() as tmp:
-        profile, peratom = Path(tmp) / "profile.txt", Path(tmp) / "peratom.txt"
-        run_deck("concentration_grid.lmp", {"profile": profile, "peratom": peratom}, np_ranks)
+        profile, cells, peratom = (Path(tmp) / name for name in ("profile.txt", "cells.txt", "peratom.txt"))
+        run_deck("concentration_grid.lmp", {"profile": profile, "cells": cells, "peratom": peratom}, np_ranks)
         table = np.loadtxt(profile, comments="#", skiprows=4)[:, 1:]    # drop the row index
+        grid = np.loadtxt(cells, comments="#", skiprows=4)[:, 1:]
         atoms = np.loadtxt(peratom, skiprows=9)
     z, total, classes, types = table[:, 0], table[:, 1], table[:, 2:5], table[:, 5:7]
     cell = 0.01 * 0.01 * (0.02 / 80)
@@ -310,6 +311,28 @@ def concentration_grid(np_ranks: int):
     interp = np.interp(atoms[:, 1], z, total)
     inside = (atoms[:, 1] > z[0]) & (atoms[:, 1] < z[-1])
     assert np.allclose(atoms[inside, 3], interp[inside], rtol=1e-12, atol=0)
+
+    # 3d cells (x fastest): x y z centres, then the same columns. Summed over x and y they must give
+    # the layers (exact slab volumes, an independent formula); fractions conserve the solid volume.
+    fractions = grid[:, 3:].reshape(80, 25, 25, 6)
+    as_layers = fractions.mean(axis=(1, 2))
+    layer_diff = float(np.max(np.abs(as_layers - table[:, 1:])))
+    conserved_cells = abs(fractions[..., 0].sum() * cell / 625 - solid) / solid
+    # per-atom: periodic trilinear interpolation between cell centres
+    def bracket(x, h, n):
+        s = x / h - 0.5
+        k = np.floor(s).astype(int)
+        return k % n, (k + 1) % n, s - k
+    (x0, x1, wx), (y0, y1, wy), (z0, z1, wz) = (bracket(atoms[:, col], h, n) for col, h, n in
+                                                ((4, 0.01 / 25, 25), (5, 0.01 / 25, 25), (1, 0.02 / 80, 80)))
+    total_cells = fractions[..., 0]
+    interp_cells = sum(total_cells[zk, yk, xk] * (wz if zu else 1 - wz) * (wy if yu else 1 - wy) * (wx if xu else 1 - wx)
+                       for zu, zk in ((0, z0), (1, z1)) for yu, yk in ((0, y0), (1, y1)) for xu, xk in ((0, x0), (1, x1)))
+    interp_err = float(np.max(np.abs(atoms[:, 6] - interp_cells)))
+    report(f"concentration grid, 25 x 25 x 80 cells: solid volume conserved to {conserved_cells:.1e}; cells summed over "
+           f"x, y match the layers within {layer_diff:.1e} (fraction); per-atom trilinear within {interp_err:.1e}; "
+           f"max cell fraction {total_cells.max():.3f}")
+    assert conserved_cells < 1e-12 and layer_diff < 1e-13 and interp_err < 1e-13
 
 
 @check
@@ -397,10 +420,14 @@ BAD_INPUT = [
     ("fix f all fluid density 1000 viscosity 1e-3\nfix b all fluid/buoyancy f mixture c_c", "'mixture' needs c_ID and the solid density"),
     ("fix f all fluid density 1000 viscosity 1e-3\nfix b all fluid/buoyancy f mixture c_c -5", "mixture solid density must be > 0"),
     ("fix f all fluid density 1000 viscosity 1e-3\nfix b all fluid/buoyancy f mixture c_c 2650\nrun 0", "compute 'c' does not exist"),
-    ("compute c all concentration/grid", "keyword 'layers AXIS N' is required"),
+    ("compute c all concentration/grid", "the grid is required: 'layers AXIS N' or 'cells NX NY NZ'"),
+    ("compute c all concentration/grid cells 4 4", "'cells' needs 3 counts in a 3d simulation"),
+    ("compute c all concentration/grid cells 4 4 4 bounds 0 1 0 1", "'bounds' needs 6 values (xlo xhi ylo yhi zlo zhi)"),
+    ("compute c all concentration/grid cells 4 4 4 layers z 3", "give either 'layers' or 'cells', once"),
+    ("compute c all concentration/grid cells 4 4 4\nfix l all layers/hdf5 10 a.h5 c_c\nrun 0", "bins into 3d cells"),
     ("compute c all concentration/grid layers w 10", "layer axis must be x, y or z"),
-    ("compute c all concentration/grid layers z 0", "number of layers must be >= 1"),
-    ("compute c all concentration/grid layers z 10 bounds 1 0", "bounds need LO < HI"),
+    ("compute c all concentration/grid layers z 0", "numbers of layers or cells must be >= 1"),
+    ("compute c all concentration/grid layers z 10 bounds 1 0", "bounds need LO < HI along z"),
     ("compute c all concentration/grid layers z 10 classes 2 1", "positive and increasing"),
     ("compute c all concentration/grid layers z 10 thickness 1", "'thickness' is for 2d simulations only"),
     ("compute c all concentration/grid layers z 10 smooth -1", "smooth width must be > 0"),
