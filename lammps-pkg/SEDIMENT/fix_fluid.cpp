@@ -151,10 +151,10 @@ sediment::Submergence FixFluid::immersion(const double *x, double radius) const
 FixFluid *FixFluid::find(LAMMPS *lmp, const char *fluid_id, const char *caller)
 {
   const int ifix = lmp->modify->find_fix(fluid_id);
-  if (ifix < 0) lmp->error->all(FLERR, "Fix {}: fluid fix '{}' does not exist", caller, fluid_id);
+  if (ifix < 0) lmp->error->all(FLERR, "{}: fluid fix '{}' does not exist", caller, fluid_id);
   auto fluid = dynamic_cast<FixFluid *>(lmp->modify->fix[ifix]);
   if (!fluid)
-    lmp->error->all(FLERR, "Fix {}: fix '{}' is a fix {}, not a fix fluid", caller, fluid_id,
+    lmp->error->all(FLERR, "{}: fix '{}' is a fix {}, not a fix fluid", caller, fluid_id,
                     lmp->modify->fix[ifix]->style);
   return fluid;
 }

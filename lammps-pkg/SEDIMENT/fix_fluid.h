@@ -35,7 +35,8 @@ class FixFluid : public Fix {
   bool is_bingham() const { return fluid.yield_stress > 0.0; }
   const double *velocity() const { return flow; }
 
-  // Finds fix ID `fluid_id` and checks that it is a fix fluid; `caller` names the style asking.
+  // Finds fix ID `fluid_id` and checks that it is a fix fluid; `caller` names the style asking
+  // ("Fix fluid/drag", "Pair lubricate/fluid").
   static FixFluid *find(class LAMMPS *lmp, const char *fluid_id, const char *caller);
 
  private:

@@ -67,7 +67,7 @@ int FixFluidBuoyancy::setmask()
 
 void FixFluidBuoyancy::init()
 {
-  fluid = FixFluid::find(lmp, fluid_id, "fluid/buoyancy");
+  fluid = FixFluid::find(lmp, fluid_id, "Fix fluid/buoyancy");
 
   Fix *gravity_fix = nullptr;
   if (gravity_id) {

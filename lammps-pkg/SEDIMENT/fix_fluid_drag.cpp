@@ -106,7 +106,7 @@ int FixFluidDrag::setmask()
 
 void FixFluidDrag::init()
 {
-  fluid = FixFluid::find(lmp, fluid_id, "fluid/drag");
+  fluid = FixFluid::find(lmp, fluid_id, "Fix fluid/drag");
   model = std::make_unique<sediment::DragModel>(law, fluid->properties(), hindrance_buoyancy);
   concentration =
       concentration_id ? ComputeConcentrationGrid::find_fraction(lmp, concentration_id, "fluid/drag") : nullptr;

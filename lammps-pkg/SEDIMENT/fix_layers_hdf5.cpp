@@ -198,7 +198,7 @@ void FixLayersHDF5::init()
                compute_id, modify->compute[icompute]->style);
   if (!grid->is_layers())
     error->all(FLERR, "Fix layers/hdf5: compute '{}' bins into 3d cells; layer files need 'layers AXIS N'", compute_id);
-  fluid = fluid_id ? FixFluid::find(lmp, fluid_id, "layers/hdf5") : nullptr;
+  fluid = fluid_id ? FixFluid::find(lmp, fluid_id, "Fix layers/hdf5") : nullptr;
 }
 
 void FixLayersHDF5::setup(int /*vflag*/)

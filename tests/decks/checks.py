@@ -335,6 +335,90 @@ def concentration_grid(np_ranks: int):
     assert conserved_cells < 1e-12 and layer_diff < 1e-13 and interp_err < 1e-13
 
 
+# ---- lubrication ------------------------------------------------------------------------------
+def lubrication_run(np_ranks: int, **variables) -> np.ndarray:
+    return run_deck("lubrication.lmp", variables, np_ranks).samples    # time, gap, approach speed
+
+
+@check
+def lubrication(np_ranks: int):
+    mu, rho_f, d, rho_p = 1e-3, 1000.0, 1e-4, 2650.0
+    a = d / 4    # effective radius of two equal spheres
+    mass = rho_p * math.pi / 6 * d ** 3
+    dt = _core.rayleigh_time(d / 2, rho_p, 3e10, 0.25) / 5    # the time step the Hertz contacts need
+
+    # Coasting head-on: m_red dv/dt = -6 pi mu a^2 v / h with dh/dt = -v gives
+    # v0 - v = K ln(h0 / h), K = 6 pi mu a^2 / m_red, down to the inner cutoff h_in = 0.01 a.
+    k = 6 * math.pi * mu * a * a / (mass / 2)
+    v0, h0 = 2.0 * k, 0.5 * a
+    run = lubrication_run(np_ranks, speed=v0, gap0=h0, dt=dt, steps=int(0.6e-3 / dt), every=200)
+    gap, speed = run[:, 1], run[:, 2]
+    film = (gap > 0.01 * a) & (v0 - speed > 0.05 * v0)
+    reynolds = k * np.log(h0 / gap[film])
+    worst = float(np.max(np.abs((v0 - speed[film]) - reynolds) / reynolds))
+    report(f"lubrication, head-on at v0 = {v0:.4g} m/s = 2 K, dt = {dt:.3g} s (T_R / 5): deceleration within "
+           f"{100 * worst:.3f} % of K ln(h0/h) over {int(film.sum())} samples; at the end h = {gap[-1] / a:.4f} a, "
+           f"v = {speed[-1] / v0:.1e} v0 (Reynolds: comes to rest at {math.exp(-2) * 0.5:.4f} a)")
+    assert worst < 0.02 and gap.min() > 0.01 * a and speed.min() > -1e-9 * v0
+
+    # The fastest grains of the sedimentation cases (70 um, v_t = 4.0e-3 m/s, case B) meeting head-on
+    # at ten times that speed: the film stops them before the inner cutoff.
+    d70 = 70e-6
+    fast = lubrication_run(np_ranks, speed=0.04, gap0=0.5 * d70 / 4, d=d70, density=2500, dt=dt,
+                           steps=int(1e-3 / dt), every=500)
+    report(f"lubrication, 70 um grains head-on at 0.04 m/s: smallest gap {fast[:, 1].min() / (d70 / 4):.3f} a, "
+           f"inner cutoff 0.01 a")
+    assert fast[:, 1].min() > 0.01 * d70 / 4
+
+    # Settling onto a held sphere with buoyancy, Stokes drag and the film, at the contact time step:
+    # compare with the ODE m dv/dt = W - (3 pi mu d + c(h)) v, dh/dt = -v (RK4), above h_in.
+    weight = (rho_p - rho_f) * G * math.pi / 6 * d ** 3
+    v_start, h_start = weight / (3 * math.pi * mu * d), 0.6 * a
+    t_end = 12e-3
+    every = 2000
+    settle = lubrication_run(np_ranks, settle=1, speed=v_start, gap0=h_start, dt=dt, steps=int(t_end / dt),
+                             every=every)
+
+    def rhs(state):
+        h, v = state
+        c = 6 * math.pi * mu * a * a / max(h, 0.01 * a) if h < 0.5 * a else 0.0
+        return np.array([-v, (weight - (3 * math.pi * mu * d + c) * v) / mass])
+    state, step, reference = np.array([h_start, v_start]), 1e-7, []
+    for t in settle[:, 0]:
+        while len(reference) == 0 or reference[-1][0] < t - 1e-12:
+            if not reference:
+                reference.append((0.0, *state))
+                continue
+            t0 = reference[-1][0]
+            k1 = rhs(state); k2 = rhs(state + step / 2 * k1); k3 = rhs(state + step / 2 * k2); k4 = rhs(state + step * k3)
+            state = state + step / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
+            reference.append((t0 + step, *state))
+    ref = np.array(reference)
+    ref_gap = np.interp(settle[:, 0], ref[:, 0], ref[:, 1])
+    above = ref_gap > 0.01 * a
+    gap_err = float(np.max(np.abs(settle[above, 1] - ref_gap[above]) / ref_gap[above]))
+    report(f"lubrication, settling onto a held sphere at dt = {dt:.3g} s: gap within {gap_err:.1e} (relative) of "
+           f"the ODE over {int(above.sum())} samples down to h_in; final gap {settle[-1, 1]:.3g} m "
+           f"(contact overlap), final speed {settle[-1, 2]:.3g} m/s")
+    assert gap_err < 0.02
+    assert abs(settle[-1, 2]) < 1e-3 * v_start and settle[-1, 1] > -1e-3 * d    # resting on the contact
+
+    # Far above the contact time step, with a small inner cutoff (c dt / m up to 34 at h_in), the
+    # film alone would overshoot explicitly: `limit yes` keeps the approach speed falling
+    # monotonically (the film's resistance capped at m / 2 dt), `limit no` blows up.
+    def approach(limit):
+        return lubrication_run(np_ranks, settle=1, speed=v_start, gap0=h_start, dt=1e-4, steps=75, every=1,
+                               limit=limit, inner=0.001, contact=0)
+    limited, free = approach("yes"), approach("no")
+    closing = limited[:, 1] > 0
+    rises = int(np.sum(np.diff(limited[closing, 2]) > 1e-12 * v_start))
+    blown = float(np.max(np.abs(free[:, 2]))) / v_start
+    report(f"lubrication at dt = 1e-4 s, inner 0.001 a (c dt / m = {6 * math.pi * mu * a / 0.001 * 1e-4 / mass:.0f} "
+           f"at h_in): limit yes: approach speed never rises over {int(closing.sum())} steps to contact; "
+           f"limit no: |speed| reaches {blown:.2g} v_start")
+    assert rises == 0 and np.all(limited[closing, 2] > 0) and blown > 3    # the drive alone gives v_start
+
+
 @check
 def hindered_settling(np_ranks: int):
     # Validation case G: Richardson & Zaki (1954), u / u_t = (1 - phi)^4.65 at low Re.
@@ -420,6 +504,15 @@ BAD_INPUT = [
     ("fix f all fluid density 1000 viscosity 1e-3\nfix b all fluid/buoyancy f mixture c_c", "'mixture' needs c_ID and the solid density"),
     ("fix f all fluid density 1000 viscosity 1e-3\nfix b all fluid/buoyancy f mixture c_c -5", "mixture solid density must be > 0"),
     ("fix f all fluid density 1000 viscosity 1e-3\nfix b all fluid/buoyancy f mixture c_c 2650\nrun 0", "compute 'c' does not exist"),
+    ("pair_style lubricate/fluid", "needs the ID of a fix fluid"),
+    ("pair_style lubricate/fluid w inner 0.5 outer 0.1", "need 0 < inner < outer"),
+    ("pair_style lubricate/fluid w squeeze 2", "unknown keyword 'squeeze'"),
+    ("pair_style lubricate/fluid w limit maybe", "limit must be yes or no, not 'maybe'"),
+    ("pair_style lubricate/fluid w repulsion -1", "repulsion force scale must be > 0"),
+    ("pair_style lubricate/fluid w\npair_coeff * * 1.0", "pair_coeff takes the two types only"),
+    ("fix w all fluid density 1000 viscosity 1e-3\npair_style lubricate/fluid w\npair_coeff * *\nrun 0",
+     "use 'comm_modify vel yes'"),
+    ("comm_modify vel yes\npair_style lubricate/fluid nowater\npair_coeff * *\nrun 0", "Pair lubricate/fluid: fluid fix 'nowater' does not exist"),
     ("compute c all concentration/grid", "the grid is required: 'layers AXIS N' or 'cells NX NY NZ'"),
     ("compute c all concentration/grid cells 4 4", "'cells' needs 3 counts in a 3d simulation"),
     ("compute c all concentration/grid cells 4 4 4 bounds 0 1 0 1", "'bounds' needs 6 values (xlo xhi ylo yhi zlo zhi)"),

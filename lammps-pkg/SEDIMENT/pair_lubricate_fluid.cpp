@@ -1,0 +1,244 @@
+/* ----------------------------------------------------------------------
+   SEDIMENT package: pair lubricate/fluid
+------------------------------------------------------------------------- */
+
+#include "pair_lubricate_fluid.h"
+
+#include "fix_fluid.h"
+
+#include "atom.h"
+#include "comm.h"
+#include "error.h"
+#include "force.h"
+#include "memory.h"
+#include "neigh_list.h"
+#include "neighbor.h"
+#include "update.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <mpi.h>
+
+using namespace LAMMPS_NS;
+
+namespace {
+// The repulsion is cut where it has fallen to 1e-3 of its value at contact: g / q = ln(1000) / 10,
+// i.e. a gap of 0.69 q d_i <= 1.39 d_i.
+constexpr double kRepulsionReach = 0.6907755278982137;
+}    // namespace
+
+PairLubricateFluid::PairLubricateFluid(LAMMPS *lmp) :
+    Pair(lmp), fluid_id(nullptr), fluid(nullptr), repulsion_scale(0.0), limit(1), maxrad(0.0),
+    damping_sum(nullptr), nmax(0)
+{
+  single_enable = 0;
+  restartinfo = 0;    // holds a fix ID: the input deck restates it after read_restart
+  comm_forward = 1;
+  comm_reverse = 1;
+}
+
+PairLubricateFluid::~PairLubricateFluid()
+{
+  delete[] fluid_id;
+  memory->destroy(damping_sum);
+  if (allocated) {
+    memory->destroy(setflag);
+    memory->destroy(cutsq);
+  }
+}
+
+void PairLubricateFluid::allocate()
+{
+  allocated = 1;
+  const int n = atom->ntypes;
+  memory->create(setflag, n + 1, n + 1, "pair:setflag");
+  for (int i = 1; i <= n; ++i)
+    for (int j = i; j <= n; ++j) setflag[i][j] = 0;
+  memory->create(cutsq, n + 1, n + 1, "pair:cutsq");
+}
+
+void PairLubricateFluid::settings(int narg, char **arg)
+{
+  if (narg < 1) error->all(FLERR, "Pair lubricate/fluid: needs the ID of a fix fluid");
+  delete[] fluid_id;
+  fluid_id = utils::strdup(arg[0]);
+  range = sediment::LubricationRange{};
+  repulsion_scale = 0.0;
+  limit = 1;
+  int iarg = 1;
+  while (iarg < narg) {
+    const char *keyword = arg[iarg];
+    if (iarg + 1 >= narg) error->all(FLERR, "Pair lubricate/fluid: '{}' needs a value", keyword);
+    const char *value = arg[iarg + 1];
+    if (strcmp(keyword, "inner") == 0) {
+      range.inner = utils::numeric(FLERR, value, false, lmp);
+    } else if (strcmp(keyword, "outer") == 0) {
+      range.outer = utils::numeric(FLERR, value, false, lmp);
+    } else if (strcmp(keyword, "repulsion") == 0) {
+      repulsion_scale = utils::numeric(FLERR, value, false, lmp);
+      if (!(repulsion_scale > 0.0)) error->all(FLERR, "Pair lubricate/fluid: repulsion force scale must be > 0");
+    } else if (strcmp(keyword, "limit") == 0) {
+      if (strcmp(value, "yes") == 0) limit = 1;
+      else if (strcmp(value, "no") == 0) limit = 0;
+      else error->all(FLERR, "Pair lubricate/fluid: limit must be yes or no, not '{}'", value);
+    } else {
+      error->all(FLERR, "Pair lubricate/fluid: unknown keyword '{}' (expected inner, outer, repulsion or limit)", keyword);
+    }
+    iarg += 2;
+  }
+  if (!(range.inner > 0.0) || !(range.outer > range.inner))
+    error->all(FLERR, "Pair lubricate/fluid: need 0 < inner < outer (gaps in units of the effective radius)");
+}
+
+void PairLubricateFluid::coeff(int narg, char **arg)
+{
+  if (narg != 2) error->all(FLERR, "Pair lubricate/fluid: pair_coeff takes the two types only");
+  if (!allocated) allocate();
+  int ilo, ihi, jlo, jhi;
+  utils::bounds(FLERR, arg[0], 1, atom->ntypes, ilo, ihi, error);
+  utils::bounds(FLERR, arg[1], 1, atom->ntypes, jlo, jhi, error);
+  int count = 0;
+  for (int i = ilo; i <= ihi; ++i)
+    for (int j = std::max(jlo, i); j <= jhi; ++j) {
+      setflag[i][j] = 1;
+      ++count;
+    }
+  if (count == 0) error->all(FLERR, "Pair lubricate/fluid: pair_coeff sets no type pairs");
+}
+
+void PairLubricateFluid::init_style()
+{
+  if (!atom->radius_flag || !atom->rmass_flag)
+    error->all(FLERR, "Pair lubricate/fluid requires atom attributes radius and rmass (atom_style sphere)");
+  if (!comm->ghost_velocity)
+    error->all(FLERR, "Pair lubricate/fluid needs the velocities of ghost atoms: use 'comm_modify vel yes'");
+  fluid = FixFluid::find(lmp, fluid_id, "Pair lubricate/fluid");
+  if (!(fluid->properties().viscosity > 0.0))
+    error->all(FLERR, "Pair lubricate/fluid: fix {} has no viscosity", fluid_id);
+  neighbor->request(this, instance_me);
+
+  double local_max = 0.0;
+  for (int i = 0; i < atom->nlocal; ++i) local_max = std::max(local_max, atom->radius[i]);
+  MPI_Allreduce(&local_max, &maxrad, 1, MPI_DOUBLE, MPI_MAX, world);
+}
+
+double PairLubricateFluid::init_one(int i, int j)
+{
+  if (!setflag[i][j]) error->all(FLERR, "Pair lubricate/fluid: pair_coeff not set for types {} {}", i, j);
+  // The largest gap that matters between any two spheres present: a <= r_max / 2.
+  double reach = range.outer * 0.5 * maxrad;
+  if (repulsion_scale > 0.0) reach = std::max(reach, kRepulsionReach * 2.0 * 2.0 * maxrad);
+  return 2.0 * maxrad + reach;
+}
+
+void PairLubricateFluid::sum_damping()
+{
+  if (atom->nmax > nmax) {
+    memory->destroy(damping_sum);
+    nmax = atom->nmax;
+    memory->create(damping_sum, nmax, "lubricate/fluid:damping_sum");
+  }
+  const int nall = atom->nlocal + atom->nghost;
+  std::fill(damping_sum, damping_sum + nall, 0.0);
+  double **x = atom->x;
+  double *radius = atom->radius;
+  const double viscosity = fluid->properties().viscosity;
+  const int nlocal = atom->nlocal;
+  for (int ii = 0; ii < list->inum; ++ii) {
+    const int i = list->ilist[ii];
+    for (int jj = 0; jj < list->numneigh[i]; ++jj) {
+      const int j = list->firstneigh[i][jj] & NEIGHMASK;
+      const double dx = x[i][0] - x[j][0], dy = x[i][1] - x[j][1], dz = x[i][2] - x[j][2];
+      const double gap = std::sqrt(dx * dx + dy * dy + dz * dz) - radius[i] - radius[j];
+      const double c = sediment::squeeze_coefficient(viscosity, radius[i], radius[j], gap, range);
+      damping_sum[i] += c;
+      if (force->newton_pair || j < nlocal) damping_sum[j] += c;
+    }
+  }
+  if (force->newton_pair) comm->reverse_comm_pair(this);
+  comm->forward_comm_pair(this);
+}
+
+void PairLubricateFluid::compute(int eflag, int vflag)
+{
+  ev_init(eflag, vflag);
+  if (limit) sum_damping();
+
+  double **x = atom->x;
+  double **v = atom->v;
+  double **f = atom->f;
+  double *radius = atom->radius;
+  double *rmass = atom->rmass;
+  int *type = atom->type;
+  const int nlocal = atom->nlocal;
+  const int newton_pair = force->newton_pair;
+  const double viscosity = fluid->properties().viscosity;
+  const double dt = update->dt;
+
+  for (int ii = 0; ii < list->inum; ++ii) {
+    const int i = list->ilist[ii];
+    for (int jj = 0; jj < list->numneigh[i]; ++jj) {
+      const int j = list->firstneigh[i][jj] & NEIGHMASK;
+      if (!setflag[std::min(type[i], type[j])][std::max(type[i], type[j])]) continue;
+      const double delx = x[i][0] - x[j][0], dely = x[i][1] - x[j][1], delz = x[i][2] - x[j][2];
+      const double r = std::sqrt(delx * delx + dely * dely + delz * delz);
+      if (r == 0.0) continue;
+      const double gap = r - radius[i] - radius[j];
+      double c = sediment::squeeze_coefficient(viscosity, radius[i], radius[j], gap, range);
+      double push_i = 0.0, push_j = 0.0;
+      if (repulsion_scale > 0.0) {
+        const double di = 2.0 * radius[i], dj = 2.0 * radius[j];
+        const double q_i = 2.0 * di / (di + dj), q_j = 2.0 * dj / (di + dj);
+        if (gap < kRepulsionReach * q_i * di) push_i = repulsion_scale * sediment::bravo_repulsion(di, dj, gap);
+        if (gap < kRepulsionReach * q_j * dj) push_j = repulsion_scale * sediment::bravo_repulsion(dj, di, gap);
+      }
+      if (c == 0.0 && push_i == 0.0 && push_j == 0.0) continue;
+      if (limit && c > 0.0) c *= sediment::damping_share(dt, rmass[i], damping_sum[i], rmass[j], damping_sum[j]);
+
+      // Along the line of centres n = (x_i - x_j) / r: the film resists dh/dt = (v_i - v_j) . n.
+      const double approach = ((v[i][0] - v[j][0]) * delx + (v[i][1] - v[j][1]) * dely +
+                               (v[i][2] - v[j][2]) * delz) / r;
+      const double film = -c * approach;
+      const double on_i = (film + push_i) / r, on_j = (film + push_j) / r;
+      f[i][0] += on_i * delx;
+      f[i][1] += on_i * dely;
+      f[i][2] += on_i * delz;
+      if (newton_pair || j < nlocal) {
+        f[j][0] -= on_j * delx;
+        f[j][1] -= on_j * dely;
+        f[j][2] -= on_j * delz;
+      }
+      // The virial takes the mean pair force (the repulsion is not symmetric for unequal spheres).
+      if (evflag) ev_tally(i, j, nlocal, newton_pair, 0.0, 0.0, 0.5 * (on_i + on_j), delx, dely, delz);
+    }
+  }
+  if (vflag_fdotr) virial_fdotr_compute();
+}
+
+int PairLubricateFluid::pack_forward_comm(int n, int *list_, double *buf, int /*pbc_flag*/, int * /*pbc*/)
+{
+  for (int k = 0; k < n; ++k) buf[k] = damping_sum[list_[k]];
+  return n;
+}
+
+void PairLubricateFluid::unpack_forward_comm(int n, int first, double *buf)
+{
+  for (int k = 0; k < n; ++k) damping_sum[first + k] = buf[k];
+}
+
+int PairLubricateFluid::pack_reverse_comm(int n, int first, double *buf)
+{
+  for (int k = 0; k < n; ++k) buf[k] = damping_sum[first + k];
+  return n;
+}
+
+void PairLubricateFluid::unpack_reverse_comm(int n, int *list_, double *buf)
+{
+  for (int k = 0; k < n; ++k) damping_sum[list_[k]] += buf[k];
+}
+
+double PairLubricateFluid::memory_usage()
+{
+  return static_cast<double>(nmax) * sizeof(double);
+}
