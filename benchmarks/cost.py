@@ -20,7 +20,9 @@ from sediment.paths import lmp_executable  # noqa: E402
 SCENES = {"plain": "nve/sphere + gravity (reference)",
           "drag": "nve/sphere/fluid + buoyancy + stokes drag",
           "nonlinear": "as drag with dallavalle (general Newton step)",
-          "hindered": "as nonlinear + concentration/grid (400 layers) + difelice"}
+          "hindered": "as nonlinear + concentration/grid (400 layers) + difelice",
+          "cells": "as hindered on 20 x 20 x 100 3d cells",
+          "lubricated": "as drag + pair lubricate/fluid"}
 
 
 def loop_time(scene: str, particles: int, steps: int) -> float:
@@ -44,7 +46,10 @@ def main() -> None:
         print(f"{s:10s} {per[s]:17.2f} {per[s] / per['plain']:15.2f}  {what}")
     grid = per["hindered"] - per["nonlinear"]
     print(f"grid + Di Felice hindrance on top of the nonlinear step: {grid:.1f} ns/particle-step "
-          f"({grid / per['plain']:.2f}x the plain step)")
+          f"({grid / per['plain']:.2f}x the plain step); with 3d cells "
+          f"{per['cells'] - per['nonlinear']:.1f} ns ({(per['cells'] - per['nonlinear']) / per['plain']:.2f}x)")
+    film = per["lubricated"] - per["drag"]
+    print(f"lubrication on top of the Stokes step: {film:.1f} ns/particle-step ({film / per['plain']:.2f}x the plain step)")
 
 
 if __name__ == "__main__":
