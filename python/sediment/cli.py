@@ -5,7 +5,10 @@ import argparse
 import sys
 from pathlib import Path
 
+import numpy as np
+
 from . import _core
+from .readout import SCHEDULES as SCHEDULE_NAMES
 
 
 def positive(text: str) -> float:
@@ -41,6 +44,37 @@ def cmd_case_a(args: argparse.Namespace) -> int:
     return 0
 
 
+def cmd_readout(args: argparse.Namespace) -> int:
+    from .granulometry import error_summary, read_all, write_report
+    from .psd import read_psd
+    from .readout import Column, Fluid
+    from .synthetic import stokes_column
+
+    psd = read_psd(args.psd) if args.psd else None
+    if args.layers is not None:
+        from .layers import read_layers
+        column = Column.from_layers(read_layers(args.layers), surface=args.surface)
+        title = str(args.layers)
+    else:
+        if psd is None:
+            raise ValueError("give a layer file, or --psd with --stokes-preview for an analytic column")
+        fluid = Fluid(particle_density=args.particle_density)
+        times = np.concatenate([[0.0], np.geomspace(10.0, 1440 * 60.0, 400)])
+        column = stokes_column(psd, args.height, times, args.concentration, fluid)
+        title = f"{args.psd.name}: Stokes settling preview (no DEM)"
+    instruments = ["hydrometer", "buoyancy", "pipette"] if args.instrument == "all" else [args.instrument]
+    readings, notes = read_all(column, instruments, args.schedule, args.sphere_depth, args.pipette_depth,
+                               args.pipette_volume, args.cylinder_area)
+    for note in notes:
+        print(note)
+    for path in write_report(readings, args.out, psd, title=title):
+        print(f"wrote {path}")
+    if psd is not None:
+        for instrument, size_range, count, error in error_summary(readings, psd):
+            print(f"{instrument:10s} {size_range:10s} {count:3d} readings, mean |P - PSD| = {error:.2f} points")
+    return 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="sediment", description="SEDIMENT: settling of DEM spheres in "
                                      "fluids with LAMMPS, and sedimentation-test readouts.")
@@ -61,6 +95,26 @@ def build_parser() -> argparse.ArgumentParser:
                             "error vs time step for the implicit and explicit integrators")
     case_a.add_argument("--out", type=Path, default=Path("out/case_a"), help="output folder")
     case_a.set_defaults(func=cmd_case_a)
+
+    readout = sub.add_parser("readout", help="hydrometer, buoyancy-sphere and pipette readings from a layer "
+                             "file (fix layers/hdf5), with CSV tables, the granulometry figure and errors")
+    readout.add_argument("layers", type=Path, nargs="?", help="layer file (HDF5)")
+    readout.add_argument("--instrument", default="all", choices=["hydrometer", "buoyancy", "pipette", "all"])
+    readout.add_argument("--schedule", default="d422", choices=sorted(SCHEDULE_NAMES),
+                         help="reading times (the buoyancy sphere uses Bravo et al.'s unless another is given)")
+    readout.add_argument("--psd", type=Path, help="input PSD (diameter_um,percent_finer) to compare with")
+    readout.add_argument("--stokes-preview", action="store_true",
+                         help="without a layer file: read an analytic Stokes column of --psd")
+    readout.add_argument("--height", type=positive, default=0.36, help="preview column height [m]")
+    readout.add_argument("--concentration", type=positive, default=50.0, help="preview solids [g/L]")
+    readout.add_argument("--particle-density", type=positive, default=2650.0, help="preview [kg/m3]")
+    readout.add_argument("--surface", type=float, help="free-surface coordinate [m] (default: top of the layers)")
+    readout.add_argument("--sphere-depth", type=positive, help="buoyancy sphere centre depth [m] (default 0.3 H)")
+    readout.add_argument("--pipette-depth", type=positive, default=0.10, help="[m]")
+    readout.add_argument("--pipette-volume", type=positive, default=25e-6, help="[m3]")
+    readout.add_argument("--cylinder-area", type=positive, default=27.8e-4, help="for the hydrometer's level rise [m2]")
+    readout.add_argument("--out", type=Path, default=Path("out/readout"), help="output folder")
+    readout.set_defaults(func=cmd_readout)
     return parser
 
 

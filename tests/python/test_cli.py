@@ -43,3 +43,25 @@ def test_case_a_runs_through_the_driver(integrator, bound):
     run = run_case_a(integrator, 1e-3, t_end=0.01)
     assert run.error < bound
     assert len(run.time) == 11
+
+
+def test_readout_preview_writes_tables_figure_and_errors(tmp_path, capsys):
+    psd = REPO.parent / "shared" / "data" / "psd" / "sample5.csv"
+    assert cli.main(["readout", "--psd", str(psd), "--stokes-preview", "--out", str(tmp_path)]) == 0
+    for name in ("hydrometer.csv", "buoyancy.csv", "pipette.csv", "errors.csv", "granulometry.png", "granulometry.pdf"):
+        assert (tmp_path / name).stat().st_size > 0
+    rows = (tmp_path / "errors.csv").read_text().splitlines()[1:]
+    assert len(rows) == 9 and all(float(r.split(",")[3]) < 2.0 for r in rows if r.split(",")[2] != "0")
+
+
+def test_readout_bad_inputs_are_clear(tmp_path, capsys):
+    empty = tmp_path / "empty.csv"
+    empty.write_text("")
+    assert cli.main(["readout", "--psd", str(empty), "--stokes-preview", "--out", str(tmp_path)]) == 2
+    assert "empty PSD file" in capsys.readouterr().err
+    foreign = tmp_path / "other.h5"
+    import h5py
+    with h5py.File(foreign, "w") as f:
+        f.attrs["schema"] = "something-else"
+    assert cli.main(["readout", str(foreign), "--out", str(tmp_path)]) == 2
+    assert "not a SEDIMENT layer file" in capsys.readouterr().err

@@ -1,0 +1,117 @@
+"""Particle-size distributions: the input table, its interpolation and its discretisation into size
+classes (sedimentation-tests.md section 1, Bravo et al. eq. 15)."""
+from __future__ import annotations
+
+import csv
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+
+class PSDError(ValueError):
+    """A PSD table that cannot be used, with the reason and the row."""
+
+
+@dataclass(frozen=True)
+class PSD:
+    """Percent finer by mass against diameter; linear in log(diameter) between rows."""
+
+    diameter: np.ndarray        # [m], strictly increasing
+    percent_finer: np.ndarray   # [%], non-decreasing, within 0..100
+    name: str = ""
+
+    def __post_init__(self) -> None:
+        d, p = np.asarray(self.diameter, float), np.asarray(self.percent_finer, float)
+        where = f"{self.name}: " if self.name else ""
+        if d.ndim != 1 or d.size < 2 or p.shape != d.shape:
+            raise PSDError(f"{where}a PSD needs at least two rows of (diameter, percent finer)")
+        if not np.all(np.isfinite(d)) or not np.all(np.isfinite(p)):
+            raise PSDError(f"{where}diameters and percents must be numbers")
+        if d[0] <= 0:
+            raise PSDError(f"{where}diameters must be > 0 (row 1: {d[0]:g})")
+        bad = np.flatnonzero(np.diff(d) <= 0)
+        if bad.size:
+            raise PSDError(f"{where}diameters must increase: row {bad[0] + 2} ({d[bad[0] + 1]:g}) "
+                           f"after row {bad[0] + 1} ({d[bad[0]]:g})")
+        outside = np.flatnonzero((p < 0) | (p > 100))
+        if outside.size:
+            raise PSDError(f"{where}percent finer must be within 0..100: row {outside[0] + 1} has {p[outside[0]]:g}")
+        falls = np.flatnonzero(np.diff(p) < 0)
+        if falls.size:
+            raise PSDError(f"{where}percent finer must not decrease with diameter: row {falls[0] + 2} "
+                           f"({p[falls[0] + 1]:g} %) after row {falls[0] + 1} ({p[falls[0]]:g} %)")
+        object.__setattr__(self, "diameter", d)
+        object.__setattr__(self, "percent_finer", p)
+
+    def at(self, diameter) -> np.ndarray:
+        """Percent finer at the given diameters [m] (flat beyond the table)."""
+        return np.interp(np.log(np.asarray(diameter, float)), np.log(self.diameter), self.percent_finer)
+
+
+def read_psd(path: str | Path) -> PSD:
+    """Reads a CSV with columns diameter_um, percent_finer (as in shared/data/psd)."""
+    path = Path(path)
+    if not path.is_file():
+        raise PSDError(f"{path}: no such PSD file")
+    with open(path, newline="") as f:
+        rows = [row for row in csv.reader(f) if row and not row[0].lstrip().startswith("#")]
+    if not rows:
+        raise PSDError(f"{path}: empty PSD file (expected a header diameter_um,percent_finer and rows)")
+    header, body = [h.strip() for h in rows[0]], rows[1:]
+    if header[:2] != ["diameter_um", "percent_finer"]:
+        raise PSDError(f"{path}: header must be 'diameter_um,percent_finer', not '{','.join(header)}'")
+    if not body:
+        raise PSDError(f"{path}: no rows below the header")
+    try:
+        values = np.array([[float(row[0]), float(row[1])] for row in body])
+    except (ValueError, IndexError):
+        raise PSDError(f"{path}: every row needs two numbers (diameter in um, percent finer)") from None
+    return PSD(values[:, 0] * 1e-6, values[:, 1], name=str(path))
+
+
+@dataclass(frozen=True)
+class SizeClasses:
+    """Discrete diameters with the particle count and mass fraction of each."""
+
+    diameter: np.ndarray        # [m] class diameters phi_k
+    mass_fraction: np.ndarray   # of the input PSD, sums to the fraction of mass within the classes
+    count: np.ndarray           # particles per class in the simulated volume (>= 1 where mass > 0)
+
+    def simulated_mass_fraction(self) -> np.ndarray:
+        mass = self.count * self.diameter ** 3
+        return mass / mass.sum()
+
+    def simulated_psd(self) -> PSD:
+        """The PSD the particles actually have: percent finer at the upper edge of each class."""
+        edges = class_edges(self.diameter)
+        cumulative = 100 * np.concatenate([[0.0], np.cumsum(self.simulated_mass_fraction())])
+        return PSD(edges, np.minimum(cumulative, 100.0), name="simulated")
+
+
+def class_edges(diameter: np.ndarray) -> np.ndarray:
+    """Geometric mid-points between class diameters, with the outer edges mirrored."""
+    d = np.log(diameter)
+    mid = 0.5 * (d[1:] + d[:-1])
+    first, last = d[0] - (mid[0] - d[0]), d[-1] + (d[-1] - mid[-1])
+    return np.exp(np.concatenate([[first], mid, [last]]))
+
+
+def discretise(psd: PSD, classes: int, sample_mass: float, particle_density: float,
+               volume_fraction: float) -> SizeClasses:
+    """Bravo et al. eq. 15 on `classes` log-spaced diameters spanning the PSD: class k holds the mass
+    between its lower and upper mid-points, n_k = 6 M dw_k / (rho_p pi phi_k^3) scaled by the
+    simulated fraction of the cylinder; every class with mass keeps at least one particle."""
+    if classes < 2:
+        raise PSDError("need at least 2 size classes")
+    if not (sample_mass > 0 and particle_density > 0 and 0 < volume_fraction <= 1):
+        raise PSDError("sample mass and particle density must be > 0, the simulated fraction within (0, 1]")
+    lo = psd.diameter[np.argmax(psd.percent_finer > 0) - 1] if psd.percent_finer[0] == 0 else psd.diameter[0]
+    hi = psd.diameter[np.argmax(psd.percent_finer >= 100)] if psd.percent_finer[-1] >= 100 else psd.diameter[-1]
+    # Class diameters at the centres of log-equal bins between lo and hi.
+    bins = np.exp(np.linspace(np.log(lo), np.log(hi), classes + 1))
+    diameter = np.sqrt(bins[1:] * bins[:-1])
+    fraction = np.diff(psd.at(bins)) / 100.0
+    exact = 6 * sample_mass * fraction / (particle_density * np.pi * diameter ** 3) * volume_fraction
+    count = np.where(fraction > 0, np.maximum(np.rint(exact), 1), 0).astype(np.int64)
+    return SizeClasses(diameter=diameter, mass_fraction=fraction, count=count)

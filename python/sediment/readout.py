@@ -1,0 +1,266 @@
+"""Readouts of the hydrometer (ASTM 152H), buoyancy-sphere and pipette tests from layer profiles
+(sedimentation-tests.md sections 2-5). SI units throughout: m, s, kg.
+
+A `Column` is the suspension at the reading times: layer edges as depth below the free surface and
+the solid volume fraction per layer. Each instrument turns it into a `Readings` table
+(t, depth, reading, D, P): D from Stokes' law at the instrument's depth, P = 100 c / c0.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+G = 9.81
+WATER_20C = 998.2          # kg/m3
+VISCOSITY_20C = 1.002e-3   # Pa s
+R_FACTOR = 1 - 1 / 2.65    # 152H: R = (rho_s - rho_w) / 0.6226 in g/L, calibrated for Gs = 2.65
+
+SCHEDULES = {              # reading times [min]
+    "d422": [2, 5, 15, 30, 60, 250, 1440],
+    "d7928": [1, 2, 4, 15, 30, 60, 240, 1440],
+    "bravo": [0.5, 1, 2, 4, 15, 30, 60, 120, 240, 480],
+}
+
+
+@dataclass(frozen=True)
+class Fluid:
+    density: float = WATER_20C
+    viscosity: float = VISCOSITY_20C
+    particle_density: float = 2650.0
+    gravity: float = G
+
+    @property
+    def specific_gravity(self) -> float:
+        return self.particle_density / 1000.0
+
+    def stokes_diameter(self, depth, time) -> np.ndarray:
+        """Largest diameter still present at `depth` after `time`: sqrt(18 mu y / ((rho_p - rho_f) g t))."""
+        return np.sqrt(18 * self.viscosity * np.asarray(depth) /
+                       ((self.particle_density - self.density) * self.gravity * np.asarray(time)))
+
+    def stokes_time(self, depth, diameter) -> np.ndarray:
+        return 18 * self.viscosity * np.asarray(depth) / ((self.particle_density - self.density) * self.gravity
+                                                          * np.asarray(diameter) ** 2)
+
+
+@dataclass(frozen=True)
+class Column:
+    """Solid fraction per layer at a series of times, layers ordered from the surface down."""
+
+    depth_edges: np.ndarray     # [layers + 1], increasing from the surface (0) down
+    time: np.ndarray            # [frames] s
+    fraction: np.ndarray        # [frames, layers]
+    fluid: Fluid = field(default_factory=Fluid)
+    slab_thickness: float = 0.0  # > 0 for a 2d slab (pipette samples a disc)
+
+    def __post_init__(self) -> None:
+        if self.fraction.shape != (len(self.time), len(self.depth_edges) - 1):
+            raise ValueError(f"fraction has shape {self.fraction.shape}, expected "
+                             f"({len(self.time)}, {len(self.depth_edges) - 1})")
+        if np.any(np.diff(self.time) <= 0):
+            raise ValueError("frame times must increase")
+
+    @classmethod
+    def from_layers(cls, layers, surface: float | None = None) -> "Column":
+        """The column of a layer file (sediment.layers.LayerFile) below a free surface at
+        coordinate `surface` along the layer axis (default: the top of the layers)."""
+        attrs = layers.attributes
+        missing = [k for k in ("fluid_density", "fluid_viscosity", "particle_density") if k not in attrs]
+        if missing:
+            raise ValueError(f"{layers.path}: readouts need {', '.join(missing)} in the layer file "
+                             "(fix layers/hdf5 ... fluid ID particle_density RHO)")
+        z_edges = layers.layer_lo + layers.layer_thickness * np.arange(len(layers.centres) + 1)
+        top = z_edges[-1] if surface is None else surface
+        depth = (top - z_edges)[::-1]                      # from the top layer down
+        keep = depth[1:] > 0                               # layers (partly) below the surface
+        edges = np.clip(np.concatenate([depth[:-1][keep][:1], depth[1:][keep]]), 0.0, None)
+        fraction = layers.total[:, ::-1][:, keep]
+        fluid = Fluid(attrs["fluid_density"], attrs["fluid_viscosity"], attrs["particle_density"])
+        return cls(edges, np.asarray(layers.time, float), fraction, fluid, attrs.get("slab_thickness", 0.0))
+
+    @property
+    def height(self) -> float:
+        return float(self.depth_edges[-1])
+
+    def initial_concentration(self) -> float:
+        """c0 [kg/m3]: solids per volume of suspension in the first frame."""
+        widths = np.diff(self.depth_edges)
+        return float(self.fluid.particle_density * np.sum(self.fraction[0] * widths) / self.height)
+
+    def at(self, t: float) -> np.ndarray:
+        """Solid fraction per layer at time t, linear between frames."""
+        if not self.time[0] <= t <= self.time[-1]:
+            raise ValueError(f"time {t:g} s outside the frames ({self.time[0]:g} .. {self.time[-1]:g} s)")
+        k = int(np.clip(np.searchsorted(self.time, t) - 1, 0, len(self.time) - 2)) if len(self.time) > 1 else 0
+        if len(self.time) == 1:
+            return self.fraction[0]
+        w = (t - self.time[k]) / (self.time[k + 1] - self.time[k])
+        return (1 - w) * self.fraction[k] + w * self.fraction[k + 1]
+
+    def density(self, t: float) -> np.ndarray:
+        """Suspension density rho_f + (rho_p - rho_f) phi per layer [kg/m3]."""
+        return self.fluid.density + (self.fluid.particle_density - self.fluid.density) * self.at(t)
+
+    def mass_above(self, depth, t: float) -> np.ndarray:
+        """Integral of the suspension density from the surface to `depth` [kg/m2], exact for
+        layer-wise constant density (linear inside a layer); clear fluid below the column."""
+        rho = self.density(t)
+        cumulative = np.concatenate([[0.0], np.cumsum(rho * np.diff(self.depth_edges))])
+        depth = np.asarray(depth, float)
+        inside = np.interp(depth, self.depth_edges, cumulative)
+        return inside + np.maximum(depth - self.height, 0.0) * self.fluid.density
+
+    def weighted_mean(self, t: float, centre: float, radius: float, disc: bool = False) -> float:
+        """Mean solid fraction over a sphere (or, in a 2d slab, a disc) centred at `centre` depth,
+        with the exact share of each layer."""
+        a = np.clip(self.depth_edges[:-1] - centre, -radius, radius)
+        b = np.clip(self.depth_edges[1:] - centre, -radius, radius)
+        if disc:
+            def area_below(u):
+                return u * np.sqrt(radius ** 2 - u ** 2) + radius ** 2 * np.arcsin(u / radius)
+            weights = area_below(b) - area_below(a)
+        else:
+            weights = np.pi * (radius ** 2 * (b - a) - (b ** 3 - a ** 3) / 3)
+        if weights.sum() <= 0:
+            raise ValueError(f"depth {centre:g} m is outside the column (0 .. {self.height:g} m)")
+        return float(np.sum(weights * self.at(t)) / weights.sum())
+
+
+@dataclass
+class Readings:
+    instrument: str
+    time: np.ndarray        # s
+    depth: np.ndarray       # m, the depth Stokes' law uses
+    reading: np.ndarray     # instrument units (152H: g/L; sphere: apparent mass g; pipette: g/L)
+    diameter: np.ndarray    # m
+    percent_finer: np.ndarray
+
+    def table(self) -> str:
+        unit = {"hydrometer": "R [g/L]", "buoyancy": "m_app [g]", "pipette": "c [g/L]"}[self.instrument]
+        lines = [f"time_min,depth_cm,{unit},diameter_um,percent_finer"]
+        for row in zip(self.time / 60, self.depth * 100, self.reading, self.diameter * 1e6, self.percent_finer):
+            lines.append(",".join(f"{v:.6g}" for v in row))
+        return "\n".join(lines) + "\n"
+
+
+@dataclass(frozen=True)
+class Hydrometer:
+    """A hydrometer as a cylindrical bulb under a cylindrical stem, with its scale on the stem:
+    the surface crosses the stem at distance `scale_zero - scale_step R` above the bulb top."""
+
+    bulb_length: float      # L2 [m]
+    bulb_volume: float      # VB [m3]
+    stem_area: float        # [m2]
+    mass: float             # [kg]
+    scale_zero: float       # L1 at R = 0 [m]
+    scale_step: float       # decrease of L1 per unit of R [m per g/L]
+
+    @classmethod
+    def astm_152h(cls, bulb_length=0.140, bulb_volume=67.0e-6, scale_zero=0.105, scale_at_50=0.023,
+                  water_density=WATER_20C) -> "Hydrometer":
+        """The nominal 152H of ASTM D422. Stem area and mass follow from the calibration: it floats
+        with the surface at L1(R) in a uniform suspension of density rho_w + 0.6226 R."""
+        step = (scale_zero - scale_at_50) / 50.0
+        rho50 = water_density + R_FACTOR * 50.0
+        stem = (rho50 - water_density) * bulb_volume / (water_density * scale_zero - rho50 * scale_at_50)
+        mass = water_density * (bulb_volume + stem * scale_zero)
+        return cls(bulb_length, bulb_volume, stem, mass, scale_zero, step)
+
+    @classmethod
+    def measured(cls, bulb_length, bulb_volume, stem_diameter, mass, scale_zero, scale_at_50) -> "Hydrometer":
+        """An instrument measured in the laboratory (stem diameter, mass, scale marks)."""
+        return cls(bulb_length, bulb_volume, np.pi / 4 * stem_diameter ** 2, mass, scale_zero,
+                   (scale_zero - scale_at_50) / 50.0)
+
+    def bulb_top_depth(self, column: Column, t: float) -> float:
+        """Depth of the bulb top where the hydrostatic force on the immersed stem and bulb equals
+        the weight (bisection on the exact mass profile)."""
+        bulb_area = self.bulb_volume / self.bulb_length
+
+        def excess(y):
+            above = column.mass_above(y, t)
+            return self.stem_area * above + bulb_area * (column.mass_above(y + self.bulb_length, t) - above) - self.mass
+        lo, hi = 0.0, column.height
+        if excess(lo) > 0:
+            raise ValueError("the hydrometer would float with its bulb out of the suspension")
+        if excess(hi) < 0:
+            raise ValueError("the hydrometer sinks to the bottom: column too short or suspension too light")
+        for _ in range(100):
+            mid = 0.5 * (lo + hi)
+            lo, hi = (mid, hi) if excess(mid) < 0 else (lo, mid)
+        return 0.5 * (lo + hi)
+
+    def read(self, column: Column, times_s, cylinder_area: float = 27.8e-4, level_rise: bool = True) -> Readings:
+        """Readings at the given times. The Stokes depth is the bulb centre; with `level_rise` it is
+        taken as in D422, L = L1 + (L2 - VB / A_c) / 2: the bulb lifts the surface by VB / A_c."""
+        fluid = column.fluid
+        c0 = column.initial_concentration()
+        a = 1.65 * fluid.specific_gravity / (2.65 * (fluid.specific_gravity - 1))    # 152H Gs correction
+        rows = []
+        for t in times_s:
+            top = self.bulb_top_depth(column, t)
+            reading = (self.scale_zero - top) / self.scale_step
+            depth = top + 0.5 * (self.bulb_length - (self.bulb_volume / cylinder_area if level_rise else 0.0))
+            rows.append((t, depth, reading, fluid.stokes_diameter(depth, t), _percent(reading * a, c0)))
+        return _readings("hydrometer", rows)
+
+
+@dataclass(frozen=True)
+class BuoyancySphere:
+    """A sphere hung from a balance at a fixed centre depth (Bardet & Young 1997)."""
+
+    depth: float
+    diameter: float = 0.025
+    mass: float = 0.0       # its own mass [kg]; only shifts the apparent mass
+
+    def read(self, column: Column, times_s) -> Readings:
+        fluid = column.fluid
+        volume = np.pi / 6 * self.diameter ** 3
+        c0 = column.initial_concentration()
+        rows = []
+        for t in times_s:
+            phi = column.weighted_mean(t, self.depth, self.diameter / 2)
+            rho = fluid.density + (fluid.particle_density - fluid.density) * phi
+            apparent = self.mass - rho * volume
+            in_water = self.mass - fluid.density * volume
+            gs = fluid.specific_gravity
+            concentration = (in_water - apparent) / volume * gs / (gs - 1)    # kg/m3 (Gs from water at 1000)
+            rows.append((t, self.depth, apparent * 1e3, fluid.stokes_diameter(self.depth, t),
+                         _percent(concentration, c0)))
+        return _readings("buoyancy", rows)
+
+
+@dataclass(frozen=True)
+class Pipette:
+    """A sample of `volume` drawn around the tip at a fixed depth: a sphere of that volume, or in a
+    2d slab a disc of that volume over the slab thickness."""
+
+    depth: float
+    volume: float = 25e-6
+
+    def read(self, column: Column, times_s) -> Readings:
+        fluid = column.fluid
+        disc = column.slab_thickness > 0
+        radius = (np.sqrt(self.volume / column.slab_thickness / np.pi) if disc
+                  else (3 * self.volume / (4 * np.pi)) ** (1 / 3))
+        c0 = column.initial_concentration()
+        rows = []
+        for t in times_s:
+            concentration = fluid.particle_density * column.weighted_mean(t, self.depth, radius, disc=disc)
+            rows.append((t, self.depth, concentration, fluid.stokes_diameter(self.depth, t),
+                         _percent(concentration, c0)))
+        return _readings("pipette", rows)
+
+    def default_times(self, fluid: Fluid) -> np.ndarray:
+        """Stokes times of 50, 20, 10, 5 and 2 um at the pipette depth."""
+        return fluid.stokes_time(self.depth, np.array([50, 20, 10, 5, 2]) * 1e-6)
+
+
+def _percent(concentration: float, initial: float) -> float:
+    return 100 * concentration / initial if initial > 0 else float("nan")    # no solids: undefined
+
+
+def _readings(name: str, rows: list[tuple]) -> Readings:
+    data = np.array(rows, float).reshape(-1, 5)
+    return Readings(name, *(data[:, k] for k in range(5)))

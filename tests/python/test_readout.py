@@ -1,0 +1,121 @@
+"""Readouts of the hydrometer, buoyancy sphere and pipette (sedimentation-tests.md sections 3-5)."""
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from sediment.psd import PSD, PSDError, discretise, read_psd
+from sediment.readout import SCHEDULES, BuoyancySphere, Column, Fluid, Hydrometer, Pipette, R_FACTOR
+from sediment.synthetic import stokes_column
+
+SHARED = Path(__file__).resolve().parents[3] / "shared" / "data" / "psd"
+
+
+def uniform(concentration: float, height: float = 0.36, fluid: Fluid = Fluid()) -> Column:
+    phi = concentration / fluid.particle_density
+    return Column(np.linspace(0, height, 361), np.array([0.0, 1.0]), np.full((2, 360), phi), fluid)
+
+
+def test_152h_geometry_matches_d422():
+    h = Hydrometer.astm_152h()
+    assert np.sqrt(4 * h.stem_area / np.pi) == pytest.approx(5.7e-3, rel=0.01)     # stem about 5.7 mm
+    assert h.mass == pytest.approx(69.6e-3, rel=0.002)                               # about 69.6 g
+    # effective depth L = 16.3 - 0.1641 R cm (D422), with the level rise of VB / A_c
+    # The scale is linear between its R = 0 and R = 50 marks, the float's position is not (it goes
+    # with 1 / rho): in between it reads up to 0.4 g/L high, within the 0.5 g/L self-check.
+    column = uniform(30 * 2650 / (2650 - 998.2) * R_FACTOR)    # rho_s = rho_w + 0.6226 * 30
+    reading = h.read(column, [0.5])
+    assert reading.reading[0] == pytest.approx(30, abs=0.5)
+    assert reading.depth[0] * 100 == pytest.approx(16.3 - 0.1641 * reading.reading[0], abs=0.01)
+
+
+@pytest.mark.parametrize("grams_per_litre", [0, 5, 10, 20, 30, 40, 50, 60])
+def test_hydrometer_reads_a_uniform_suspension(grams_per_litre):
+    column = uniform(grams_per_litre)
+    reading = Hydrometer.astm_152h().read(column, [0.5]).reading[0]
+    assert reading == pytest.approx(grams_per_litre, abs=0.5)
+    if grams_per_litre == 0:    # clear water: floats with the surface at the R = 0 mark
+        assert Hydrometer.astm_152h().bulb_top_depth(column, 0.5) == pytest.approx(0.105, abs=1e-9)
+
+
+def test_measured_instrument_is_a_parameter_set():
+    nominal = Hydrometer.astm_152h()
+    heavier = Hydrometer.measured(0.140, 67e-6, 5.72e-3, nominal.mass * 1.01, 0.105, 0.023)
+    column = uniform(20)
+    assert heavier.read(column, [0.5]).reading[0] < nominal.read(column, [0.5]).reading[0] - 5    # sinks deeper
+
+
+def recovered_error(readings, psd: PSD, lo: float, hi: float) -> float:
+    resolved = (readings.diameter >= lo) & (readings.diameter <= hi)
+    assert resolved.sum() >= 3
+    return float(np.max(np.abs(readings.percent_finer[resolved] - psd.at(readings.diameter[resolved]))))
+
+
+@pytest.fixture(scope="module")
+def sample5():
+    psd = read_psd(SHARED / "sample5.csv")
+    times = np.array(sorted(set(SCHEDULES["d422"] + SCHEDULES["d7928"] + SCHEDULES["bravo"]))) * 60.0
+    fluid = Fluid(particle_density=2650.0)
+    column = stokes_column(psd, 0.36, np.concatenate([[0.0], times]), 50.0, fluid)
+    return psd, column, times
+
+
+INSTRUMENTS = {
+    "hydrometer": lambda: Hydrometer.astm_152h(),
+    "buoyancy": lambda: BuoyancySphere(depth=0.3 * 0.36),    # Bravo et al.: 0.3 H
+    "pipette": lambda: Pipette(depth=0.10),                  # soil labs: 10 cm
+}
+
+
+@pytest.mark.parametrize("instrument", INSTRUMENTS)
+def test_instrument_recovers_a_stokes_psd(sample5, instrument):
+    """Sample 5 (smooth gradation) settling by Stokes' law alone: every reading between 3 and 60 um
+    must sit within 2 percentage points of the PSD (the hydrometer's bulb averages over 14 cm)."""
+    psd, column, times = sample5
+    readings = INSTRUMENTS[instrument]().read(column, times)
+    error = recovered_error(readings, psd, 3e-6, 60e-6)
+    print(f"{instrument}: max |P - PSD| = {error:.3f} percentage points over 3-60 um")
+    assert error < 2.0
+
+
+def test_psd_validation(tmp_path):
+    def table(text):
+        path = tmp_path / "psd.csv"
+        path.write_text(text)
+        return path
+    for text, message in [("", "empty PSD file"),
+                          ("diameter_um,percent_finer\n", "no rows"),
+                          ("size,pct\n1,0\n2,100\n", "header must be"),
+                          ("diameter_um,percent_finer\n1,0\n1,50\n2,100\n", "diameters must increase: row 2"),
+                          ("diameter_um,percent_finer\n1,0\n2,120\n", "within 0..100: row 2"),
+                          ("diameter_um,percent_finer\n1,0\n2,60\n3,40\n", "must not decrease"),
+                          ("diameter_um,percent_finer\n1,0\n2,abc\n", "two numbers")]:
+        with pytest.raises(PSDError, match=message):
+            read_psd(table(text))
+
+
+def test_discretisation_keeps_every_class_and_reports_the_simulated_psd():
+    psd = read_psd(SHARED / "sample1.csv")    # 60 % fines, a plateau, 40 % coarse
+    classes = discretise(psd, 60, sample_mass=0.06, particle_density=2500, volume_fraction=1e-7)
+    assert np.all(classes.count[classes.mass_fraction > 0] >= 1)
+    assert classes.mass_fraction.sum() == pytest.approx(1.0)
+    simulated = classes.simulated_psd()
+    assert simulated.percent_finer[-1] == pytest.approx(100.0)
+    # where classes hold many particles the simulated PSD follows the input
+    assert abs(simulated.at(15e-6) - psd.at(15e-6)) < 5
+
+
+def test_column_from_a_layer_file_reads_depth_from_the_surface(tmp_path):
+    from types import SimpleNamespace
+    total = np.array([[0.1, 0.2, 0.3, 0.4]])    # layers from z = 0 up
+    layers = SimpleNamespace(path=tmp_path / "x.h5", layer_lo=0.0, layer_thickness=0.1, centres=np.arange(4),
+                             time=np.array([0.0]), total=total,
+                             attributes={"fluid_density": 1000.0, "fluid_viscosity": 1e-3, "particle_density": 2650.0})
+    column = Column.from_layers(layers, surface=0.35)
+    assert np.allclose(column.depth_edges, [0.0, 0.05, 0.15, 0.25, 0.35])
+    assert np.allclose(column.fraction[0], [0.4, 0.3, 0.2, 0.1])
+    layers.attributes = {}
+    with pytest.raises(ValueError, match="readouts need fluid_density"):
+        Column.from_layers(layers)
