@@ -132,6 +132,23 @@ double PairLubricateFluid::init_one(int i, int j)
   return 2.0 * maxrad + reach;
 }
 
+template <class Visit> void PairLubricateFluid::for_each_pair(Visit visit)
+{
+  double **x = atom->x;
+  double *radius = atom->radius;
+  int *type = atom->type;
+  for (int ii = 0; ii < list->inum; ++ii) {
+    const int i = list->ilist[ii];
+    for (int jj = 0; jj < list->numneigh[i]; ++jj) {
+      const int j = list->firstneigh[i][jj] & NEIGHMASK;
+      if (!setflag[std::min(type[i], type[j])][std::max(type[i], type[j])]) continue;
+      const double del[3] = {x[i][0] - x[j][0], x[i][1] - x[j][1], x[i][2] - x[j][2]};
+      const double r = std::sqrt(del[0] * del[0] + del[1] * del[1] + del[2] * del[2]);
+      if (r > 0.0) visit(i, j, del, r, r - radius[i] - radius[j]);
+    }
+  }
+}
+
 void PairLubricateFluid::sum_damping()
 {
   if (atom->nmax > nmax) {
@@ -139,23 +156,15 @@ void PairLubricateFluid::sum_damping()
     nmax = atom->nmax;
     memory->create(damping_sum, nmax, "lubricate/fluid:damping_sum");
   }
-  const int nall = atom->nlocal + atom->nghost;
-  std::fill(damping_sum, damping_sum + nall, 0.0);
-  double **x = atom->x;
+  std::fill(damping_sum, damping_sum + atom->nlocal + atom->nghost, 0.0);
   double *radius = atom->radius;
   const double viscosity = fluid->properties().viscosity;
   const int nlocal = atom->nlocal;
-  for (int ii = 0; ii < list->inum; ++ii) {
-    const int i = list->ilist[ii];
-    for (int jj = 0; jj < list->numneigh[i]; ++jj) {
-      const int j = list->firstneigh[i][jj] & NEIGHMASK;
-      const double dx = x[i][0] - x[j][0], dy = x[i][1] - x[j][1], dz = x[i][2] - x[j][2];
-      const double gap = std::sqrt(dx * dx + dy * dy + dz * dz) - radius[i] - radius[j];
-      const double c = sediment::squeeze_coefficient(viscosity, radius[i], radius[j], gap, range);
-      damping_sum[i] += c;
-      if (force->newton_pair || j < nlocal) damping_sum[j] += c;
-    }
-  }
+  for_each_pair([&](int i, int j, const double *, double, double gap) {
+    const double c = sediment::squeeze_coefficient(viscosity, radius[i], radius[j], gap, range);
+    damping_sum[i] += c;
+    if (force->newton_pair || j < nlocal) damping_sum[j] += c;
+  });
   if (force->newton_pair) comm->reverse_comm_pair(this);
   comm->forward_comm_pair(this);
 }
@@ -165,54 +174,38 @@ void PairLubricateFluid::compute(int eflag, int vflag)
   ev_init(eflag, vflag);
   if (limit) sum_damping();
 
-  double **x = atom->x;
   double **v = atom->v;
   double **f = atom->f;
   double *radius = atom->radius;
   double *rmass = atom->rmass;
-  int *type = atom->type;
   const int nlocal = atom->nlocal;
   const int newton_pair = force->newton_pair;
   const double viscosity = fluid->properties().viscosity;
   const double dt = update->dt;
 
-  for (int ii = 0; ii < list->inum; ++ii) {
-    const int i = list->ilist[ii];
-    for (int jj = 0; jj < list->numneigh[i]; ++jj) {
-      const int j = list->firstneigh[i][jj] & NEIGHMASK;
-      if (!setflag[std::min(type[i], type[j])][std::max(type[i], type[j])]) continue;
-      const double delx = x[i][0] - x[j][0], dely = x[i][1] - x[j][1], delz = x[i][2] - x[j][2];
-      const double r = std::sqrt(delx * delx + dely * dely + delz * delz);
-      if (r == 0.0) continue;
-      const double gap = r - radius[i] - radius[j];
-      double c = sediment::squeeze_coefficient(viscosity, radius[i], radius[j], gap, range);
-      double push_i = 0.0, push_j = 0.0;
-      if (repulsion_scale > 0.0) {
-        const double di = 2.0 * radius[i], dj = 2.0 * radius[j];
-        const double q_i = 2.0 * di / (di + dj), q_j = 2.0 * dj / (di + dj);
-        if (gap < kRepulsionReach * q_i * di) push_i = repulsion_scale * sediment::bravo_repulsion(di, dj, gap);
-        if (gap < kRepulsionReach * q_j * dj) push_j = repulsion_scale * sediment::bravo_repulsion(dj, di, gap);
-      }
-      if (c == 0.0 && push_i == 0.0 && push_j == 0.0) continue;
-      if (limit && c > 0.0) c *= sediment::damping_share(dt, rmass[i], damping_sum[i], rmass[j], damping_sum[j]);
-
-      // Along the line of centres n = (x_i - x_j) / r: the film resists dh/dt = (v_i - v_j) . n.
-      const double approach = ((v[i][0] - v[j][0]) * delx + (v[i][1] - v[j][1]) * dely +
-                               (v[i][2] - v[j][2]) * delz) / r;
-      const double film = -c * approach;
-      const double on_i = (film + push_i) / r, on_j = (film + push_j) / r;
-      f[i][0] += on_i * delx;
-      f[i][1] += on_i * dely;
-      f[i][2] += on_i * delz;
-      if (newton_pair || j < nlocal) {
-        f[j][0] -= on_j * delx;
-        f[j][1] -= on_j * dely;
-        f[j][2] -= on_j * delz;
-      }
-      // The virial takes the mean pair force (the repulsion is not symmetric for unequal spheres).
-      if (evflag) ev_tally(i, j, nlocal, newton_pair, 0.0, 0.0, 0.5 * (on_i + on_j), delx, dely, delz);
+  for_each_pair([&](int i, int j, const double *del, double r, double gap) {
+    double c = sediment::squeeze_coefficient(viscosity, radius[i], radius[j], gap, range);
+    double push_i = 0.0, push_j = 0.0;
+    if (repulsion_scale > 0.0) {
+      const double di = 2.0 * radius[i], dj = 2.0 * radius[j];
+      const double q_i = 2.0 * di / (di + dj), q_j = 2.0 * dj / (di + dj);
+      if (gap < kRepulsionReach * q_i * di) push_i = repulsion_scale * sediment::bravo_repulsion(di, dj, gap);
+      if (gap < kRepulsionReach * q_j * dj) push_j = repulsion_scale * sediment::bravo_repulsion(dj, di, gap);
     }
-  }
+    if (c == 0.0 && push_i == 0.0 && push_j == 0.0) return;
+    if (limit && c > 0.0) c *= sediment::damping_share(dt, rmass[i], damping_sum[i], rmass[j], damping_sum[j]);
+
+    // Along the line of centres n = (x_i - x_j) / r: the film resists dh/dt = (v_i - v_j) . n.
+    double approach = 0.0;
+    for (int d = 0; d < 3; ++d) approach += (v[i][d] - v[j][d]) * del[d];
+    const double film = -c * approach / r;
+    const double on_i = (film + push_i) / r, on_j = (film + push_j) / r;
+    for (int d = 0; d < 3; ++d) f[i][d] += on_i * del[d];
+    if (newton_pair || j < nlocal)
+      for (int d = 0; d < 3; ++d) f[j][d] -= on_j * del[d];
+    // The virial takes the mean pair force (the repulsion is not symmetric for unequal spheres).
+    if (evflag) ev_tally(i, j, nlocal, newton_pair, 0.0, 0.0, 0.5 * (on_i + on_j), del[0], del[1], del[2]);
+  });
   if (vflag_fdotr) virial_fdotr_compute();
 }
 

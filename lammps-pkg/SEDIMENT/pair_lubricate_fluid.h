@@ -46,6 +46,8 @@ class PairLubricateFluid : public Pair {
 
   void allocate();
   void sum_damping();
+  // Calls visit(i, j, x_i - x_j, r, gap) for every neighbour pair of types given a pair_coeff.
+  template <class Visit> void for_each_pair(Visit visit);
 };
 
 }    // namespace LAMMPS_NS
