@@ -42,19 +42,6 @@ void touched(const Layers &axis, double lo, double hi, int &first, int &last)
   }
 }
 
-// Calls visit(cell, volume) for the slices of the sphere in the layers it touches.
-template <class Visit> void for_each_slice(const Layers &axis, double centre, double radius, Visit visit)
-{
-  int first, last;
-  touched(axis, centre - radius, centre + radius, first, last);
-  double lower = below(radius, axis.lo + first * axis.thickness - centre);
-  for (int k = first; k <= last; ++k) {
-    const double upper = below(radius, axis.lo + (k + 1) * axis.thickness - centre);
-    visit(cell_of(axis, k), upper - lower);
-    lower = upper;
-  }
-}
-
 struct Bracket {
   int k0, k1;
   double w;    // weight of k1
@@ -179,12 +166,18 @@ double sphere_slab_volume(double centre, double radius, double a, double b)
 
 double add_sphere_to_layers(const Layers &layers, double centre, double radius, double *values, int stride)
 {
-  double inside = 0.0;
-  for_each_slice(layers, centre, radius, [&](int k, double volume) {
-    if (k < 0) return;
-    values[k * stride] += volume;
-    inside += volume;
-  });
+  int first, last;
+  touched(layers, centre - radius, centre + radius, first, last);
+  double lower = below(radius, layers.lo + first * layers.thickness - centre), inside = 0.0;
+  for (int k = first; k <= last; ++k) {
+    const double upper = below(radius, layers.lo + (k + 1) * layers.thickness - centre);
+    const int cell = cell_of(layers, k);
+    if (cell >= 0) {
+      values[cell * stride] += upper - lower;
+      inside += upper - lower;
+    }
+    lower = upper;
+  }
   return 4.0 / 3.0 * pi * radius * radius * radius - inside;
 }
 
@@ -226,7 +219,7 @@ void smooth_profile(const Layers &layers, const double *values, double width, do
 double add_sphere_to_grid(const Grid &grid, const double centre[3], double radius, double *values, int stride)
 {
   const double total = 4.0 / 3.0 * pi * radius * radius * radius;
-  int first[3], last[3], crossing[3], ncrossing = 0;
+  int first[3], last[3], ncrossing = 0, along = -1;
   bool crosses[3] = {false, false, false};
   for (int d = 0; d < 3; ++d) {
     first[d] = last[d] = 0;
@@ -234,34 +227,28 @@ double add_sphere_to_grid(const Grid &grid, const double centre[3], double radiu
     const Layers &axis = grid.axes[d];
     // A sphere crossing a face (an outer one too) is split along d; the range is clamped after.
     if (std::floor((centre[d] - radius - axis.lo) / axis.thickness) !=
-        std::floor((centre[d] + radius - axis.lo) / axis.thickness))
-      crosses[d] = true, crossing[ncrossing++] = d;
+        std::floor((centre[d] + radius - axis.lo) / axis.thickness)) {
+      crosses[d] = true;
+      along = d;
+      ++ncrossing;
+    }
     touched(axis, centre[d] - radius, centre[d] + radius, first[d], last[d]);
     if (first[d] > last[d]) return total;
   }
+  if (ncrossing > 1) return total - spread_over_cells(grid, centre, radius, first, last, crosses, values, stride);
 
+  // Whole in one cell, or sliced like layers along the one crossing axis within the cell of the others.
+  int cell[3];
+  for (int d = 0; d < 3; ++d) cell[d] = d == along || !grid.resolved[d] ? 0 : cell_of(grid.axes[d], first[d]);
+  if (cell[0] < 0 || cell[1] < 0 || cell[2] < 0) return total;
   const int nx = grid.axes[0].count, ny = grid.axes[1].count;
-  if (ncrossing <= 1) {    // exact: whole, or slices along the one crossing axis
-    int cell[3];
-    for (int d = 0; d < 3; ++d) cell[d] = grid.resolved[d] ? cell_of(grid.axes[d], first[d]) : 0;
-    if (ncrossing == 0) {
-      if (cell[0] < 0 || cell[1] < 0 || cell[2] < 0) return total;
-      values[(cell[0] + nx * (cell[1] + ny * cell[2])) * stride] += total;
-      return 0.0;
-    }
-    const int a = crossing[0];
-    for (int d = 0; d < 3; ++d)
-      if (d != a && cell[d] < 0) return total;
-    double inside = 0.0;
-    for_each_slice(grid.axes[a], centre[a], radius, [&](int k, double volume) {
-      if (k < 0) return;
-      cell[a] = k;
-      values[(cell[0] + nx * (cell[1] + ny * cell[2])) * stride] += volume;
-      inside += volume;
-    });
-    return total - inside;
+  double *base = values + (cell[0] + nx * (cell[1] + ny * cell[2])) * stride;
+  if (along < 0) {
+    *base += total;
+    return 0.0;
   }
-  return total - spread_over_cells(grid, centre, radius, first, last, crosses, values, stride);
+  const int step[3] = {1, nx, nx * ny};
+  return add_sphere_to_layers(grid.axes[along], centre[along], radius, base, step[along] * stride);
 }
 
 double grid_value_at(const Grid &grid, const double *values, const double point[3], int stride)

@@ -14,8 +14,14 @@ double squeeze_coefficient(double viscosity, double ri, double rj, double gap, c
   return 6.0 * pi * viscosity * a * a / std::max(gap, range.inner * a);
 }
 
+double bravo_reach(double di, double dj)
+{
+  return std::log(1000.0) / 10.0 * 2.0 * di / (di + dj) * di;
+}
+
 double bravo_repulsion(double di, double dj, double gap)
 {
+  if (gap >= bravo_reach(di, dj)) return 0.0;
   const double q = 2.0 * di / (di + dj);
   return 10.0 * q * q * q * std::exp(-10.0 * (std::max(gap, 0.0) / di) / q);
 }

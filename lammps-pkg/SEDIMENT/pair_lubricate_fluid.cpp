@@ -22,12 +22,6 @@
 
 using namespace LAMMPS_NS;
 
-namespace {
-// The repulsion is cut where it has fallen to 1e-3 of its value at contact: g / q = ln(1000) / 10,
-// i.e. a gap of 0.69 q d_i <= 1.39 d_i.
-constexpr double kRepulsionReach = 0.6907755278982137;
-}    // namespace
-
 PairLubricateFluid::PairLubricateFluid(LAMMPS *lmp) :
     Pair(lmp), fluid_id(nullptr), fluid(nullptr), repulsion_scale(0.0), limit(1), maxrad(0.0),
     damping_sum(nullptr), nmax(0)
@@ -128,7 +122,7 @@ double PairLubricateFluid::init_one(int i, int j)
   if (!setflag[i][j]) error->all(FLERR, "Pair lubricate/fluid: pair_coeff not set for types {} {}", i, j);
   // The largest gap that matters between any two spheres present: a <= r_max / 2.
   double reach = range.outer * 0.5 * maxrad;
-  if (repulsion_scale > 0.0) reach = std::max(reach, kRepulsionReach * 2.0 * 2.0 * maxrad);
+  if (repulsion_scale > 0.0) reach = std::max(reach, sediment::bravo_reach(2.0 * maxrad, 0.0));
   return 2.0 * maxrad + reach;
 }
 
@@ -187,10 +181,8 @@ void PairLubricateFluid::compute(int eflag, int vflag)
     double c = sediment::squeeze_coefficient(viscosity, radius[i], radius[j], gap, range);
     double push_i = 0.0, push_j = 0.0;
     if (repulsion_scale > 0.0) {
-      const double di = 2.0 * radius[i], dj = 2.0 * radius[j];
-      const double q_i = 2.0 * di / (di + dj), q_j = 2.0 * dj / (di + dj);
-      if (gap < kRepulsionReach * q_i * di) push_i = repulsion_scale * sediment::bravo_repulsion(di, dj, gap);
-      if (gap < kRepulsionReach * q_j * dj) push_j = repulsion_scale * sediment::bravo_repulsion(dj, di, gap);
+      push_i = repulsion_scale * sediment::bravo_repulsion(2.0 * radius[i], 2.0 * radius[j], gap);
+      push_j = repulsion_scale * sediment::bravo_repulsion(2.0 * radius[j], 2.0 * radius[i], gap);
     }
     if (c == 0.0 && push_i == 0.0 && push_j == 0.0) return;
     if (limit && c > 0.0) c *= sediment::damping_share(dt, rmass[i], damping_sum[i], rmass[j], damping_sum[j]);

@@ -97,6 +97,13 @@ def class_edges(diameter: np.ndarray) -> np.ndarray:
     return np.exp(np.concatenate([[first], mid, [last]]))
 
 
+def log_classes(psd: PSD, lo: float, hi: float, classes: int) -> tuple[np.ndarray, np.ndarray]:
+    """Diameters at the centres of `classes` log-equal bins between lo and hi, and the mass fraction
+    of the PSD in each bin."""
+    bins = np.exp(np.linspace(np.log(lo), np.log(hi), classes + 1))
+    return np.sqrt(bins[1:] * bins[:-1]), np.diff(psd.at(bins)) / 100.0
+
+
 def discretise(psd: PSD, classes: int, sample_mass: float, particle_density: float,
                volume_fraction: float) -> SizeClasses:
     """Bravo et al. eq. 15 on `classes` log-spaced diameters spanning the PSD: class k holds the mass
@@ -108,10 +115,7 @@ def discretise(psd: PSD, classes: int, sample_mass: float, particle_density: flo
         raise PSDError("sample mass and particle density must be > 0, the simulated fraction within (0, 1]")
     lo = psd.diameter[np.argmax(psd.percent_finer > 0) - 1] if psd.percent_finer[0] == 0 else psd.diameter[0]
     hi = psd.diameter[np.argmax(psd.percent_finer >= 100)] if psd.percent_finer[-1] >= 100 else psd.diameter[-1]
-    # Class diameters at the centres of log-equal bins between lo and hi.
-    bins = np.exp(np.linspace(np.log(lo), np.log(hi), classes + 1))
-    diameter = np.sqrt(bins[1:] * bins[:-1])
-    fraction = np.diff(psd.at(bins)) / 100.0
+    diameter, fraction = log_classes(psd, lo, hi, classes)
     exact = 6 * sample_mass * fraction / (particle_density * np.pi * diameter ** 3) * volume_fraction
     count = np.where(fraction > 0, np.maximum(np.rint(exact), 1), 0).astype(np.int64)
     return SizeClasses(diameter=diameter, mass_fraction=fraction, count=count)

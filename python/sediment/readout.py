@@ -34,14 +34,16 @@ class Fluid:
     def specific_gravity(self) -> float:
         return self.particle_density / 1000.0
 
+    def stokes_speed(self, diameter) -> np.ndarray:
+        """(rho_p - rho_f) g D^2 / (18 mu)."""
+        return (self.particle_density - self.density) * self.gravity * np.asarray(diameter) ** 2 / (18 * self.viscosity)
+
     def stokes_diameter(self, depth, time) -> np.ndarray:
-        """Largest diameter still present at `depth` after `time`: sqrt(18 mu y / ((rho_p - rho_f) g t))."""
-        return np.sqrt(18 * self.viscosity * np.asarray(depth) /
-                       ((self.particle_density - self.density) * self.gravity * np.asarray(time)))
+        """Largest diameter still present at `depth` after `time`: the one settling depth / time."""
+        return np.sqrt(np.asarray(depth) / np.asarray(time) / self.stokes_speed(1.0))
 
     def stokes_time(self, depth, diameter) -> np.ndarray:
-        return 18 * self.viscosity * np.asarray(depth) / ((self.particle_density - self.density) * self.gravity
-                                                          * np.asarray(diameter) ** 2)
+        return np.asarray(depth) / self.stokes_speed(diameter)
 
 
 @dataclass(frozen=True)
@@ -92,9 +94,9 @@ class Column:
         """Solid fraction per layer at time t, linear between frames."""
         if not self.time[0] <= t <= self.time[-1]:
             raise ValueError(f"time {t:g} s outside the frames ({self.time[0]:g} .. {self.time[-1]:g} s)")
-        k = int(np.clip(np.searchsorted(self.time, t) - 1, 0, len(self.time) - 2)) if len(self.time) > 1 else 0
         if len(self.time) == 1:
             return self.fraction[0]
+        k = min(int(np.searchsorted(self.time, t, side="right")) - 1, len(self.time) - 2)
         w = (t - self.time[k]) / (self.time[k + 1] - self.time[k])
         return (1 - w) * self.fraction[k] + w * self.fraction[k + 1]
 

@@ -5,20 +5,16 @@ from __future__ import annotations
 
 import numpy as np
 
-from .psd import PSD
+from .psd import PSD, log_classes
 from .readout import Column, Fluid
 
 
 def stokes_column(psd: PSD, height: float, times, initial_concentration: float, fluid: Fluid = Fluid(),
                   layers: int = 2000, classes: int = 600) -> Column:
     """Column of `layers` over `height` [m] at `times` [s]; `initial_concentration` in kg/m3."""
-    lo = psd.diameter[0]
-    hi = psd.diameter[-1]
-    bins = np.exp(np.linspace(np.log(lo), np.log(hi), classes + 1))
-    diameter = np.sqrt(bins[1:] * bins[:-1])
-    share = np.diff(psd.at(bins)) / 100.0
-    share[0] += psd.at(lo) / 100.0     # mass below the table's first diameter settles with the finest class
-    speed = (fluid.particle_density - fluid.density) * fluid.gravity * diameter ** 2 / (18 * fluid.viscosity)
+    diameter, share = log_classes(psd, psd.diameter[0], psd.diameter[-1], classes)
+    share[0] += psd.percent_finer[0] / 100.0    # mass below the table's first diameter settles with the finest class
+    speed = fluid.stokes_speed(diameter)
     edges = np.linspace(0.0, height, layers + 1)
     phi0 = initial_concentration / fluid.particle_density
     times = np.asarray(times, float)

@@ -37,3 +37,13 @@ TEST(Lubrication, DampingShareCapsOnlyWhatWouldOvershoot)
   EXPECT_DOUBLE_EQ(damping_share(1.0, 1.0, 2.0, 1.0, 1.0), 0.25);    // m_i / (2 dt S_i)
   EXPECT_DOUBLE_EQ(damping_share(1.0, 4.0, 1.0, 1.0, 4.0), 0.125);   // the stricter sphere sets it
 }
+
+TEST(Lubrication, BravoRepulsionIsCutAtAThousandthOfItsContactValue)
+{
+  const double reach = bravo_reach(1.0, 1.0);
+  EXPECT_NEAR(reach, std::log(1000.0) / 10.0, 1e-15);
+  // just inside: 1e-3 of the contact value, raised by exp(0.01 reach) = 1.007
+  EXPECT_NEAR(bravo_repulsion(1.0, 1.0, 0.999 * reach), 1e-3 * bravo_repulsion(1.0, 1.0, 0.0) * std::exp(0.01 * reach), 1e-12);
+  EXPECT_EQ(bravo_repulsion(1.0, 1.0, reach), 0.0);
+  EXPECT_NEAR(bravo_reach(1.0, 0.0), 2.0 * std::log(1000.0) / 10.0, 1e-15);    // q -> 2
+}

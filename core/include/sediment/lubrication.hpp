@@ -17,8 +17,12 @@ inline double effective_radius(double ri, double rj) { return ri * rj / (ri + rj
 double squeeze_coefficient(double viscosity, double ri, double rj, double gap, const LubricationRange &range);
 
 // The Bravo et al. repulsion on sphere i from sphere j, in units of the user's force scale:
-// 10 q^3 exp(-10 g / q) with q = 2 d_i / (d_i + d_j) and g = h / d_i.
+// 10 q^3 exp(-10 g / q) with q = 2 d_i / (d_i + d_j) and g = h / d_i; zero from bravo_reach on.
 double bravo_repulsion(double di, double dj, double gap);
+
+// The gap where the repulsion on sphere i has fallen to 1e-3 of its contact value and is cut:
+// g / q = ln(1000) / 10, i.e. 0.69 q d_i (at most 1.39 d_i, as d_j -> 0).
+double bravo_reach(double di, double dj);
 
 // The largest share of c_ij that keeps an explicit velocity update damped monotonically: with
 // S_i = sum_j c_ij over sphere i's neighbours, every c_ij scaled by
