@@ -120,7 +120,7 @@ class SphereCuts {
 // inclusion-exclusion of SphereCuts::corner at its eight vertices, so the cells telescope to the
 // whole sphere. Along an axis not crossed the one cell spans [-r, r].
 double spread_over_cells(const Grid &grid, const double centre[3], double radius, const int first[3],
-                         const int last[3], const bool crossing[3], double *values, int stride)
+                         const int last[3], const bool crossing[3], double *values, int stride, double weight)
 {
   std::vector<double> edges[3];
   std::vector<int> cells[3];
@@ -151,7 +151,7 @@ double spread_over_cells(const Grid &grid, const double centre[3], double radius
         if (cells[0][i] < 0 || cells[1][j] < 0 || cells[2][k] < 0) continue;
         const double volume = at(i + 1, j, k) - at(i, j, k) - at(i + 1, j + 1, k) + at(i, j + 1, k) -
             at(i + 1, j, k + 1) + at(i, j, k + 1) + at(i + 1, j + 1, k + 1) - at(i, j + 1, k + 1);
-        values[(cells[0][i] + nx * (cells[1][j] + ny * cells[2][k])) * stride] += volume;
+        values[(cells[0][i] + nx * (cells[1][j] + ny * cells[2][k])) * stride] += weight * volume;
         inside += volume;
       }
   return inside;
@@ -164,7 +164,8 @@ double sphere_slab_volume(double centre, double radius, double a, double b)
   return below(radius, b - centre) - below(radius, a - centre);
 }
 
-double add_sphere_to_layers(const Layers &layers, double centre, double radius, double *values, int stride)
+double add_sphere_to_layers(const Layers &layers, double centre, double radius, double *values, int stride,
+                            double weight)
 {
   int first, last;
   touched(layers, centre - radius, centre + radius, first, last);
@@ -173,7 +174,7 @@ double add_sphere_to_layers(const Layers &layers, double centre, double radius, 
     const double upper = below(radius, layers.lo + (k + 1) * layers.thickness - centre);
     const int cell = cell_of(layers, k);
     if (cell >= 0) {
-      values[cell * stride] += upper - lower;
+      values[cell * stride] += weight * (upper - lower);
       inside += upper - lower;
     }
     lower = upper;
@@ -216,7 +217,8 @@ void smooth_profile(const Layers &layers, const double *values, double width, do
   }
 }
 
-double add_sphere_to_grid(const Grid &grid, const double centre[3], double radius, double *values, int stride)
+double add_sphere_to_grid(const Grid &grid, const double centre[3], double radius, double *values, int stride,
+                          double weight)
 {
   const double total = 4.0 / 3.0 * pi * radius * radius * radius;
   int first[3], last[3], ncrossing = 0, along = -1;
@@ -235,7 +237,8 @@ double add_sphere_to_grid(const Grid &grid, const double centre[3], double radiu
     touched(axis, centre[d] - radius, centre[d] + radius, first[d], last[d]);
     if (first[d] > last[d]) return total;
   }
-  if (ncrossing > 1) return total - spread_over_cells(grid, centre, radius, first, last, crosses, values, stride);
+  if (ncrossing > 1)
+    return total - spread_over_cells(grid, centre, radius, first, last, crosses, values, stride, weight);
 
   // Whole in one cell, or sliced like layers along the one crossing axis within the cell of the others.
   int cell[3];
@@ -244,11 +247,11 @@ double add_sphere_to_grid(const Grid &grid, const double centre[3], double radiu
   const int nx = grid.axes[0].count, ny = grid.axes[1].count;
   double *base = values + (cell[0] + nx * (cell[1] + ny * cell[2])) * stride;
   if (along < 0) {
-    *base += total;
+    *base += weight * total;
     return 0.0;
   }
   const int step[3] = {1, nx, nx * ny};
-  return add_sphere_to_layers(grid.axes[along], centre[along], radius, base, step[along] * stride);
+  return add_sphere_to_layers(grid.axes[along], centre[along], radius, base, step[along] * stride, weight);
 }
 
 double grid_value_at(const Grid &grid, const double *values, const double point[3], int stride)

@@ -20,7 +20,8 @@ using namespace LAMMPS_NS;
 
 ComputeConcentrationGrid::ComputeConcentrationGrid(LAMMPS *lmp, int narg, char **arg) :
     Compute(lmp, narg, arg), axis(-1), counts{0, 0, 0}, has_bounds(0), bounds{}, ncentres(0), by_type(0),
-    thickness(0.0), smooth_width(0.0), ncols(1), grid{}, cell_volume(1.0), profiled_step(-1), nmax(0)
+    thickness(0.0), smooth_width(0.0), weight_index(-1), ncols(1), grid{}, cell_volume(1.0), profiled_step(-1),
+    nmax(0)
 {
   const int dimension = domain->dimension;
   int nbounds = 0;
@@ -79,9 +80,15 @@ ComputeConcentrationGrid::ComputeConcentrationGrid(LAMMPS *lmp, int narg, char *
       smooth_width = utils::numeric(FLERR, arg[iarg + 1], false, lmp);
       if (!(smooth_width > 0.0)) error->all(FLERR, "Compute concentration/grid: smooth width must be > 0");
       iarg += 2;
+    } else if (strcmp(keyword, "weight") == 0) {
+      if (iarg + 1 >= narg || strncmp(arg[iarg + 1], "d_", 2) != 0 || !arg[iarg + 1][2])
+        error->all(FLERR, "Compute concentration/grid: 'weight' needs a per-atom property d_NAME "
+                          "(fix property/atom d_NAME)");
+      weight_name = arg[iarg + 1] + 2;
+      iarg += 2;
     } else {
       error->all(FLERR, "Compute concentration/grid: unknown keyword '{}' (expected layers, cells, bounds, "
-                        "classes, types, thickness or smooth)", keyword);
+                        "classes, types, thickness, smooth or weight)", keyword);
     }
   }
   if (counts[0] == 0)
@@ -141,6 +148,14 @@ void ComputeConcentrationGrid::init()
     cell_volume *= grid.resolved[d] ? grid.axes[d].thickness : extent(d);
   }
   profiled_step = -1;
+
+  if (!weight_name.empty()) {
+    int is_double = 0, cols = 0;
+    weight_index = atom->find_custom(weight_name.c_str(), is_double, cols);
+    if (weight_index < 0 || !is_double || cols != 0)
+      error->all(FLERR, "Compute concentration/grid: weight d_{} is not a per-atom floating-point vector "
+                        "(define it with fix property/atom d_{})", weight_name, weight_name);
+  }
 }
 
 // Extent of the cells along an axis the grid does not resolve: the box, or the 2d slab thickness.
@@ -194,13 +209,16 @@ void ComputeConcentrationGrid::profile()
   const int class_col = 1;
   const int type_col = 1 + (class_edges.empty() ? 0 : static_cast<int>(class_edges.size()) + 1);
 
+  const double *weight = weight_index >= 0 ? atom->dvector[weight_index] : nullptr;
+
   for (int i = 0; i < atom->nlocal; ++i) {
     if (!(mask[i] & groupbit)) continue;
+    const double count = weight ? weight[i] : 1.0;
     int columns[3] = {0, -1, -1};
     if (!class_edges.empty()) columns[1] = class_col + size_class(2.0 * radius[i]);
     if (by_type) columns[2] = type_col + type[i] - 1;
     for (int c : columns)
-      if (c >= 0) sediment::add_sphere_to_grid(grid, x[i], radius[i], local.data() + c, ncols);
+      if (c >= 0) sediment::add_sphere_to_grid(grid, x[i], radius[i], local.data() + c, ncols, count);
   }
   MPI_Allreduce(local.data(), fractions.data(), static_cast<int>(local.size()), MPI_DOUBLE, MPI_SUM, world);
 

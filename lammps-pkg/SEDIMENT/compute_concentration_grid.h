@@ -55,6 +55,8 @@ class ComputeConcentrationGrid : public Compute {
   int by_type;
   double thickness;                   // 2d: slab thickness converting areas to volumes
   double smooth_width;                // 0: no smoothing
+  std::string weight_name;            // per-atom property: real spheres each atom stands for
+  int weight_index;
   int ncols;                          // fraction columns: total, classes, types
 
   sediment::Grid grid;

@@ -9,6 +9,7 @@
 #include "fix_fluid_drag.h"
 
 #include "atom.h"
+#include "domain.h"
 #include "error.h"
 #include "force.h"
 #include "memory.h"
@@ -23,10 +24,23 @@ using namespace FixConst;
 static constexpr double INERTIA = 0.4;    // moment of inertia prefactor for a solid sphere
 
 FixNVESphereFluid::FixNVESphereFluid(LAMMPS *lmp, int narg, char **arg) :
-    Fix(lmp, narg, arg), weights(nullptr)
+    Fix(lmp, narg, arg), weights(nullptr), floor_axis(-1), floor_level(0.0)
 {
-  if (narg > 3)
-    error->all(FLERR, "Fix nve/sphere/fluid: unexpected argument '{}' (the style takes none)", arg[3]);
+  int iarg = 3;
+  while (iarg < narg) {
+    if (strcmp(arg[iarg], "floor") == 0) {
+      if (iarg + 2 >= narg) error->all(FLERR, "Fix nve/sphere/fluid: 'floor' needs an axis and a coordinate");
+      const char *dim = arg[iarg + 1];
+      floor_axis = strcmp(dim, "x") == 0 ? 0 : strcmp(dim, "y") == 0 ? 1 : strcmp(dim, "z") == 0 ? 2 : -1;
+      if (floor_axis < 0) error->all(FLERR, "Fix nve/sphere/fluid: floor axis must be x, y or z, not '{}'", dim);
+      if (floor_axis == 2 && domain->dimension == 2)
+        error->all(FLERR, "Fix nve/sphere/fluid: a floor along z in a 2d simulation");
+      floor_level = utils::numeric(FLERR, arg[iarg + 2], false, lmp);
+      iarg += 3;
+    } else {
+      error->all(FLERR, "Fix nve/sphere/fluid: unknown keyword '{}' (expected floor)", arg[iarg]);
+    }
+  }
   if (!atom->sphere_flag)
     error->all(FLERR, "Fix nve/sphere/fluid requires atom_style sphere");
 
@@ -109,6 +123,7 @@ void FixNVESphereFluid::initial_integrate(int /*vflag*/)
       x[i][0] += dt * v[i][0];
       x[i][1] += dt * v[i][1];
       x[i][2] += dt * v[i][2];
+      settle_on_floor(i);
       continue;
     }
 
@@ -130,6 +145,7 @@ void FixNVESphereFluid::initial_integrate(int /*vflag*/)
     w[DIRX] = corr.dir[0];
     w[DIRY] = corr.dir[1];
     w[DIRZ] = corr.dir[2];
+    settle_on_floor(i);
   }
 }
 
@@ -150,6 +166,7 @@ void FixNVESphereFluid::final_integrate()
     const double *w = weights[i];
     if (w[IN_FLUID] == 0.0) {
       nve_sphere_half_step(i);
+      settle_on_floor(i);
       continue;
     }
     const double mass = rmass[i];
@@ -166,7 +183,23 @@ void FixNVESphereFluid::final_integrate()
     omega[i][0] += spin * torque[i][0];
     omega[i][1] += spin * torque[i][1];
     omega[i][2] += spin * torque[i][2];
+    settle_on_floor(i);
   }
+}
+
+void FixNVESphereFluid::settle_on_floor(int i)
+{
+  // A perfectly inelastic floor without a bed: a sphere reaching it stops with its lowest point
+  // on it, and stays while the forces press it down (only the settling is resolved, not the deposit).
+  if (floor_axis < 0) return;
+  double *x = atom->x[i];
+  double *v = atom->v[i];
+  const double rest = floor_level + atom->radius[i];
+  if (x[floor_axis] > rest || (x[floor_axis] == rest && v[floor_axis] > 0.0)) return;
+  x[floor_axis] = rest;
+  v[0] = v[1] = v[2] = 0.0;
+  double *omega = atom->omega[i];
+  omega[0] = omega[1] = omega[2] = 0.0;
 }
 
 void FixNVESphereFluid::nve_sphere_half_step(int i)

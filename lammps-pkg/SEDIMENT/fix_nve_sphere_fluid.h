@@ -44,6 +44,10 @@ class FixNVESphereFluid : public Fix {
   std::vector<class FixFluidDrag *> drags;
   void nve_sphere_half_step(int i);
 
+  int floor_axis;         // -1: no floor
+  double floor_level;     // spheres stop with their lowest point here
+  void settle_on_floor(int i);
+
   RankSums<2> counts;    // spheres stuck by the yield stress, held at a Cd jump
 };
 

@@ -169,6 +169,25 @@ TEST(Grid, CoarseCellsAgreeWithTheirRefinedSubcellsAndVolumeIsConserved)
   std::printf("coarse vs refined cells: worst difference %.2e of the sphere volume\n", worst);
 }
 
+TEST(Grid, AWeightedSphereCountsAsThatManySpheresInEveryPath)
+{
+  // Inside one cell, sliced along one axis, and split along three: each adds weight x its volume;
+  // the volume returned as outside is the sphere's own.
+  const double r = 0.05, weight = 2.5e7, total = 4.0 / 3.0 * pi * r * r * r;
+  const Grid grid = cube_grid(0.0, 0.1, 10);
+  for (const double shift : {0.05, 0.1, 0.0}) {
+    const double centre[3] = {0.45, 0.45, 0.45 + shift};
+    const double at_edge[3] = {shift, 0.5, 0.5};
+    std::vector<double> one(1000, 0.0), many(1000, 0.0);
+    add_sphere_to_grid(grid, centre, r, one.data());
+    EXPECT_NEAR(add_sphere_to_grid(grid, centre, r, many.data(), 1, weight), 0.0, 1e-15 * total);
+    for (int cell = 0; cell < 1000; ++cell) EXPECT_NEAR(many[cell], weight * one[cell], 1e-15 * weight * total);
+    std::vector<double> clipped(1000, 0.0);
+    const double outside = add_sphere_to_grid(grid, at_edge, r, clipped.data(), 1, weight);
+    EXPECT_NEAR(sum(clipped), weight * (total - outside), 1e-14 * weight * total);
+  }
+}
+
 TEST(Grid, OuterFacesClipUnlessPeriodic)
 {
   // Centred on the x = lo and z = hi faces: a quarter of the sphere is inside the bounded grid.

@@ -335,6 +335,33 @@ def concentration_grid(np_ranks: int):
     assert conserved_cells < 1e-12 and layer_diff < 1e-13 and interp_err < 1e-13
 
 
+# ---- deposit on a floor, weighted layers -----------------------------------------------------
+@check
+def deposit(np_ranks: int):
+    with tempfile.TemporaryDirectory() as tmp:
+        mid, final, profile = (Path(tmp) / name for name in ("mid.txt", "final.txt", "profile.txt"))
+        run_deck("deposit.lmp", {"mid": mid, "final": final, "profile": profile}, np_ranks)
+        at5, at50 = np.loadtxt(mid, skiprows=9), np.loadtxt(final, skiprows=9)
+        first = np.loadtxt(profile, comments="#", skiprows=4, max_rows=101)[:, 2]
+    z, vz, r, weight = at5[:, 1], at5[:, 2], at5[:, 3], at5[:, 4]
+    vt, tau = stokes_reference(2 * r, 2650.0)
+    t = 5.0
+    free = 0.005 - vt * (t - tau * (1 - np.exp(-t / tau)))    # exact for Stokes drag at any dt
+    down = free <= r
+    moving_err = float(np.max(np.abs(z[~down] - free[~down]) / (vt[~down] * t)))
+    report(f"deposit at t = 5 s: {down.sum()} of {len(z)} spheres on the floor (z = r, v = 0 exactly: "
+           f"{bool(np.all(z[down] == r[down]) and np.all(vz[down] == 0))}); the others within {moving_err:.1e} "
+           f"of the exact Stokes fall")
+    assert 0 < down.sum() < len(z) and np.all(z[down] == r[down]) and np.all(vz[down] == 0)
+    assert moving_err < 1e-10
+    assert np.all(at50[:, 1] == at50[:, 3]) and np.all(at50[:, [2, 5, 6]] == 0)
+    solid = float(np.sum(weight * 4 / 3 * np.pi * r ** 3))
+    weighted = first.sum() * 0.002 * 0.002 * 0.0102 / 101
+    report(f"weighted layers: sum of fraction x layer volume = {weighted:.6e} m3, sum of weight x sphere volume "
+           f"= {solid:.6e} m3 (relative {abs(weighted - solid) / solid:.1e}); all {len(at50)} on the floor at 50 s")
+    assert abs(weighted - solid) < 1e-12 * solid
+
+
 # ---- lubrication ------------------------------------------------------------------------------
 def lubrication_run(np_ranks: int, **variables) -> np.ndarray:
     return run_deck("lubrication.lmp", variables, np_ranks).samples    # time, gap, approach speed
@@ -500,7 +527,9 @@ BAD_INPUT = [
     ("fix f all fluid density 1000 viscosity 1e-3\nfix d all fluid/drag f law stokes rotation maybe", "rotation must be yes or no"),
     ("unfix grav\nfix f all fluid density 1000 viscosity 1e-3\nfix b all fluid/buoyancy f\nrun 0", "needs a fix gravity"),
     ("fix f all fluid density 1000 viscosity 1e-3\nfix b all fluid/buoyancy f gravity f\nrun 0", "is a fix fluid, not a fix gravity"),
-    ("fix n all nve/sphere/fluid extra", "unexpected argument 'extra'"),
+    ("fix n all nve/sphere/fluid extra", "unknown keyword 'extra' (expected floor)"),
+    ("fix n all nve/sphere/fluid floor z", "'floor' needs an axis and a coordinate"),
+    ("fix n all nve/sphere/fluid floor w 0", "floor axis must be x, y or z, not 'w'"),
     ("fix f all fluid density 1000 viscosity 1e-3\nfix b all fluid/buoyancy f mixture c_c", "'mixture' needs c_ID and the solid density"),
     ("fix f all fluid density 1000 viscosity 1e-3\nfix b all fluid/buoyancy f mixture c_c -5", "mixture solid density must be > 0"),
     ("fix f all fluid density 1000 viscosity 1e-3\nfix b all fluid/buoyancy f mixture c_c 2650\nrun 0", "compute 'c' does not exist"),
@@ -525,6 +554,8 @@ BAD_INPUT = [
     ("compute c all concentration/grid layers z 10 thickness 1", "'thickness' is for 2d simulations only"),
     ("compute c all concentration/grid layers z 10 smooth -1", "smooth width must be > 0"),
     ("compute c all concentration/grid layers z 10 sieve 3", "unknown keyword 'sieve'"),
+    ("compute c all concentration/grid layers z 10 weight w", "'weight' needs a per-atom property d_NAME"),
+    ("compute c all concentration/grid layers z 10 weight d_w\nrun 0", "weight d_w is not a per-atom floating-point vector"),
     ("fix l all layers/hdf5 0 a.h5 c_c", "N must be > 0"),
     ("fix l all layers/hdf5 10 a.h5 conc", "expected a compute reference c_ID"),
     ("fix l all layers/hdf5 10 a.h5 c_nothing\nrun 0", "compute 'nothing' does not exist"),

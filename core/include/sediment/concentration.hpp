@@ -18,10 +18,11 @@ struct Layers {
   double hi() const { return lo + thickness * count; }
 };
 
-// Adds the sphere's volume in every layer it overlaps to values[k * stride]; returns the part of
-// its volume outside [lo, hi] (none along a periodic axis). Volumes telescope, so they sum exactly
-// to the inside part.
-double add_sphere_to_layers(const Layers &layers, double centre, double radius, double *values, int stride = 1);
+// Adds the sphere's volume in every layer it overlaps, times `weight` (the number of real spheres
+// it stands for), to values[k * stride]; returns the part of its own volume outside [lo, hi] (none
+// along a periodic axis). Volumes telescope, so they sum exactly to the inside part.
+double add_sphere_to_layers(const Layers &layers, double centre, double radius, double *values, int stride = 1,
+                            double weight = 1.0);
 
 // The piecewise-linear profile through the layer centres at x (flat beyond the outer centres, or
 // wrapped along a periodic axis).
@@ -41,11 +42,12 @@ struct Grid {
   int cells() const { return axes[0].count * axes[1].count * axes[2].count; }
 };
 
-// Adds the sphere's volume in every cell it overlaps to values[cell * stride]; returns the part of
-// its volume outside the grid. A sphere crossing faces along one axis is sliced like layers; one
+// Adds the sphere's volume in every cell it overlaps, times `weight`, to values[cell * stride];
+// returns the part of its own volume outside the grid. A sphere crossing faces along one axis is sliced like layers; one
 // crossing faces along two or three is split by inclusion-exclusion of the closed-form volume of
 // the sphere beyond three perpendicular planes (cost: the sphere's cell vertices).
-double add_sphere_to_grid(const Grid &grid, const double centre[3], double radius, double *values, int stride = 1);
+double add_sphere_to_grid(const Grid &grid, const double centre[3], double radius, double *values, int stride = 1,
+                          double weight = 1.0);
 
 // Trilinear interpolation between cell centres (flat beyond the outer centres, wrapped along
 // periodic axes).
