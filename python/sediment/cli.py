@@ -44,13 +44,49 @@ def cmd_case_a(args: argparse.Namespace) -> int:
     return 0
 
 
+def cmd_sample(args: argparse.Namespace) -> int:
+    from .psd import read_psd
+    from .readout import Fluid
+    from .sample import Cylinder, Effects, describe, plan, write
+
+    cylinder = Cylinder.bravo() if args.cylinder == "bravo" else Cylinder()
+    if args.height is not None:
+        cylinder = Cylinder(cylinder.area, args.height)
+    scene = plan(read_psd(args.psd), geometry=args.geometry, cylinder=cylinder, mass=args.mass,
+                 fluid=Fluid(particle_density=args.particle_density), width=args.width, classes=args.classes,
+                 particles=None if args.real_grains else args.particles,
+                 effects=Effects(args.law, args.hindered, args.contacts, args.lubrication),
+                 layers=args.layers, t_end=args.t_end, courant=args.courant, seed=args.seed)
+    print(describe(scene))
+    for path in write(scene, args.out):
+        print(f"wrote {path}")
+    print(f"next: sediment run {args.out / 'in.sedimentation'}")
+    return 0
+
+
+def cmd_run(args: argparse.Namespace) -> int:
+    from .run import run_deck
+
+    result = run_deck(args.deck, ranks=args.np, variables=dict(args.var or []), progress=not args.quiet)
+    print(f"{result.deck.name}: {result.steps} steps, {result.simulated_time:.6g} s simulated in "
+          f"{result.wall_seconds:.1f} s on {args.np} rank(s); log {result.log}")
+    return 0
+
+
 def cmd_readout(args: argparse.Namespace) -> int:
     from .granulometry import error_summary, read_all, write_report
     from .psd import read_psd
     from .readout import Column, Fluid
     from .synthetic import stokes_column
 
+    if args.layers is not None:    # PSD tables that `sediment sample` wrote beside the run
+        for option, name in (("psd", "input_psd.csv"), ("simulated", "simulated_psd.csv")):
+            beside = args.layers.parent / name
+            if getattr(args, option) is None and beside.is_file():
+                setattr(args, option, beside)
+                print(f"using {beside}")
     psd = read_psd(args.psd) if args.psd else None
+    simulated = read_psd(args.simulated) if args.simulated else None
     if args.layers is not None:
         from .layers import read_layers
         column = Column.from_layers(read_layers(args.layers), surface=args.surface)
@@ -67,11 +103,12 @@ def cmd_readout(args: argparse.Namespace) -> int:
                                args.pipette_volume, args.cylinder_area)
     for note in notes:
         print(note)
-    for path in write_report(readings, args.out, psd, title=title):
+    for path in write_report(readings, args.out, psd, simulated, title=title):
         print(f"wrote {path}")
-    if psd is not None:
-        for instrument, size_range, count, error in error_summary(readings, psd):
-            print(f"{instrument:10s} {size_range:10s} {count:3d} readings, mean |P - PSD| = {error:.2f} points")
+    for name, reference in (("input", psd), ("simulated", simulated)):
+        if reference is not None:
+            for instrument, size_range, count, error in error_summary(readings, reference):
+                print(f"{instrument:10s} {size_range:10s} {count:3d} readings, mean |P - {name} PSD| = {error:.2f} points")
     return 0
 
 
@@ -96,13 +133,53 @@ def build_parser() -> argparse.ArgumentParser:
     case_a.add_argument("--out", type=Path, default=Path("out/case_a"), help="output folder")
     case_a.set_defaults(func=cmd_case_a)
 
+    sample = sub.add_parser("sample", help="a sedimentation test as a LAMMPS scene: size classes of a PSD, "
+                            "particles placed in a sub-volume of the cylinder, data file and ready deck")
+    sample.add_argument("psd", type=Path, help="PSD table (CSV: diameter_um,percent_finer)")
+    sample.add_argument("--out", type=Path, default=Path("out/sample"), help="output folder")
+    sample.add_argument("--geometry", default="column", choices=["column", "slab"],
+                        help="3D periodic column, or Bravo et al.'s 2D slab of the cylinder's axial section")
+    sample.add_argument("--cylinder", default="d422", choices=["d422", "bravo"],
+                        help="ASTM D422 (27.8 cm2, 0.36 m) or Bravo et al. (B 0.0635 m, H 0.457 m)")
+    sample.add_argument("--height", type=positive, help="suspension height [m] (default: the cylinder's)")
+    sample.add_argument("--width", type=positive, help="column side or slab width [m] (default: 2 largest "
+                        "diameters; the slab spans the cylinder)")
+    sample.add_argument("--mass", type=positive, default=0.060, help="dry sample mass [kg]")
+    sample.add_argument("--particle-density", type=positive, default=2650.0, help="[kg/m3]")
+    sample.add_argument("--classes", type=int, default=40, help="log-spaced size classes (eq. 15)")
+    sample.add_argument("--particles", type=int, default=20000,
+                        help="simulated particles, as parcels of equal real mass (weights)")
+    sample.add_argument("--real-grains", action="store_true",
+                        help="one atom per real grain at the real concentration (eq. 15 counts, at least one "
+                             "per class); needed with --contacts or --lubrication")
+    sample.add_argument("--law", default="dallavalle", choices=["stokes", "schiller-naumann", "dallavalle"])
+    sample.add_argument("--hindered", action="store_true", help="Di Felice drag on the local concentration")
+    sample.add_argument("--contacts", action="store_true", help="Hertz contacts between grains and with the floor")
+    sample.add_argument("--lubrication", action="store_true", help="squeeze-film lubrication (with contacts)")
+    sample.add_argument("--layers", type=int, default=400, help="layers of the concentration grid")
+    sample.add_argument("--t-end", type=positive, default=86400.0, help="simulated time [s] (default 24 h)")
+    sample.add_argument("--courant", type=positive, default=1.0,
+                        help="layers the fastest grain in suspension may cross per step")
+    sample.add_argument("--seed", type=int, default=1, help="placement seed")
+    sample.set_defaults(func=cmd_sample)
+
+    run = sub.add_parser("run", help="run a deck with lmp_sediment (serial or mpirun) with a progress bar")
+    run.add_argument("deck", type=Path, help="LAMMPS input deck (e.g. from `sediment sample`)")
+    run.add_argument("--np", type=int, default=1, help="MPI ranks")
+    run.add_argument("--var", nargs=2, action="append", metavar=("NAME", "VALUE"), help="LAMMPS -var")
+    run.add_argument("--quiet", action="store_true", help="no progress bar")
+    run.set_defaults(func=cmd_run)
+
     readout = sub.add_parser("readout", help="hydrometer, buoyancy-sphere and pipette readings from a layer "
                              "file (fix layers/hdf5), with CSV tables, the granulometry figure and errors")
     readout.add_argument("layers", type=Path, nargs="?", help="layer file (HDF5)")
     readout.add_argument("--instrument", default="all", choices=["hydrometer", "buoyancy", "pipette", "all"])
     readout.add_argument("--schedule", default="d422", choices=sorted(SCHEDULE_NAMES),
                          help="reading times (the buoyancy sphere uses Bravo et al.'s unless another is given)")
-    readout.add_argument("--psd", type=Path, help="input PSD (diameter_um,percent_finer) to compare with")
+    readout.add_argument("--psd", type=Path, help="input PSD (diameter_um,percent_finer) to compare with "
+                         "(default: input_psd.csv beside the layer file)")
+    readout.add_argument("--simulated", type=Path, help="PSD actually simulated (default: simulated_psd.csv "
+                         "beside the layer file)")
     readout.add_argument("--stokes-preview", action="store_true",
                          help="without a layer file: read an analytic Stokes column of --psd")
     readout.add_argument("--height", type=positive, default=0.36, help="preview column height [m]")

@@ -64,10 +64,11 @@ def write_report(readings: list[Readings], out: Path, psd: PSD | None = None, si
         path = out / f"{r.instrument}.csv"
         path.write_text(r.table())
         written.append(path)
-    if psd is not None:
+    references = [(name, curve) for name, curve in (("input", psd), ("simulated", simulated)) if curve is not None]
+    if references:
         path = out / "errors.csv"
-        path.write_text("instrument,size_range,readings,mean_abs_error_points\n" + "".join(
-            f"{a},{b},{n},{e:.4g}\n" for a, b, n, e in error_summary(readings, psd)))
+        path.write_text("reference,instrument,size_range,readings,mean_abs_error_points\n" + "".join(
+            f"{name},{a},{b},{n},{e:.4g}\n" for name, curve in references for a, b, n, e in error_summary(readings, curve)))
         written.append(path)
     fig, ax = plt.subplots(figsize=(7, 4.5))
     for curve, style, label in ((psd, "k-", "input PSD"), (simulated, "k--", "simulated PSD")):

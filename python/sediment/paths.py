@@ -17,3 +17,10 @@ def lmp_executable() -> str:
         if candidate and Path(candidate).is_file():
             return str(Path(candidate).resolve())
     raise FileNotFoundError("lmp_sediment not found: build it with `make build` or set SEDIMENT_LMP")
+
+
+def mpirun_prefix(ranks: int) -> list[str]:
+    """The launcher for `ranks` MPI ranks (none for one); allowed as root and on fewer cores."""
+    if ranks <= 1:
+        return []
+    return ["mpirun", "--allow-run-as-root", "--oversubscribe", "-np", str(ranks)]

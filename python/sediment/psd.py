@@ -72,14 +72,16 @@ def read_psd(path: str | Path) -> PSD:
 
 @dataclass(frozen=True)
 class SizeClasses:
-    """Discrete diameters with the particle count and mass fraction of each."""
+    """Discrete diameters with the particle count and mass fraction of each. Each simulated particle
+    stands for `weight` real ones of its class (1: the real count)."""
 
     diameter: np.ndarray        # [m] class diameters phi_k
     mass_fraction: np.ndarray   # of the input PSD, sums to the fraction of mass within the classes
-    count: np.ndarray           # particles per class in the simulated volume (>= 1 where mass > 0)
+    count: np.ndarray           # simulated particles per class (>= 1 where mass > 0)
+    weight: np.ndarray          # real particles per simulated one, per class
 
     def simulated_mass_fraction(self) -> np.ndarray:
-        mass = self.count * self.diameter ** 3
+        mass = self.count * self.weight * self.diameter ** 3
         return mass / mass.sum()
 
     def simulated_psd(self) -> PSD:
@@ -105,17 +107,27 @@ def log_classes(psd: PSD, lo: float, hi: float, classes: int) -> tuple[np.ndarra
 
 
 def discretise(psd: PSD, classes: int, sample_mass: float, particle_density: float,
-               volume_fraction: float) -> SizeClasses:
+               volume_fraction: float, particles: int | None = None) -> SizeClasses:
     """Bravo et al. eq. 15 on `classes` log-spaced diameters spanning the PSD: class k holds the mass
     between its lower and upper mid-points, n_k = 6 M dw_k / (rho_p pi phi_k^3) scaled by the
-    simulated fraction of the cylinder; every class with mass keeps at least one particle."""
+    simulated fraction of the cylinder; every class with mass keeps at least one particle.
+
+    With `particles`, about that many are simulated as parcels of equal real mass (n_k in proportion
+    to dw_k, at least one), each standing for the real n_k / (simulated n_k) particles: the simulated
+    PSD is then the discretised one exactly, and every class is sampled alike."""
     if classes < 2:
         raise PSDError("need at least 2 size classes")
     if not (sample_mass > 0 and particle_density > 0 and 0 < volume_fraction <= 1):
         raise PSDError("sample mass and particle density must be > 0, the simulated fraction within (0, 1]")
+    if particles is not None and particles < classes:
+        raise PSDError(f"{particles} particles cannot sample {classes} size classes: give at least one per class")
     lo = psd.diameter[np.argmax(psd.percent_finer > 0) - 1] if psd.percent_finer[0] == 0 else psd.diameter[0]
     hi = psd.diameter[np.argmax(psd.percent_finer >= 100)] if psd.percent_finer[-1] >= 100 else psd.diameter[-1]
     diameter, fraction = log_classes(psd, lo, hi, classes)
     exact = 6 * sample_mass * fraction / (particle_density * np.pi * diameter ** 3) * volume_fraction
-    count = np.where(fraction > 0, np.maximum(np.rint(exact), 1), 0).astype(np.int64)
-    return SizeClasses(diameter=diameter, mass_fraction=fraction, count=count)
+    if particles is None:
+        count = np.where(fraction > 0, np.maximum(np.rint(exact), 1), 0).astype(np.int64)
+    else:
+        count = np.where(fraction > 0, np.maximum(np.rint(particles * fraction / fraction.sum()), 1), 0).astype(np.int64)
+    weight = np.divide(exact, count, out=np.ones_like(exact), where=count > 0) if particles else np.ones_like(exact)
+    return SizeClasses(diameter=diameter, mass_fraction=fraction, count=count, weight=weight)

@@ -51,7 +51,7 @@ def test_readout_preview_writes_tables_figure_and_errors(tmp_path, capsys):
     for name in ("hydrometer.csv", "buoyancy.csv", "pipette.csv", "errors.csv", "granulometry.png", "granulometry.pdf"):
         assert (tmp_path / name).stat().st_size > 0
     rows = (tmp_path / "errors.csv").read_text().splitlines()[1:]
-    assert len(rows) == 9 and all(float(r.split(",")[3]) < 2.0 for r in rows if r.split(",")[2] != "0")
+    assert len(rows) == 9 and all(float(r.split(",")[4]) < 2.0 for r in rows if r.split(",")[3] != "0")
 
 
 def test_readout_bad_inputs_are_clear(tmp_path, capsys):

@@ -1,0 +1,81 @@
+"""Runs a deck through lmp_sediment (serial or mpirun) with a progress bar in simulated time.
+
+Decks written by `sediment sample` announce their plan ("SEDIMENT plan steps N t_end T") and print
+thermo rows beginning with step and time; the bar advances in simulated time and its ETA follows
+the steps, which cost alike whatever the time step."""
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+from .paths import lmp_executable, mpirun_prefix
+
+
+@dataclass
+class RunResult:
+    deck: Path
+    log: Path
+    wall_seconds: float
+    steps: int
+    simulated_time: float
+
+
+def run_deck(deck: Path, ranks: int = 1, variables: dict[str, str] | None = None, progress: bool = True) -> RunResult:
+    """Runs `deck` in its folder, writing log.lammps there; raises RuntimeError with LAMMPS's error
+    message if it fails."""
+    deck = Path(deck).resolve()
+    if not deck.is_file():
+        raise FileNotFoundError(f"{deck}: no such deck")
+    log = deck.parent / "log.lammps"
+    cmd = mpirun_prefix(ranks) + [lmp_executable(), "-in", deck.name, "-log", log.name, "-nocite"]
+    for name, value in (variables or {}).items():
+        cmd += ["-var", name, str(value)]
+    env = dict(os.environ, OMP_NUM_THREADS="1", OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
+    start = time.monotonic()
+    total_steps, t_end, step, now, errors, tail = 0, 0.0, 0, 0.0, [], []
+    bar = None
+    with subprocess.Popen(cmd, cwd=deck.parent, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
+                          env=env) as proc:
+        assert proc.stdout is not None
+        for line in proc.stdout:
+            tail = (tail + [line.rstrip()])[-20:]
+            words = line.split()
+            if line.startswith("ERROR"):
+                errors.append(line.strip())
+            elif line.startswith("SEDIMENT plan") and len(words) >= 6:
+                total_steps, t_end = int(words[3]), float(words[5])
+                if progress:
+                    from tqdm import tqdm
+                    bar = tqdm(total=t_end, unit="s", desc="simulated", file=sys.stderr, dynamic_ncols=True,
+                               mininterval=0.5, bar_format="{desc}: {percentage:3.0f}%|{bar}| {n:.4g}/{total:.4g} s "
+                                                           "[{elapsed}{postfix}]")
+            elif len(words) >= 2 and words[0].isdigit() and _is_float(words[1]):
+                step, now = int(words[0]), float(words[1])
+                if bar is not None and step:
+                    left = (time.monotonic() - start) * (total_steps - step) / step
+                    bar.set_postfix_str(f"ETA {_clock(left)}", refresh=False)
+                    bar.update(min(now, t_end) - bar.n)
+        code = proc.wait()
+    if bar is not None:
+        bar.close()
+    if code != 0 or errors:
+        message = errors[0] if errors else "\n".join(tail[-5:])
+        raise RuntimeError(f"{deck.name} failed (exit {code}): {message} (see {log})")
+    return RunResult(deck, log, time.monotonic() - start, step, now)
+
+
+def _is_float(word: str) -> bool:
+    try:
+        float(word)
+    except ValueError:
+        return False
+    return True
+
+
+def _clock(seconds: float) -> str:
+    minutes, secs = divmod(int(round(seconds)), 60)
+    return f"{minutes // 60:d}:{minutes % 60:02d}:{secs:02d}" if minutes >= 60 else f"{minutes:d}:{secs:02d}"

@@ -1,0 +1,393 @@
+"""A sedimentation test as a LAMMPS scene (sedimentation-tests.md section 1): the sample's PSD
+discretised into size classes, a representative sub-volume of the cylinder (a 3D periodic column or
+Bravo et al.'s 2D slab), stratified random placement, and a LAMMPS data file with a ready deck.
+
+The deck settles the grains with drag and buoyancy onto a floor where they stop, and writes the layer
+file the readouts need. Its time step follows the physics: the fastest grain still in suspension
+crosses at most `courant` layers per step, so the step doubles each time the column has been
+cleared of the grains fast enough to need the smaller one (steps per doubling: layers / courant).
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from datetime import datetime, timezone
+from pathlib import Path
+
+import numpy as np
+
+from . import _core
+from .psd import PSD, SizeClasses, class_edges, discretise
+from .readout import Fluid
+
+GEOMETRIES = ("column", "slab")
+
+
+@dataclass(frozen=True)
+class Cylinder:
+    """The sedimentation cylinder: inner cross-section and suspension height."""
+
+    area: float = 27.8e-4       # m2, ASTM D422 (inner diameter 5.95 cm)
+    height: float = 0.36        # m, the 1000 mL mark
+
+    @classmethod
+    def bravo(cls) -> "Cylinder":
+        """Bravo et al. (2015): H = 0.457 m, B = 0.0635 m."""
+        return cls(math.pi / 4 * 0.0635 ** 2, 0.457)
+
+    @property
+    def diameter(self) -> float:
+        return math.sqrt(4 * self.area / math.pi)
+
+
+@dataclass(frozen=True)
+class Effects:
+    """What the scene simulates beyond drag and buoyancy."""
+
+    law: str = "dallavalle"         # drag law; readouts assume Stokes, so the difference shows
+    hindered: bool = False          # Di Felice drag on the local concentration
+    contacts: bool = False          # Hertz contacts between grains and with the floor
+    lubrication: bool = False       # squeeze film between close grains (implies contacts)
+
+    @property
+    def interacting(self) -> bool:
+        return self.contacts or self.lubrication
+
+
+@dataclass
+class Scene:
+    """Everything `write` needs; built by `plan`."""
+
+    psd: PSD
+    classes: SizeClasses
+    fluid: Fluid
+    cylinder: Cylinder
+    geometry: str
+    width: float                    # column: side of the square section; slab: across the cylinder
+    thickness: float                # out of plane: the column side, or the slab thickness
+    height: float
+    mass: float                     # whole sample [kg]
+    effects: Effects
+    layers: int
+    t_end: float
+    courant: float
+    seed: int
+    diameter: np.ndarray = field(default_factory=lambda: np.empty(0))    # per atom [m]
+    weight: np.ndarray = field(default_factory=lambda: np.empty(0))
+    position: np.ndarray = field(default_factory=lambda: np.empty((0, 3)))
+
+    @property
+    def dimension(self) -> int:
+        return 2 if self.geometry == "slab" else 3
+
+    @property
+    def volume(self) -> float:
+        return self.width * self.thickness * self.height
+
+    @property
+    def volume_fraction(self) -> float:
+        """Share of the cylinder the sub-volume stands for."""
+        return self.volume / (self.cylinder.area * self.cylinder.height)
+
+    @property
+    def initial_concentration(self) -> float:
+        """Solids per volume of suspension [kg/m3]."""
+        return self.mass / (self.cylinder.area * self.cylinder.height)
+
+    def stages(self) -> list[tuple[float, int]]:
+        """(time step, steps) per stage up to t_end. Until the largest grains can have left the
+        column (H / v_max) the step is courant layers / v_max; after a time t only grains slower
+        than H / t can remain, so each following stage, as long as the time before it, takes a step
+        twice the last. Stages are whole numbers of frames."""
+        steps = FRAMES_PER_STAGE * max(1, math.ceil(self.layers / self.courant / FRAMES_PER_STAGE))
+        if self.effects.interacting:                  # contacts set the step everywhere
+            dt = self.contact_time_step()
+            return [(dt, math.ceil(self.t_end / dt))]
+        v_max = terminal_speed(self.fluid, self.classes.diameter[self.classes.count > 0].max(), self.effects.law)
+        time, dt, result = 0.0, self.height / v_max / steps, []
+        while time < self.t_end * (1 - 1e-12):
+            n = min(steps, self.frame_steps() * math.ceil((self.t_end - time) / (dt * self.frame_steps())))
+            result.append((dt, n))
+            time += n * dt
+            if time >= self.height / v_max * (1 - 1e-12):
+                dt = time / steps
+        return result
+
+    def frame_steps(self) -> int:
+        """Steps between layer frames: FRAMES_PER_STAGE frames per stage."""
+        if self.effects.interacting:
+            return max(1, math.ceil(self.t_end / self.contact_time_step() / 400))
+        return max(1, math.ceil(self.layers / self.courant / FRAMES_PER_STAGE))
+
+    def contact_time_step(self) -> float:
+        """A fifth of the Rayleigh time of the smallest grain (Young's modulus as in `write`)."""
+        radius = 0.5 * self.classes.diameter[self.classes.count > 0].min()
+        return 0.2 * _core.rayleigh_time(radius, self.fluid.particle_density, YOUNGS_MODULUS, POISSON_RATIO)
+
+    def simulated_psd(self) -> PSD:
+        return self.classes.simulated_psd()
+
+
+FRAMES_PER_STAGE = 20
+MAX_PARTICLES = 10_000_000
+YOUNGS_MODULUS = 1e7    # Pa: a soft grain (contact time long enough to be affordable), as in the examples
+POISSON_RATIO = 0.3
+
+
+def terminal_speed(fluid: Fluid, diameter: float, law: str) -> float:
+    drag_law = "dallavalle" if law == "difelice" else law    # Di Felice alone is Dallavalle's C_d
+    speed, _ = _core.terminal_velocity(drag_law, fluid.density, fluid.viscosity, 0.0, float(diameter),
+                                       fluid.particle_density, fluid.gravity)
+    return speed
+
+
+def plan(psd: PSD, *, geometry: str = "column", cylinder: Cylinder = Cylinder(), mass: float = 0.060,
+         fluid: Fluid = Fluid(), width: float | None = None, classes: int = 40, particles: int | None = 20000,
+         effects: Effects = Effects(), layers: int = 400, t_end: float = 86400.0, courant: float = 1.0,
+         seed: int = 1) -> Scene:
+    """The scene of a test: sub-volume, classes, particles and their placement.
+
+    `particles` simulated as equal-mass parcels (compute concentration/grid weight); None: real
+    grains at the real concentration of the sub-volume (required with contacts or lubrication,
+    where every atom must be a grain)."""
+    if geometry not in GEOMETRIES:
+        raise ValueError(f"geometry must be one of {', '.join(GEOMETRIES)}, not '{geometry}'")
+    if effects.law not in _core.drag_law_names() or effects.law.startswith("zhang-li"):
+        raise ValueError(f"drag law must be stokes, schiller-naumann or dallavalle, not '{effects.law}'")
+    if effects.interacting and particles is not None:
+        raise ValueError("contacts and lubrication need real grains: use --real-grains (no parcels)")
+    if not (mass > 0 and layers >= 10 and t_end > 0 and courant > 0):
+        raise ValueError("mass and end time must be > 0, layers >= 10, courant > 0")
+    d_max = psd.diameter[-1] if psd.percent_finer[-1] < 100 else psd.diameter[np.argmax(psd.percent_finer >= 100)]
+    if geometry == "slab":
+        width = cylinder.diameter if width is None else width
+        thickness = d_max
+    else:
+        width = 2 * d_max if width is None else width
+        thickness = width
+    if not 0 < width <= (cylinder.diameter if geometry == "slab" else math.sqrt(cylinder.area)):
+        raise ValueError(f"sub-volume width {width:g} m does not fit the cylinder ({cylinder.diameter:g} m across)")
+    fraction = width * thickness / cylinder.area
+    size_classes = discretise(psd, classes, mass, fluid.particle_density, fraction, particles)
+    if size_classes.count.sum() > MAX_PARTICLES:
+        raise ValueError(f"{size_classes.count.sum():.3g} real grains in this sub-volume (more than {MAX_PARTICLES:.0e}): "
+                         "simulate parcels (--particles) or a smaller sub-volume (--width, --height)")
+    scene = Scene(psd, size_classes, fluid, cylinder, geometry, width, thickness, cylinder.height, mass, effects,
+                  layers, t_end, courant, seed)
+    place(scene)
+    return scene
+
+
+def place(scene: Scene) -> None:
+    """Stratified random placement: each class's particles get distinct cells of a grid of about
+    cubic cells (as many as the particles) over the sub-volume, one at a random point of each, so
+    every class starts uniform at every scale above its spacing. Centres stay one radius inside the
+    column. With contacts, overlapping grains are redrawn in their cells."""
+    rng = np.random.default_rng(scene.seed)
+    lateral = 1 if scene.geometry == "slab" else 2
+    diameters, weights, positions = [], [], []
+    for d, n, w in zip(scene.classes.diameter, scene.classes.count, scene.classes.weight):
+        if n == 0:
+            continue
+        cells = _stratify(rng, int(n), scene.width, scene.height - d, lateral)
+        lo = np.array([0.0, 0.0, 0.5 * d])
+        positions.append(lo + cells)
+        diameters.append(np.full(n, d))
+        weights.append(np.full(n, w))
+    scene.diameter = np.concatenate(diameters)
+    scene.weight = np.concatenate(weights)
+    scene.position = np.concatenate(positions)
+    if scene.geometry == "slab":                       # (x, 0, height) -> (x, height, 0) in LAMMPS 2d
+        scene.position = scene.position[:, [0, 2, 1]]
+    if scene.effects.interacting:
+        _separate(scene, rng)
+
+
+def _stratify(rng: np.random.Generator, n: int, width: float, height: float, lateral: int) -> np.ndarray:
+    """n points, one in each of n distinct cells of a grid over [0, width]^lateral x [0, height]."""
+    side = (width ** lateral * height / n) ** (1 / (lateral + 1))
+    across = max(1, round(width / side))
+    rows = math.ceil(n / across ** lateral)
+    chosen = rng.choice(across ** lateral * rows, size=n, replace=False)
+    index = [chosen % across, (chosen // across) % across if lateral == 2 else np.zeros(n, int),
+             chosen // across ** lateral]
+    sizes = [width / across, width / across if lateral == 2 else 0.0, height / rows]
+    return np.column_stack([(index[k] + rng.random(n)) * sizes[k] for k in range(3)])
+
+
+def _separate(scene: Scene, rng: np.random.Generator, attempts: int = 200) -> None:
+    """Redraws overlapping grains (the smaller of each pair) at random heights until none overlap."""
+    from scipy.spatial import cKDTree
+
+    radius = 0.5 * scene.diameter
+    vertical = 1 if scene.geometry == "slab" else 2
+    periodic = [scene.width, scene.thickness, 4 * scene.height]     # vertical: never wraps
+    if scene.geometry == "slab":
+        periodic = [scene.width, 4 * scene.height, scene.thickness]
+    for _ in range(attempts):
+        points = scene.position.copy()
+        points[:, 2 if scene.geometry == "column" else 1] += scene.height    # keep inside [0, boxsize)
+        points[:, 0] %= scene.width
+        if scene.geometry == "column":
+            points[:, 1] %= scene.width
+        tree = cKDTree(points, boxsize=periodic)
+        pairs = tree.query_pairs(2 * radius.max(), output_type="ndarray")
+        if len(pairs):
+            gap = np.linalg.norm(_periodic_delta(points[pairs[:, 0]] - points[pairs[:, 1]], periodic), axis=1)
+            pairs = pairs[gap < radius[pairs[:, 0]] + radius[pairs[:, 1]]]
+        if not len(pairs):
+            return
+        move = np.unique(np.where(radius[pairs[:, 0]] <= radius[pairs[:, 1]], pairs[:, 0], pairs[:, 1]))
+        scene.position[move, 0] = rng.random(len(move)) * scene.width
+        if scene.geometry == "column":
+            scene.position[move, 1] = rng.random(len(move)) * scene.width
+        scene.position[move, vertical] = radius[move] + rng.random(len(move)) * (scene.height - 2 * radius[move])
+    raise ValueError("could not place the grains without overlaps: the sub-volume is too crowded")
+
+
+def _periodic_delta(delta: np.ndarray, box: list[float]) -> np.ndarray:
+    box = np.asarray(box)
+    return delta - box * np.rint(delta / box)
+
+
+def write(scene: Scene, out: Path, layer_file: str = "layers.h5") -> list[Path]:
+    """The data file, the deck and the PSD tables of the scene into `out`."""
+    out.mkdir(parents=True, exist_ok=True)
+    paths = [out / "sample.data", out / "in.sedimentation", out / "input_psd.csv", out / "simulated_psd.csv",
+             out / "classes.csv"]
+    _write_data(scene, paths[0])
+    paths[1].write_text(_deck(scene, paths[0].name, layer_file))
+    _write_psd(scene.psd, paths[2])
+    _write_psd(scene.simulated_psd(), paths[3])
+    c = scene.classes
+    paths[4].write_text("diameter_um,input_mass_fraction,simulated_mass_fraction,particles,weight\n" + "".join(
+        f"{d * 1e6:.6g},{m:.6g},{s:.6g},{n},{w:.6g}\n"
+        for d, m, s, n, w in zip(c.diameter, c.mass_fraction, c.simulated_mass_fraction(), c.count, c.weight)))
+    return paths
+
+
+def _write_psd(psd: PSD, path: Path) -> None:
+    path.write_text("diameter_um,percent_finer\n" + "".join(
+        f"{d * 1e6:.8g},{p:.8g}\n" for d, p in zip(psd.diameter, psd.percent_finer)))
+
+
+def _write_data(scene: Scene, path: Path) -> None:
+    lo, hi = scene_box(scene)
+    n = len(scene.diameter)
+    lines = [f"SEDIMENT sedimentation test: {n} grains ({scene.geometry})", "",
+             f"{n} atoms", "1 atom types", ""]
+    lines += [f"{lo[k]:.17g} {hi[k]:.17g} {a}lo {a}hi" for k, a in enumerate("xyz")]
+    lines += ["", "Atoms # sphere", ""]
+    rho = scene.fluid.particle_density
+    lines += [f"{i + 1} 1 {d:.17g} {rho:.17g} {x:.17g} {y:.17g} {z:.17g}"
+              for i, (d, (x, y, z)) in enumerate(zip(scene.diameter, scene.position))]
+    lines += ["", "Weights", ""]
+    lines += [f"{i + 1} {w:.17g}" for i, w in enumerate(scene.weight)]
+    path.write_text("\n".join(lines) + "\n")
+
+
+def scene_box(scene: Scene) -> tuple[list[float], list[float]]:
+    if scene.geometry == "slab":
+        return [0.0, 0.0, -0.5 * scene.thickness], [scene.width, scene.height, 0.5 * scene.thickness]
+    return [0.0, 0.0, 0.0], [scene.width, scene.width, scene.height]
+
+
+def _deck(scene: Scene, data: str, layer_file: str) -> str:
+    e, f = scene.effects, scene.fluid
+    slab = scene.geometry == "slab"
+    up = "y" if slab else "z"
+    gravity = "0 -1 0" if slab else "0 0 -1"
+    d_max = float(scene.diameter.max())
+    stages = scene.stages()
+    frames_every = scene.frame_steps()
+    total_steps = sum(n for _, n in stages)
+    c = scene.classes
+    real = float(np.sum(c.count * c.weight))
+    when = datetime.now(timezone.utc).strftime("%Y-%m-%d")
+    lines = [
+        f"# Sedimentation test written by `sediment sample` ({when}): {scene.psd.name or 'PSD'}",
+        f"# {scene.geometry} {scene.width:.4g} x {scene.thickness:.4g} x {scene.height:.4g} m of a cylinder of "
+        f"{scene.cylinder.area * 1e4:.4g} cm2 x {scene.cylinder.height:.4g} m (fraction {scene.volume_fraction:.3g}),",
+        f"# {len(scene.diameter)} atoms in {int(np.sum(c.count > 0))} size classes standing for {real:.4g} grains "
+        f"({scene.mass * 1e3:.4g} g sample, c0 = {scene.initial_concentration:.4g} kg/m3).",
+        f"# Effects: drag ({e.law}{', hindered (Di Felice)' if e.hindered else ''}), buoyancy"
+        f"{', contacts' if e.contacts or e.lubrication else ', deposit on the floor (no contacts)'}"
+        f"{', lubrication' if e.lubrication else ''}.",
+        f"# {len(stages)} stages, {total_steps} steps to {scene.t_end:g} s; layer frames every {frames_every} steps.",
+        "#",
+        "#   sediment run in.sedimentation        (or: lmp_sediment -in in.sedimentation)",
+        f"variable        layers_file index {layer_file}",
+        f"variable        t_end equal {scene.t_end:.12g}",
+        "",
+        "units           si",
+        f"dimension       {scene.dimension}",
+        "atom_style      sphere",
+        f"boundary        {'p f p' if slab else 'p p f'}",
+        "fix             weights all property/atom d_weight    # real grains each atom stands for",
+        f"read_data       {data} fix weights NULL Weights",
+        f"neighbor        {d_max:.6g} bin",
+        f"atom_modify     sort 1000 {scene.height / scene.layers:.6g}    # neighbours in memory, layer by layer",
+    ]
+    if e.interacting:    # pair forces need ghosts within a contact or film reach
+        lines.append(f"comm_modify     cutoff {3 * d_max:.6g} vel yes")
+    else:                # no pair forces: a thin shell of ghosts only keeps LAMMPS from warning
+        lines.append(f"comm_modify     cutoff {0.01 * min(scene.width, scene.thickness):.6g}")
+    lines += [
+        "",
+        f"fix             grav all gravity {f.gravity:.12g} vector {gravity}",
+        f"fix             water all fluid density {f.density:.12g} viscosity {f.viscosity:.12g}",
+        "fix             buoy all fluid/buoyancy water",
+        f"compute         conc all concentration/grid layers {up} {scene.layers} bounds 0 {scene.height:.12g}"
+        f"{f' thickness {scene.thickness:.12g}' if slab else ''} weight d_weight",
+    ]
+    if e.hindered:
+        lines.append("fix             drag all fluid/drag water law difelice concentration c_conc")
+    else:
+        lines.append(f"fix             drag all fluid/drag water law {e.law}")
+    granular = (f"granular hertz/material {YOUNGS_MODULUS:g} 0.3 {POISSON_RATIO:g} tangential mindlin NULL 1.0 0.5 "
+                "damping tsuji")
+    if e.interacting:
+        if e.lubrication:
+            lines += ["pair_style      hybrid/overlay granular lubricate/fluid water inner 0.01 outer 0.5 limit yes",
+                      f"pair_coeff      * * {granular}", "pair_coeff      * * lubricate/fluid"]
+        else:
+            lines += ["pair_style      granular", f"pair_coeff      * * {granular.split(' ', 1)[1]}"]
+        lines += [f"fix             floor all wall/gran {granular} {up}plane 0 NULL",
+                  "fix             step all nve/sphere/fluid"]
+    else:
+        lines.append(f"fix             step all nve/sphere/fluid floor {up} 0.0")
+    lines += [
+        f"fix             layers all layers/hdf5 {frames_every} ${{layers_file}} c_conc fluid water "
+        f"particle_density {f.particle_density:.12g}",
+        "",
+        "thermo_style    custom step time dt f_layers",
+        f"thermo          {frames_every * 5}",
+        "thermo_modify   norm no",
+        f'print           "SEDIMENT plan steps {total_steps} t_end {scene.t_end:.12g}"',
+    ]
+    for dt, steps in stages:
+        lines += [f"timestep        {dt:.17g}", f"run             {steps} post no"]
+    return "\n".join(lines) + "\n"
+
+
+def describe(scene: Scene) -> str:
+    """A short report: particles, classes, and the PSD actually simulated against the input."""
+    c = scene.classes
+    real = float(np.sum(c.count * c.weight))
+    stages = scene.stages()
+    sim = scene.simulated_psd()
+    edges = class_edges(c.diameter)
+    worst = float(np.max(np.abs(sim.percent_finer - scene.psd.at(edges))))
+    lines = [f"{len(scene.diameter)} particles in {int(np.sum(c.count > 0))} size classes "
+             f"({c.diameter[0] * 1e6:.3g}-{c.diameter[-1] * 1e6:.3g} um), standing for {real:.4g} real grains "
+             f"({'weights ' + f'{c.weight.min():.3g}-{c.weight.max():.3g}' if not np.all(c.weight == 1) else 'real grains'})",
+             f"sub-volume: {scene.geometry} {scene.width * 1e3:.4g} x {scene.thickness * 1e3:.4g} x "
+             f"{scene.height * 1e3:.4g} mm = {scene.volume_fraction:.3g} of the cylinder; "
+             f"c0 = {scene.initial_concentration:.4g} kg/m3",
+             f"simulated PSD vs input at the class edges: max difference {worst:.2f} percentage points",
+             f"time: {len(stages)} stages, {sum(n for _, n in stages)} steps to {scene.t_end:g} s "
+             f"(dt {stages[0][0]:.3g} .. {stages[-1][0]:.3g} s)"]
+    if scene.effects.interacting:
+        lines.append(f"contacts: dt = {stages[0][0]:.3g} s (Rayleigh time / 5 of the smallest grain): "
+                     f"{stages[0][1]:.3g} steps x {len(scene.diameter)} particles")
+    return "\n".join(lines)

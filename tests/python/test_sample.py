@@ -1,0 +1,134 @@
+"""`sediment sample` and `sediment run`: the scene of a sedimentation test, and the end-to-end test of
+issue 4 (sample -> run -> readout) on sample 5."""
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from sediment import cli
+from sediment.psd import discretise, read_psd
+from sediment.readout import Fluid
+from sediment.sample import Cylinder, Effects, plan, terminal_speed, write
+
+SHARED = Path(__file__).resolve().parents[3] / "shared" / "data" / "psd"
+
+
+def test_parcels_carry_the_mass_of_each_class_exactly():
+    psd = read_psd(SHARED / "sample5.csv")
+    real = discretise(psd, 40, 0.06, 2650.0, 1e-5)
+    parcels = discretise(psd, 40, 0.06, 2650.0, 1e-5, particles=4000)
+    # the same real grains per class, now as count x weight; the simulated PSD is the discretised one
+    assert np.allclose(parcels.count * parcels.weight,
+                       6 * 0.06 * parcels.mass_fraction * 1e-5 / (2650 * np.pi * parcels.diameter ** 3), rtol=1e-12)
+    assert np.allclose(parcels.simulated_mass_fraction(), parcels.mass_fraction / parcels.mass_fraction.sum())
+    assert abs(parcels.count.sum() - 4000) <= 40
+    # real grains at this fraction: at least one per class, which distorts the coarse end
+    assert real.count.min() >= 1 and np.all(real.weight == 1)
+
+
+def test_placement_is_stratified_inside_the_column():
+    scene = plan(read_psd(SHARED / "sample5.csv"), particles=4000, layers=100)
+    z, d = scene.position[:, 2], scene.diameter
+    assert np.all(z - d / 2 >= 0) and np.all(z + d / 2 <= scene.height)
+    assert np.all((scene.position[:, :2] >= 0) & (scene.position[:, :2] <= scene.width))
+    # every class is spread evenly: in each fifth of the height, a fifth of its parcels (+- 1 row)
+    for diameter in np.unique(d)[::8]:
+        heights = z[d == diameter]
+        per_fifth = np.histogram(heights, bins=5, range=(0, scene.height))[0]
+        assert np.all(np.abs(per_fifth - len(heights) / 5) <= 2 + 0.1 * len(heights) / 5)
+
+
+def test_slab_is_the_axial_section_in_2d():
+    scene = plan(read_psd(SHARED / "sample2.csv"), geometry="slab", cylinder=Cylinder.bravo(), particles=2000)
+    assert scene.dimension == 2 and scene.width == pytest.approx(0.0635)
+    assert scene.thickness == pytest.approx(70e-6) and np.all(scene.position[:, 2] == 0)
+    assert scene.volume_fraction == pytest.approx(0.0635 * 70e-6 / (np.pi / 4 * 0.0635 ** 2))
+
+
+def test_time_steps_double_after_the_largest_grains_have_left():
+    scene = plan(read_psd(SHARED / "sample5.csv"), particles=2000, layers=200, t_end=86400.0)
+    stages = scene.stages()
+    v_max = terminal_speed(scene.fluid, scene.classes.diameter.max(), "dallavalle")
+    layer = scene.height / scene.layers
+    assert stages[0][0] == pytest.approx(layer / v_max)                 # one layer per step at first
+    for (dt, n), (dt_next, _) in zip(stages[1:-1], stages[2:]):
+        assert dt_next == pytest.approx(2 * dt)
+    times = np.cumsum([dt * n for dt, n in stages])
+    assert times[-1] >= 86400.0 and times[-2] < 86400.0
+    # after time t only grains slower than H / t remain: each stage's step keeps them within a layer
+    starts = np.concatenate([[0.0], times[:-1]])
+    for (dt, _), t in zip(stages, starts):
+        assert dt * min(v_max, scene.height / t if t > 0 else v_max) <= layer * (1 + 1e-12)
+    assert sum(n for _, n in stages) < 3000
+
+
+def test_contacts_need_real_grains_and_set_the_step(tmp_path):
+    psd = read_psd(SHARED / "sample2.csv")
+    with pytest.raises(ValueError, match="contacts and lubrication need real grains"):
+        plan(psd, effects=Effects(contacts=True))
+    with pytest.raises(ValueError, match="real grains in this sub-volume"):
+        plan(read_psd(SHARED / "sample3.csv"), particles=None, width=1e-3)
+    # a 3 mm column at the sample's concentration (60 g per 1000 mL): about 1900 real grains
+    scene = plan(psd, particles=None, width=3e-4, cylinder=Cylinder(27.8e-4, 0.003), mass=0.06 * 0.003 / 0.36,
+                 t_end=2e-6, effects=Effects(lubrication=True))
+    dt, steps = scene.stages()[0]
+    assert dt < 1e-7 and steps == math.ceil(2e-6 / dt) and len(scene.diameter) > 1000
+    # no two grains overlap (periodic across, not along the height)
+    p, r = scene.position, scene.diameter / 2
+    delta = p[:, None, :] - p[None, :, :]
+    delta[..., :2] -= scene.width * np.rint(delta[..., :2] / scene.width)
+    gap = np.linalg.norm(delta, axis=2) - (r[:, None] + r[None, :])
+    np.fill_diagonal(gap, 1.0)
+    assert gap.min() >= 0
+    # the deck with contacts, lubrication and the wall runs (a few steps, 2 ranks)
+    write(scene, tmp_path)
+    assert cli.main(["run", str(tmp_path / "in.sedimentation"), "--np", "2", "--quiet"]) == 0
+
+
+def test_sample_rejects_what_it_cannot_build(tmp_path, capsys):
+    psd = SHARED / "sample5.csv"
+    assert cli.main(["sample", str(psd), "--particles", "10", "--out", str(tmp_path)]) == 2
+    assert "10 particles cannot sample 40 size classes" in capsys.readouterr().err
+    assert cli.main(["sample", str(psd), "--width", "1", "--out", str(tmp_path)]) == 2
+    assert "does not fit the cylinder" in capsys.readouterr().err
+    falling = tmp_path / "falling.csv"
+    falling.write_text("diameter_um,percent_finer\n2,10\n5,5\n")
+    assert cli.main(["sample", str(falling), "--out", str(tmp_path)]) == 2
+    assert "must not decrease" in capsys.readouterr().err
+    assert cli.main(["run", str(tmp_path / "missing.lmp")]) == 2
+    assert "no such deck" in capsys.readouterr().err
+
+
+def test_run_reports_the_lammps_error(tmp_path, capsys):
+    deck = tmp_path / "in.bad"
+    deck.write_text("units si\natom_style sphere\nregion box block 0 1 0 1 0 1\ncreate_box 1 box\n"
+                    "fix f all fluid density 1000 viscosity -1\n")
+    assert cli.main(["run", str(deck), "--quiet"]) == 2
+    err = capsys.readouterr().err
+    assert "in.bad failed" in err and "Fix fluid" in err
+
+
+def test_end_to_end_sample5_hydrometer_follows_the_simulated_psd(tmp_path, capsys):
+    """sample -> run (2 MPI ranks) -> readout on sample 5: 3000 parcels, the full 0.36 m column, to
+    250 min (the D422 readings that cover 5-50 um). The hydrometer must read the simulated PSD within
+    5 percentage points between 5 and 50 um (issue 4)."""
+    out = tmp_path / "sample5"
+    assert cli.main(["sample", str(SHARED / "sample5.csv"), "--particles", "3000", "--layers", "200",
+                     "--t-end", "15000", "--out", str(out)]) == 0
+    assert cli.main(["run", str(out / "in.sedimentation"), "--np", "2", "--quiet"]) == 0
+    assert cli.main(["readout", str(out / "layers.h5"), "--out", str(out / "readout")]) == 0
+    printed = capsys.readouterr().out
+    rows = np.genfromtxt(out / "readout" / "hydrometer.csv", delimiter=",", names=True)
+    simulated = read_psd(out / "simulated_psd.csv")
+    d = rows["diameter_um"]
+    inside = (d >= 5) & (d <= 50)
+    error = np.abs(rows["percent_finer"] - simulated.at(d * 1e-6))[inside]
+    print(f"hydrometer vs simulated PSD, {inside.sum()} readings in 5-50 um: max {error.max():.2f}, "
+          f"mean {error.mean():.2f} points")
+    assert inside.sum() >= 4 and error.max() < 5.0
+    assert "mean |P - simulated PSD|" in printed
+    for name in ("granulometry.png", "granulometry.pdf", "errors.csv", "buoyancy.csv", "pipette.csv"):
+        assert (out / "readout" / name).stat().st_size > 0
