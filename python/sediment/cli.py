@@ -90,7 +90,7 @@ def cmd_readout(args: argparse.Namespace) -> int:
     if args.layers is not None:
         from .layers import read_layers
         column = Column.from_layers(read_layers(args.layers), surface=args.surface)
-        title = str(args.layers)
+        title = f"{args.layers.parent.name}/{args.layers.name}: simulated sedimentation test"
     else:
         if psd is None:
             raise ValueError("give a layer file, or --psd with --stokes-preview for an analytic column")

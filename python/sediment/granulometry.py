@@ -78,6 +78,8 @@ def write_report(readings: list[Readings], out: Path, psd: PSD | None = None, si
     for r, marker in zip(readings, "osD"):
         ax.plot(r.diameter * 1e6, r.percent_finer, marker + "-", ms=5, lw=1, label=r.instrument)
     ax.set_xscale("log")
+    ticks = [t for t in (1, 2, 5, 10, 20, 50, 100, 200) if ax.get_xlim()[0] <= t <= ax.get_xlim()[1]]
+    ax.set_xticks(ticks, [f"{t:g}" for t in ticks])
     ax.set_xlabel("diameter [um]")
     ax.set_ylabel("percent finer by mass [%]")
     ax.set_ylim(0, 105)
