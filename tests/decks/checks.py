@@ -9,7 +9,6 @@ import argparse
 import csv
 import math
 import os
-import sys
 import tempfile
 from pathlib import Path
 
@@ -17,8 +16,7 @@ import numpy as np
 
 from harness import HERE, report, run_deck
 
-sys.path.insert(0, str(HERE.parents[1] / "python"))
-from sediment import _core  # noqa: E402
+from sediment import _core  # noqa: E402  (harness puts python/ on the path)
 
 G = 9.81
 SHARED = Path(os.environ.get("SEDIMENT_SHARED", HERE.parents[2] / "shared"))    # ../shared beside the clone

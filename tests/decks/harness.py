@@ -14,6 +14,9 @@ from pathlib import Path
 import numpy as np
 
 HERE = Path(__file__).resolve().parent
+sys.path.insert(0, str(HERE.parents[1] / "python"))
+from sediment.paths import mpirun_prefix  # noqa: E402
+
 LMP = os.environ.get("SEDIMENT_LMP", str(HERE.parents[1] / "build" / "lmp_sediment"))
 
 
@@ -25,18 +28,12 @@ class DeckOutput:
     results: dict[str, float] = field(default_factory=dict)
 
 
-def mpi_prefix(np_ranks: int) -> list[str]:
-    if np_ranks <= 1:
-        return []
-    return ["mpirun", "--allow-run-as-root", "--oversubscribe", "-np", str(np_ranks)]
-
-
 def run_deck(deck: str | Path, variables: dict[str, object] | None = None, np_ranks: int = 1,
              expect_failure: bool = False, cwd: Path | None = None, timeout: float = 600) -> DeckOutput:
     deck = Path(deck)
     if not deck.is_absolute():
         deck = HERE / deck
-    cmd = mpi_prefix(np_ranks) + [LMP, "-in", str(deck), "-log", "none", "-nocite"]
+    cmd = mpirun_prefix(np_ranks) + [LMP, "-in", str(deck), "-log", "none", "-nocite"]
     for name, value in (variables or {}).items():
         cmd += ["-var", name, str(value)]
     proc = subprocess.run(cmd, capture_output=True, text=True, cwd=cwd or HERE, timeout=timeout)
