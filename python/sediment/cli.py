@@ -3,6 +3,7 @@ from __future__ import annotations
 
 import argparse
 import sys
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -76,7 +77,7 @@ def cmd_run(args: argparse.Namespace) -> int:
 def cmd_readout(args: argparse.Namespace) -> int:
     from .granulometry import error_summary, read_all, write_report
     from .psd import read_psd
-    from .readout import Column, Fluid
+    from .readout import Column, Fluid, Hydrometer
     from .synthetic import stokes_column
 
     if args.layers is not None:    # PSD tables that `sediment sample` wrote beside the run
@@ -90,6 +91,8 @@ def cmd_readout(args: argparse.Namespace) -> int:
     if args.layers is not None:
         from .layers import read_layers
         column = Column.from_layers(read_layers(args.layers), surface=args.surface)
+        if args.viscosity is not None:    # e.g. the lab's temperature differs from the simulation's
+            column = replace(column, fluid=replace(column.fluid, viscosity=args.viscosity))
         title = f"{args.layers.parent.name}/{args.layers.name}: simulated sedimentation test"
     else:
         if psd is None:
@@ -99,8 +102,9 @@ def cmd_readout(args: argparse.Namespace) -> int:
         column = stokes_column(psd, args.height, times, args.concentration, fluid)
         title = f"{args.psd.name}: Stokes settling preview (no DEM)"
     instruments = ["hydrometer", "buoyancy", "pipette"] if args.instrument == "all" else [args.instrument]
+    hydrometer = Hydrometer.measured(*args.hydrometer) if args.hydrometer else None
     readings, notes = read_all(column, instruments, args.schedule, args.sphere_depth, args.pipette_depth,
-                               args.pipette_volume, args.cylinder_area)
+                               args.pipette_volume, args.cylinder_area, hydrometer)
     for note in notes:
         print(note)
     for path in write_report(readings, args.out, psd, simulated, title=title):
@@ -189,6 +193,12 @@ def build_parser() -> argparse.ArgumentParser:
     readout.add_argument("--sphere-depth", type=positive, help="buoyancy sphere centre depth [m] (default 0.3 H)")
     readout.add_argument("--pipette-depth", type=positive, default=0.10, help="[m]")
     readout.add_argument("--pipette-volume", type=positive, default=25e-6, help="[m3]")
+    readout.add_argument("--hydrometer", type=positive, nargs=6,
+                         metavar=("L2", "VB", "STEM_D", "MASS", "L1_R0", "L1_R50"),
+                         help="a measured hydrometer instead of the nominal 152H: bulb length [m], bulb volume "
+                         "[m3], stem diameter [m], mass [kg], bulb top to the R = 0 and R = 50 marks [m]")
+    readout.add_argument("--viscosity", type=positive, help="viscosity for Stokes' law [Pa s] (default: the "
+                         "layer file's fluid)")
     readout.add_argument("--cylinder-area", type=positive, default=27.8e-4, help="for the hydrometer's level rise [m2]")
     readout.add_argument("--out", type=Path, default=Path("out/readout"), help="output folder")
     readout.set_defaults(func=cmd_readout)

@@ -14,10 +14,14 @@ SIZE_RANGES_UM = [(0.0, 5.0), (5.0, 20.0), (20.0, 75.0)]
 
 def read_all(column: Column, instruments: list[str], schedule: str = "d422", sphere_depth: float | None = None,
              pipette_depth: float = 0.10, pipette_volume: float = 25e-6,
-             cylinder_area: float = 27.8e-4) -> tuple[list[Readings], list[str]]:
-    """Readings of the chosen instruments at the schedule's times that the frames cover; returns
-    them with notes on the times left out."""
-    notes, results = [], []
+             cylinder_area: float = 27.8e-4, hydrometer: Hydrometer | None = None) -> tuple[list[Readings], list[str]]:
+    """Readings of the chosen instruments at the schedule's times that the frames cover (the
+    hydrometer: the nominal 152H unless another is given); returns them with notes on the inputs
+    and the times left out."""
+    f = column.fluid
+    notes = [f"readout inputs: Gs = {f.specific_gravity:.4g}, water {f.density:.6g} kg/m3, viscosity "
+             f"{f.viscosity:.4g} Pa s, c0 = {column.initial_concentration():.4g} kg/m3, column {column.height:.4g} m"]
+    results = []
     for name in instruments:
         if name == "pipette":
             tool = Pipette(pipette_depth, pipette_volume)
@@ -31,7 +35,8 @@ def read_all(column: Column, instruments: list[str], schedule: str = "d422", sph
         if not len(covered):
             continue
         if name == "hydrometer":
-            results.append(Hydrometer.astm_152h().read(column, covered, cylinder_area=cylinder_area))
+            tool = hydrometer or Hydrometer.astm_152h()
+            results.append(tool.read(column, covered, cylinder_area=cylinder_area))
         elif name == "buoyancy":
             depth = 0.3 * column.height if sphere_depth is None else sphere_depth
             results.append(BuoyancySphere(depth).read(column, covered))

@@ -3,6 +3,7 @@ import subprocess
 import sys
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from sediment import cli
@@ -65,3 +66,18 @@ def test_readout_bad_inputs_are_clear(tmp_path, capsys):
         f.attrs["schema"] = "something-else"
     assert cli.main(["readout", str(foreign), "--out", str(tmp_path)]) == 2
     assert "not a SEDIMENT layer file" in capsys.readouterr().err
+
+
+def test_readout_measured_hydrometer_option(tmp_path):
+    """The nominal 152H given as a measured instrument (--hydrometer) reads the same."""
+    from sediment.readout import Hydrometer
+    psd = REPO.parent / "shared" / "data" / "psd" / "sample5.csv"
+    h = Hydrometer.astm_152h()
+    measured = [h.bulb_length, h.bulb_volume, float(np.sqrt(4 * h.stem_area / np.pi)), h.mass, h.scale_zero,
+                h.scale_zero - 50 * h.scale_step]
+    base = ["readout", "--psd", str(psd), "--stokes-preview", "--instrument", "hydrometer"]
+    assert cli.main(base + ["--out", str(tmp_path / "a")]) == 0
+    assert cli.main(base + ["--out", str(tmp_path / "b"), "--hydrometer", *map(repr, measured)]) == 0
+    a = np.genfromtxt(tmp_path / "a" / "hydrometer.csv", delimiter=",", skip_header=1)
+    b = np.genfromtxt(tmp_path / "b" / "hydrometer.csv", delimiter=",", skip_header=1)
+    assert np.allclose(a, b, rtol=1e-9, atol=1e-9)
