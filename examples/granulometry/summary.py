@@ -1,5 +1,6 @@
 """Mean |P - PSD| per instrument and size range over several runs of run.sh, as a Markdown table:
-    python3 examples/granulometry/summary.py out/sample1 out/sample2 ... [--reference simulated|input]"""
+    python3 examples/granulometry/summary.py out/sample1 out/sample2 ... [--reference simulated|input]
+        [--readout FOLDER]   (e.g. the output of sediment readout --schedule bravo --out RUN/FOLDER)"""
 from __future__ import annotations
 
 import argparse
@@ -11,11 +12,12 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("runs", nargs="+", type=Path, help="output folders of run.sh (with readout/errors.csv)")
     parser.add_argument("--reference", default="simulated", choices=["simulated", "input"])
+    parser.add_argument("--readout", default="readout", help="readout folder inside each run")
     args = parser.parse_args()
     table: dict[str, dict[tuple[str, str], str]] = {}
     columns: list[tuple[str, str]] = []
     for run in args.runs:
-        path = run / "readout" / "errors.csv"
+        path = run / args.readout / "errors.csv"
         if not path.is_file():
             raise SystemExit(f"{path}: missing (run run.sh first)")
         with open(path, newline="") as f:

@@ -54,7 +54,7 @@ class Column:
     time: np.ndarray            # [frames] s
     fraction: np.ndarray        # [frames, layers]
     fluid: Fluid = field(default_factory=Fluid)
-    slab_thickness: float = 0.0  # > 0 for a 2d slab (pipette samples a disc)
+    slab_thickness: float = 0.0  # > 0 for a 2d slab (the pipette samples a circle)
 
     def __post_init__(self) -> None:
         if self.fraction.shape != (len(self.time), len(self.depth_edges) - 1):
@@ -235,8 +235,8 @@ class BuoyancySphere:
 
 @dataclass(frozen=True)
 class Pipette:
-    """A sample of `volume` drawn around the tip at a fixed depth: a sphere of that volume, or in a
-    2d slab a disc of that volume over the slab thickness."""
+    """A sample of `volume` drawn around the tip at a fixed depth: a sphere of that volume; in a 2d
+    slab (the cylinder's axial section) its section through the axis, a circle of the same radius."""
 
     depth: float
     volume: float = 25e-6
@@ -244,8 +244,7 @@ class Pipette:
     def read(self, column: Column, times_s) -> Readings:
         fluid = column.fluid
         disc = column.slab_thickness > 0
-        radius = (np.sqrt(self.volume / column.slab_thickness / np.pi) if disc
-                  else (3 * self.volume / (4 * np.pi)) ** (1 / 3))
+        radius = (3 * self.volume / (4 * np.pi)) ** (1 / 3)
         c0 = column.initial_concentration()
         rows = []
         for t in times_s:

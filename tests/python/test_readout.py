@@ -119,3 +119,19 @@ def test_column_from_a_layer_file_reads_depth_from_the_surface(tmp_path):
     layers.attributes = {}
     with pytest.raises(ValueError, match="readouts need fluid_density"):
         Column.from_layers(layers)
+
+
+def test_pipette_in_a_slab_samples_the_circle_of_its_sphere():
+    """In the 2d slab (the cylinder's axial section) the 25 mL sample is the section of its sphere:
+    a circle of the sphere's radius, whose chords weight the layers."""
+    edges = np.linspace(0.0, 0.36, 36001)
+    radius = (3 * 25e-6 / (4 * np.pi)) ** (1 / 3)
+    step = 0.10 + 0.5 * radius                  # suspension above, clear water below
+    fraction = np.where(edges[:-1] < step, 0.02, 0.0)
+    column = Column(edges, np.array([0.0, 1.0]), np.vstack([np.full(36000, 0.02), fraction]), Fluid(),
+                    slab_thickness=7e-5)
+    reading = Pipette(0.10).read(column, [1.0])
+    u = np.linspace(-radius, radius, 200001)     # chord weights, by direct summation
+    above = np.sum(np.sqrt(radius ** 2 - u ** 2) * (0.10 + u < step)) / np.sum(np.sqrt(radius ** 2 - u ** 2))
+    assert reading.percent_finer[0] == pytest.approx(100 * above, abs=0.05)
+    assert 78 < reading.percent_finer[0] < 83    # 1 - (segment beyond r/2) / (pi r^2) = 80.4 %
