@@ -1,6 +1,5 @@
 """The sediment command line."""
 import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np

@@ -10,7 +10,6 @@ import pytest
 
 from sediment import cli
 from sediment.psd import discretise, read_psd
-from sediment.readout import Fluid
 from sediment.sample import Cylinder, Effects, plan, terminal_speed, write
 
 SHARED = Path(__file__).resolve().parents[3] / "shared" / "data" / "psd"
