@@ -3,6 +3,7 @@
 ------------------------------------------------------------------------- */
 
 #include "compute_concentration_grid.h"
+#include "sediment_axis.h"
 
 #include "atom.h"
 #include "domain.h"
@@ -33,7 +34,7 @@ ComputeConcentrationGrid::ComputeConcentrationGrid(LAMMPS *lmp, int narg, char *
       if (keyword[0] == 'l') {
         if (iarg + 2 >= narg) error->all(FLERR, "Compute concentration/grid: 'layers' needs an axis and a count");
         const char *dim = arg[iarg + 1];
-        axis = strcmp(dim, "x") == 0 ? 0 : strcmp(dim, "y") == 0 ? 1 : strcmp(dim, "z") == 0 ? 2 : -1;
+        axis = sediment_axis(dim);
         if (axis < 0) error->all(FLERR, "Compute concentration/grid: layer axis must be x, y or z, not '{}'", dim);
         counts[0] = counts[1] = counts[2] = 1;
         counts[axis] = utils::inumeric(FLERR, arg[iarg + 2], false, lmp);

@@ -3,6 +3,7 @@
 ------------------------------------------------------------------------- */
 
 #include "fix_fluid.h"
+#include "sediment_axis.h"
 
 #include "domain.h"
 #include "error.h"
@@ -76,7 +77,7 @@ FixFluid::FixFluid(LAMMPS *lmp, int narg, char **arg) :
         }
         iarg += 8;
       } else {
-        const int dim = strcmp(axis, "x") == 0 ? 0 : strcmp(axis, "y") == 0 ? 1 : strcmp(axis, "z") == 0 ? 2 : -1;
+        const int dim = sediment_axis(axis);
         if (dim < 0)
           error->all(FLERR, "Fix fluid: surface axis must be x, y, z or plane, not '{}'", axis);
         normal[dim] = 1.0;

@@ -4,6 +4,7 @@
 ------------------------------------------------------------------------- */
 
 #include "fix_nve_sphere_fluid.h"
+#include "sediment_axis.h"
 
 #include "fix_fluid.h"
 #include "fix_fluid_drag.h"
@@ -31,7 +32,7 @@ FixNVESphereFluid::FixNVESphereFluid(LAMMPS *lmp, int narg, char **arg) :
     if (strcmp(arg[iarg], "floor") == 0) {
       if (iarg + 2 >= narg) error->all(FLERR, "Fix nve/sphere/fluid: 'floor' needs an axis and a coordinate");
       const char *dim = arg[iarg + 1];
-      floor_axis = strcmp(dim, "x") == 0 ? 0 : strcmp(dim, "y") == 0 ? 1 : strcmp(dim, "z") == 0 ? 2 : -1;
+      floor_axis = sediment_axis(dim);
       if (floor_axis < 0) error->all(FLERR, "Fix nve/sphere/fluid: floor axis must be x, y or z, not '{}'", dim);
       if (floor_axis == 2 && domain->dimension == 2)
         error->all(FLERR, "Fix nve/sphere/fluid: a floor along z in a 2d simulation");
