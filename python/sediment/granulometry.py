@@ -2,6 +2,7 @@
 input PSD, and the error per size range (sedimentation-tests.md section 6)."""
 from __future__ import annotations
 
+from functools import partial
 from pathlib import Path
 
 import numpy as np
@@ -23,25 +24,21 @@ def read_all(column: Column, instruments: list[str], schedule: str = "d422", sph
              f"{f.viscosity:.4g} Pa s, c0 = {column.initial_concentration():.4g} kg/m3, column {column.height:.4g} m"]
     results = []
     for name in instruments:
-        if name == "pipette":
-            tool = Pipette(pipette_depth, pipette_volume)
-            times = tool.default_times(column.fluid)
+        if name == "hydrometer":
+            read = partial((hydrometer or Hydrometer.astm_152h()).read, cylinder_area=cylinder_area)
+            times = np.array(SCHEDULES[schedule]) * 60.0
+        elif name == "buoyancy":
+            read = BuoyancySphere(0.3 * column.height if sphere_depth is None else sphere_depth).read
+            times = np.array(SCHEDULES["bravo" if schedule == "d422" else schedule]) * 60.0
         else:
-            times = np.array(SCHEDULES["bravo" if name == "buoyancy" and schedule == "d422" else schedule]) * 60.0
+            pipette = Pipette(pipette_depth, pipette_volume)
+            read, times = pipette.read, pipette.default_times(column.fluid)
         covered = times[(times > column.time[0]) & (times <= column.time[-1])]
         if len(covered) < len(times):
             notes.append(f"{name}: {len(times) - len(covered)} of {len(times)} reading times lie beyond the "
                          f"frames (last at {column.time[-1] / 60:.3g} min)")
-        if not len(covered):
-            continue
-        if name == "hydrometer":
-            tool = hydrometer or Hydrometer.astm_152h()
-            results.append(tool.read(column, covered, cylinder_area=cylinder_area))
-        elif name == "buoyancy":
-            depth = 0.3 * column.height if sphere_depth is None else sphere_depth
-            results.append(BuoyancySphere(depth).read(column, covered))
-        else:
-            results.append(tool.read(column, covered))
+        if len(covered):
+            results.append(read(column, covered))
     return results, notes
 
 

@@ -44,6 +44,14 @@ class PSD:
         object.__setattr__(self, "diameter", d)
         object.__setattr__(self, "percent_finer", p)
 
+    def span(self) -> tuple[float, float]:
+        """The diameters between which the mass lies: the last row at 0 % and the first at 100 %
+        (or the table's ends)."""
+        p = self.percent_finer
+        lo = self.diameter[np.argmax(p > 0) - 1] if p[0] == 0 else self.diameter[0]
+        hi = self.diameter[np.argmax(p >= 100)] if p[-1] >= 100 else self.diameter[-1]
+        return float(lo), float(hi)
+
     def at(self, diameter) -> np.ndarray:
         """Percent finer at the given diameters [m] (flat beyond the table)."""
         return np.interp(np.log(np.asarray(diameter, float)), np.log(self.diameter), self.percent_finer)
@@ -79,6 +87,10 @@ class SizeClasses:
     mass_fraction: np.ndarray   # of the input PSD, sums to the fraction of mass within the classes
     count: np.ndarray           # simulated particles per class (>= 1 where mass > 0)
     weight: np.ndarray          # real particles per simulated one, per class
+
+    def represented_grains(self) -> float:
+        """Real grains the simulated particles stand for."""
+        return float(np.sum(self.count * self.weight))
 
     def simulated_mass_fraction(self) -> np.ndarray:
         mass = self.count * self.weight * self.diameter ** 3
@@ -121,9 +133,7 @@ def discretise(psd: PSD, classes: int, sample_mass: float, particle_density: flo
         raise PSDError("sample mass and particle density must be > 0, the simulated fraction within (0, 1]")
     if particles is not None and particles < classes:
         raise PSDError(f"{particles} particles cannot sample {classes} size classes: give at least one per class")
-    lo = psd.diameter[np.argmax(psd.percent_finer > 0) - 1] if psd.percent_finer[0] == 0 else psd.diameter[0]
-    hi = psd.diameter[np.argmax(psd.percent_finer >= 100)] if psd.percent_finer[-1] >= 100 else psd.diameter[-1]
-    diameter, fraction = log_classes(psd, lo, hi, classes)
+    diameter, fraction = log_classes(psd, *psd.span(), classes)
     exact = 6 * sample_mass * fraction / (particle_density * np.pi * diameter ** 3) * volume_fraction
     if particles is None:
         count = np.where(fraction > 0, np.maximum(np.rint(exact), 1), 0).astype(np.int64)

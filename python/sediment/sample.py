@@ -65,7 +65,6 @@ class Scene:
     geometry: str
     width: float                    # column: side of the square section; slab: across the cylinder
     thickness: float                # out of plane: the column side, or the slab thickness
-    height: float
     mass: float                     # whole sample [kg]
     effects: Effects
     layers: int
@@ -75,6 +74,10 @@ class Scene:
     diameter: np.ndarray = field(default_factory=lambda: np.empty(0))    # per atom [m]
     weight: np.ndarray = field(default_factory=lambda: np.empty(0))
     position: np.ndarray = field(default_factory=lambda: np.empty((0, 3)))
+
+    @property
+    def height(self) -> float:
+        return self.cylinder.height
 
     @property
     def dimension(self) -> int:
@@ -99,14 +102,15 @@ class Scene:
         column (H / v_max) the step is courant layers / v_max; after a time t only grains slower
         than H / t can remain, so each following stage, as long as the time before it, takes a step
         twice the last. Stages are whole numbers of frames."""
-        steps = FRAMES_PER_STAGE * max(1, math.ceil(self.layers / self.courant / FRAMES_PER_STAGE))
         if self.effects.interacting:                  # contacts set the step everywhere
             dt = self.contact_time_step()
             return [(dt, math.ceil(self.t_end / dt))]
+        every = self.frame_steps()
+        steps = FRAMES_PER_STAGE * every
         v_max = terminal_speed(self.fluid, self.classes.diameter[self.classes.count > 0].max(), self.effects.law)
         time, dt, result = 0.0, self.height / v_max / steps, []
         while time < self.t_end * (1 - 1e-12):
-            n = min(steps, self.frame_steps() * math.ceil((self.t_end - time) / (dt * self.frame_steps())))
+            n = min(steps, every * math.ceil((self.t_end - time) / (dt * every)))
             result.append((dt, n))
             time += n * dt
             if time >= self.height / v_max * (1 - 1e-12):
@@ -158,7 +162,7 @@ def plan(psd: PSD, *, geometry: str = "column", cylinder: Cylinder = Cylinder(),
         raise ValueError("contacts and lubrication need real grains: use --real-grains (no parcels)")
     if not (mass > 0 and layers >= 10 and t_end > 0 and courant > 0):
         raise ValueError("mass and end time must be > 0, layers >= 10, courant > 0")
-    d_max = psd.diameter[-1] if psd.percent_finer[-1] < 100 else psd.diameter[np.argmax(psd.percent_finer >= 100)]
+    d_max = psd.span()[1]
     if geometry == "slab":
         width = cylinder.diameter if width is None else width
         thickness = d_max
@@ -172,8 +176,8 @@ def plan(psd: PSD, *, geometry: str = "column", cylinder: Cylinder = Cylinder(),
     if size_classes.count.sum() > MAX_PARTICLES:
         raise ValueError(f"{size_classes.count.sum():.3g} real grains in this sub-volume (more than {MAX_PARTICLES:.0e}): "
                          "simulate parcels (--particles) or a smaller sub-volume (--width, --height)")
-    scene = Scene(psd, size_classes, fluid, cylinder, geometry, width, thickness, cylinder.height, mass, effects,
-                  layers, t_end, courant, seed)
+    scene = Scene(psd, size_classes, fluid, cylinder, geometry, width, thickness, mass, effects, layers, t_end,
+                  courant, seed)
     place(scene)
     return scene
 
@@ -182,7 +186,7 @@ def place(scene: Scene) -> None:
     """Stratified random placement: each class's particles get distinct cells of a grid of about
     cubic cells (as many as the particles) over the sub-volume, one at a random point of each, so
     every class starts uniform at every scale above its spacing. Centres stay one radius inside the
-    column. With contacts, overlapping grains are redrawn in their cells."""
+    column. With contacts, overlapping grains are redrawn (see _separate)."""
     rng = np.random.default_rng(scene.seed)
     lateral = 1 if scene.geometry == "slab" else 2
     diameters, weights, positions = [], [], []
@@ -216,7 +220,7 @@ def _stratify(rng: np.random.Generator, n: int, width: float, height: float, lat
 
 
 def _separate(scene: Scene, rng: np.random.Generator, attempts: int = 200) -> None:
-    """Redraws overlapping grains (the smaller of each pair) at random heights until none overlap."""
+    """Redraws overlapping grains (the smaller of each pair) anywhere in the sub-volume until none overlap."""
     from scipy.spatial import cKDTree
 
     radius = 0.5 * scene.diameter
@@ -226,7 +230,7 @@ def _separate(scene: Scene, rng: np.random.Generator, attempts: int = 200) -> No
         periodic = [scene.width, 4 * scene.height, scene.thickness]
     for _ in range(attempts):
         points = scene.position.copy()
-        points[:, 2 if scene.geometry == "column" else 1] += scene.height    # keep inside [0, boxsize)
+        points[:, vertical] += scene.height    # keep inside [0, boxsize)
         points[:, 0] %= scene.width
         if scene.geometry == "column":
             points[:, 1] %= scene.width
@@ -302,13 +306,12 @@ def _deck(scene: Scene, data: str, layer_file: str) -> str:
     frames_every = scene.frame_steps()
     total_steps = sum(n for _, n in stages)
     c = scene.classes
-    real = float(np.sum(c.count * c.weight))
     when = datetime.now(timezone.utc).strftime("%Y-%m-%d")
     lines = [
         f"# Sedimentation test written by `sediment sample` ({when}): {scene.psd.name or 'PSD'}",
         f"# {scene.geometry} {scene.width:.4g} x {scene.thickness:.4g} x {scene.height:.4g} m of a cylinder of "
         f"{scene.cylinder.area * 1e4:.4g} cm2 x {scene.cylinder.height:.4g} m (fraction {scene.volume_fraction:.3g}),",
-        f"# {len(scene.diameter)} atoms in {int(np.sum(c.count > 0))} size classes standing for {real:.4g} grains "
+        f"# {len(scene.diameter)} atoms in {int(np.sum(c.count > 0))} size classes standing for {c.represented_grains():.4g} grains "
         f"({scene.mass * 1e3:.4g} g sample, c0 = {scene.initial_concentration:.4g} kg/m3).",
         f"# Effects: drag ({e.law}{', hindered (Di Felice)' if e.hindered else ''}), buoyancy"
         f"{', contacts' if e.contacts or e.lubrication else ', deposit on the floor (no contacts)'}"
@@ -373,13 +376,12 @@ def _deck(scene: Scene, data: str, layer_file: str) -> str:
 def describe(scene: Scene) -> str:
     """A short report: particles, classes, and the PSD actually simulated against the input."""
     c = scene.classes
-    real = float(np.sum(c.count * c.weight))
     stages = scene.stages()
     sim = scene.simulated_psd()
     edges = class_edges(c.diameter)
     worst = float(np.max(np.abs(sim.percent_finer - scene.psd.at(edges))))
     lines = [f"{len(scene.diameter)} particles in {int(np.sum(c.count > 0))} size classes "
-             f"({c.diameter[0] * 1e6:.3g}-{c.diameter[-1] * 1e6:.3g} um), standing for {real:.4g} real grains "
+             f"({c.diameter[0] * 1e6:.3g}-{c.diameter[-1] * 1e6:.3g} um), standing for {c.represented_grains():.4g} real grains "
              f"({'weights ' + f'{c.weight.min():.3g}-{c.weight.max():.3g}' if not np.all(c.weight == 1) else 'real grains'})",
              f"sub-volume: {scene.geometry} {scene.width * 1e3:.4g} x {scene.thickness * 1e3:.4g} x "
              f"{scene.height * 1e3:.4g} mm = {scene.volume_fraction:.3g} of the cylinder; "
