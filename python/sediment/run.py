@@ -9,6 +9,7 @@ import os
 import subprocess
 import sys
 import time
+from collections import deque
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -36,13 +37,13 @@ def run_deck(deck: Path, ranks: int = 1, variables: dict[str, str] | None = None
         cmd += ["-var", name, str(value)]
     env = dict(os.environ, OMP_NUM_THREADS="1", OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
     start = time.monotonic()
-    total_steps, t_end, step, now, errors, tail = 0, 0.0, 0, 0.0, [], []
+    total_steps, t_end, step, now, errors, tail = 0, 0.0, 0, 0.0, [], deque(maxlen=5)
     bar = None
     with subprocess.Popen(cmd, cwd=deck.parent, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
                           env=env) as proc:
         assert proc.stdout is not None
         for line in proc.stdout:
-            tail = (tail + [line.rstrip()])[-20:]
+            tail.append(line.rstrip())
             words = line.split()
             if line.startswith("ERROR"):
                 errors.append(line.strip())
@@ -63,7 +64,7 @@ def run_deck(deck: Path, ranks: int = 1, variables: dict[str, str] | None = None
     if bar is not None:
         bar.close()
     if code != 0 or errors:
-        message = errors[0] if errors else "\n".join(tail[-5:])
+        message = errors[0] if errors else "\n".join(tail)
         raise RuntimeError(f"{deck.name} failed (exit {code}): {message} (see {log})")
     return RunResult(deck, log, time.monotonic() - start, step, now)
 
