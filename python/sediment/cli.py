@@ -116,6 +116,19 @@ def cmd_readout(args: argparse.Namespace) -> int:
     return 0
 
 
+def cmd_calibrate(args: argparse.Namespace) -> int:
+    from . import calibrate
+
+    if args.test == "slump":
+        result = calibrate.yield_stress_from_slump(args.slump, args.height, args.density)
+    elif args.test == "restitution":
+        result = calibrate.restitution_from_drops(args.drop, args.rebound)
+    else:
+        result = calibrate.friction_from_tilt(args.lift, args.length)
+    print(result.describe())
+    return 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="sediment", description="SEDIMENT: settling of DEM spheres in "
                                      "fluids with LAMMPS, and sedimentation-test readouts.")
@@ -202,6 +215,20 @@ def build_parser() -> argparse.ArgumentParser:
     readout.add_argument("--cylinder-area", type=positive, default=27.8e-4, help="for the hydrometer's level rise [m2]")
     readout.add_argument("--out", type=Path, default=Path("out/readout"), help="output folder")
     readout.set_defaults(func=cmd_readout)
+
+    calib = sub.add_parser("calibrate", help="paste and contact parameters from a slump, drop or tilt test")
+    tests = calib.add_subparsers(dest="test", required=True)
+    slump = tests.add_parser("slump", help="yield stress from a cylindrical slump test (Pashias & Boger 1996)")
+    slump.add_argument("--slump", type=positive, nargs="+", required=True, help="measured slumps [m]")
+    slump.add_argument("--height", type=positive, required=True, help="cylinder height [m]")
+    slump.add_argument("--density", type=positive, required=True, help="paste density [kg/m3]")
+    drop = tests.add_parser("restitution", help="coefficient of restitution from drop and rebound heights")
+    drop.add_argument("--drop", type=positive, nargs="+", required=True, help="fall heights (any length unit)")
+    drop.add_argument("--rebound", type=positive, nargs="+", required=True, help="rebound heights (same unit)")
+    tilt = tests.add_parser("tilt", help="static friction from a tilt test, mu_s = H_l / L")
+    tilt.add_argument("--lift", type=positive, nargs="+", required=True, help="lift heights at sliding")
+    tilt.add_argument("--length", type=positive, required=True, help="plate length (same unit)")
+    calib.set_defaults(func=cmd_calibrate)
     return parser
 
 
