@@ -10,8 +10,10 @@ import subprocess
 import sys
 import time
 from collections import deque
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
+
+import numpy as np
 
 from .paths import lmp_executable, mpirun_prefix
 
@@ -67,6 +69,51 @@ def run_deck(deck: Path, ranks: int = 1, variables: dict[str, str] | None = None
         message = errors[0] if errors else "\n".join(tail)
         raise RuntimeError(f"{deck.name} failed (exit {code}): {message} (see {log})")
     return RunResult(deck, log, time.monotonic() - start, step, now)
+
+
+@dataclass
+class DeckOutput:
+    """What a deck printed: "SAMPLE v1 v2 ..." rows and "RESULT key value key value ..." lines."""
+    text: str
+    returncode: int
+    wall_seconds: float
+    samples: np.ndarray
+    results: dict[str, float] = field(default_factory=dict)
+
+    @property
+    def error(self) -> str | None:
+        """LAMMPS's first ERROR line, or the exit code if it died without one."""
+        for line in self.text.splitlines():
+            if line.startswith("ERROR"):
+                return line.strip()
+        return None if self.returncode == 0 else f"exit code {self.returncode}"
+
+
+def run_batch(deck: Path, variables: dict[str, object] | None = None, ranks: int = 1, cwd: Path | None = None,
+              timeout: float | None = None, check: bool = True) -> DeckOutput:
+    """Runs a deck quietly (no log file; in its own folder unless cwd is given) and collects what it
+    prints. With check, a failed run raises RuntimeError with LAMMPS's error message."""
+    deck = Path(deck).resolve()
+    if not deck.is_file():
+        raise FileNotFoundError(f"{deck}: no such deck")
+    cmd = mpirun_prefix(ranks) + [lmp_executable(), "-in", str(deck), "-log", "none", "-nocite"]
+    for name, value in (variables or {}).items():
+        cmd += ["-var", name, str(value)]
+    env = dict(os.environ, OMP_NUM_THREADS="1", OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
+    start = time.monotonic()
+    proc = subprocess.run(cmd, capture_output=True, text=True, cwd=cwd or deck.parent, timeout=timeout, env=env)
+    wall = time.monotonic() - start
+    rows, results = [], {}
+    for line in proc.stdout.splitlines():
+        if line.startswith("SAMPLE "):
+            rows.append([float(v) for v in line.split()[1:]])
+        elif line.startswith("RESULT "):
+            words = line.split()[1:]
+            results.update({k: float(v) for k, v in zip(words[::2], words[1::2])})
+    out = DeckOutput(proc.stdout + proc.stderr, proc.returncode, wall, np.array(rows), results)
+    if check and out.error:
+        raise RuntimeError(f"{deck.name} failed: {out.error}")
+    return out
 
 
 def _is_float(word: str) -> bool:

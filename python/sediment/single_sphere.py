@@ -5,14 +5,13 @@ and compares each velocity curve with v(t) = v_t (1 - exp(-t / tau)).
 """
 from __future__ import annotations
 
-import subprocess
-import time
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
-from .paths import REPO_DIR, lmp_executable
+from .paths import REPO_DIR
+from .run import run_batch
 
 DECK = REPO_DIR / "examples" / "single_sphere" / "in.case_a"
 DIAMETER, PARTICLE_DENSITY, FLUID_DENSITY, VISCOSITY, GRAVITY = 1e-4, 2700.0, 1000.0, 1e-3, 9.81
@@ -41,16 +40,9 @@ def exact_velocity(t: np.ndarray) -> np.ndarray:
 def run_case_a(integrator: str, dt: float, t_end: float = 0.04, samples: int = 300) -> Run:
     style = {"implicit": "nve/sphere/fluid", "explicit": "nve/sphere"}[integrator]
     steps = max(1, round(t_end / dt))
-    cmd = [lmp_executable(), "-in", str(DECK), "-log", "none", "-nocite", "-var", "integrator", style,
-           "-var", "dt", repr(dt), "-var", "steps", str(steps), "-var", "every", str(max(1, steps // samples))]
-    start = time.perf_counter()
-    proc = subprocess.run(cmd, capture_output=True, text=True, cwd=DECK.parent)
-    wall = time.perf_counter() - start
-    if proc.returncode != 0:
-        raise RuntimeError(f"lmp_sediment failed:\n{proc.stdout[-2000:]}{proc.stderr[-2000:]}")
-    rows = np.array([[float(v) for v in line.split()[1:]] for line in proc.stdout.splitlines()
-                     if line.startswith("SAMPLE ")])
-    return Run(integrator, dt, rows[:, 0], -rows[:, 2], wall)
+    out = run_batch(DECK, {"integrator": style, "dt": repr(dt), "steps": steps,
+                           "every": max(1, steps // samples)})
+    return Run(integrator, dt, out.samples[:, 0], -out.samples[:, 2], out.wall_seconds)
 
 
 # The runs drawn as velocity curves; the error panel shows every run.

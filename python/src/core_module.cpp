@@ -82,10 +82,18 @@ PYBIND11_MODULE(_core, m)
            py::arg("law"), py::arg("density"), py::arg("viscosity"), py::arg("yield_stress") = 0.0,
            py::arg("buoyancy") = "plain")
       .def("reynolds", &DragModel::reynolds, py::arg("d"), py::arg("speed"))
-      .def("force", [](const DragModel &model, double d, double speed, double voidage) {
-             return model.force(d, speed, voidage_scale(voidage));
-           }, py::arg("d"), py::arg("speed"), py::arg("voidage") = 1.0,
-           "Resisting force magnitude [N] at slip speed > 0 (voidage: local fluid fraction, difelice).")
+      .def("force", [](const DragModel &model, double d, double speed, double voidage, double area,
+                       double wetted) {
+             DragScale scale = voidage_scale(voidage);
+             if (!(area >= 0.0 && area <= 1.0 && wetted >= 0.0 && wetted <= 1.0))
+               throw py::value_error("area and wetted fractions must be in [0, 1]");
+             scale.area = area;
+             scale.wetted = wetted;
+             return model.force(d, speed, scale);
+           }, py::arg("d"), py::arg("speed"), py::arg("voidage") = 1.0, py::arg("area") = 1.0,
+           py::arg("wetted") = 1.0,
+           "Resisting force magnitude [N] at slip speed > 0 (voidage: local fluid fraction, difelice; "
+           "area, wetted: submerged fractions of a sphere at a free surface, see submergence()).")
       .def("tangent", [](const DragModel &model, double d, double speed, double voidage) {
              return model.tangent(d, speed, voidage_scale(voidage));
            }, py::arg("d"), py::arg("speed"), py::arg("voidage") = 1.0, "dF/ds [N s/m].")
