@@ -129,6 +129,64 @@ def cmd_calibrate(args: argparse.Namespace) -> int:
     return 0
 
 
+def cmd_paste(args: argparse.Namespace) -> int:
+    from . import paste
+
+    if args.study == "restitution":
+        c = paste.tsuji_for_restitution(args.target)
+        print(f"damping tsuji {c:.4f} gives a simulated restitution of {paste.simulated_restitution(c):.4f} "
+              f"(the input {args.target} itself gives {paste.simulated_restitution(args.target):.4f})")
+    elif args.study == "drop-test":
+        rows = paste.drop_study(args.out)
+        print(f"{'H_f [mm]':>9s} {'H_r meas.':>10s} {'H_r sim.':>9s} {'error':>7s}")
+        for r in rows:
+            print(f"{r.fall * 1e3:9.0f} {r.measured * 1e3:10.1f} {r.simulated * 1e3:9.2f} {r.error:+7.1%}")
+        print(f"mean |error| {np.mean([abs(r.error) for r in rows]):.1%}; wrote {args.out / 'drop_test.csv'}, "
+              f"{args.out / 'drop_test.png'}")
+    elif args.study == "balls":
+        drops = paste.ball_study(args.out)
+        print(f"{'d [mm]':>6s} {'fall [mm]':>9s} {'submergence':>11s} {'depth [mm]':>10s} {'t_rest [s]':>10s} "
+              f"{'creep [m]':>9s}")
+        for b in drops:
+            print(f"{b.diameter * 1e3:6.1f} {b.fall * 1e3:9.0f} {'partial' if b.submergence else 'step':>11s} "
+                  f"{b.depth * 1e3:10.2f} {b.t_rest:10.4f} {b.creep:9.2g}")
+        print(f"{sum(b.wall_seconds for b in drops):.1f} s of runs; wrote {args.out / 'ball_in_paste.csv'}, "
+              f"{args.out / 'ball_in_paste.png'}")
+    elif args.study == "energy":
+        balance = paste.energy_balance(args.diameter, args.fall, args.dt)
+        print(f"loss of potential + kinetic energy {balance.mechanical_loss:.6g} J; work of buoyancy "
+              f"{balance.buoyancy_work:.6g} J, of drag and yield {balance.drag_work:.6g} J; "
+              f"residual {balance.residual:+.2e} of the loss")
+    else:
+        from . import funnel
+
+        pours = funnel.funnel_study(args.out, runs=args.runs, jobs=args.jobs, dt=args.dt)
+        depths = np.concatenate([paste.PASTE["surface"] - p.positions[:, 2] for p in pours])
+        for p in pours:
+            print(f"seed {p.seed:3d}: {p.balls} of {p.placed} balls in the mould, {p.spilled} spilled, centres "
+                  f"{(paste.PASTE['surface'] - p.positions[:, 2].max()) * 1e3:.1f} to "
+                  f"{(paste.PASTE['surface'] - p.positions[:, 2].min()) * 1e3:.1f} mm deep, poured in "
+                  f"{p.pour_time:.3f} s, {p.wall_seconds:.1f} s wall")
+        print(f"all runs: centres {depths.min() * 1e3:.1f} to {depths.max() * 1e3:.1f} mm below the surface; wrote "
+              f"{args.out / 'funnel_positions.csv'}, funnel_positions.png, funnel_presence.png")
+    return 0
+
+
+def cmd_spheres(args: argparse.Namespace) -> int:
+    from .valentik import study
+
+    results = study(args.csv, args.out, laws=args.law)
+    print(f"{'law':16s} {'susp':>4s} {'d [mm]':>6s} {'rho_p':>6s} {'measured':>8s} {'law':>8s} {'simulated':>9s} "
+          f"{'sim/law-1':>9s} {'law/meas-1':>10s}")
+    for r in results:
+        s = r.sphere
+        print(f"{r.law:16s} {s.suspension:>4s} {s.d * 1e3:6.1f} {s.rho_p:6.0f} {s.measured:8.3f} {r.analytic:8.4f} "
+              f"{r.simulated:9.4f} {r.code_error:+9.1e} {r.law_error:+10.1%}  {r.regime}")
+    print(f"worst |simulated/law - 1| = {max(abs(r.code_error) for r in results):.1e}; wrote "
+          f"{args.out / 'terminal_velocities.csv'}, {args.out / 'terminal_velocities.png'}")
+    return 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="sediment", description="SEDIMENT: settling of DEM spheres in "
                                      "fluids with LAMMPS, and sedimentation-test readouts.")
@@ -229,6 +287,35 @@ def build_parser() -> argparse.ArgumentParser:
     tilt.add_argument("--lift", type=positive, nargs="+", required=True, help="lift heights at sliding")
     tilt.add_argument("--length", type=positive, required=True, help="plate length (same unit)")
     calib.set_defaults(func=cmd_calibrate)
+
+    paste = sub.add_parser("paste", help="steel balls and paste backfill (cases D-F): drop test, single balls, "
+                           "the funnel")
+    studies = paste.add_subparsers(dest="study", required=True)
+    target = studies.add_parser("restitution", help="the 'damping tsuji' input giving a restitution (drop deck)")
+    target.add_argument("--target", type=positive, default=0.612)
+    for name, text in (("drop-test", "rebounds of the five drops of case F with steel.lmp"),
+                       ("balls", "8, 12.6 and 16 mm balls from six fall heights, with and without partial "
+                                 "submergence: settling distances")):
+        study = studies.add_parser(name, help=text)
+        study.add_argument("--out", type=Path, default=Path("out/paste"), help="output folder")
+    energy = studies.add_parser("energy", help="energy balance of one ball entering the paste")
+    energy.add_argument("--diameter", type=positive, default=0.0126, help="[m]")
+    energy.add_argument("--fall", type=float, default=0.255, help="fall height above the paste [m]")
+    energy.add_argument("--dt", type=positive, default=1e-5, help="[s]")
+    pour = studies.add_parser("funnel", help="68 balls poured from a funnel, several random packings")
+    pour.add_argument("--runs", type=int, default=15)
+    pour.add_argument("--jobs", type=int, default=2, help="runs at a time")
+    pour.add_argument("--dt", type=positive, default=1e-6, help="[s]")
+    pour.add_argument("--out", type=Path, default=Path("out/paste"), help="output folder")
+    paste.set_defaults(func=cmd_paste)
+
+    spheres = sub.add_parser("spheres", help="terminal velocities of spheres in Bingham suspensions, simulated vs "
+                             "the law and the measurement (Valentik & Whitmore 1965 columns)")
+    spheres.add_argument("csv", type=Path, help="CSV with suspension,rho_f,eta_B,tau_y,d,rho_p,v_ter_measured (SI)")
+    spheres.add_argument("--law", nargs="+", default=["zhang-li", "zhang-li/smooth"],
+                         choices=["zhang-li", "zhang-li/smooth"])
+    spheres.add_argument("--out", type=Path, default=Path("out/spheres"), help="output folder")
+    spheres.set_defaults(func=cmd_spheres)
     return parser
 
 

@@ -1,0 +1,197 @@
+"""Steel balls and paste backfill (Zhang & Li 2024, cases D and F): the drop test that sets the
+contact damping, and single balls dropped into the paste (settling distance vs fall height).
+
+The decks are in examples/paste: in.drop_test, in.ball_in_paste, with the shared steel.lmp
+(contacts) and mould.lmp (mould, paste, integrator).
+"""
+from __future__ import annotations
+
+import csv
+import math
+import tempfile
+from dataclasses import asdict, dataclass
+from pathlib import Path
+
+import numpy as np
+from scipy.optimize import brentq
+
+from . import _core
+from .calibrate import restitution_from_drops
+from .paths import REPO_DIR
+from .run import run_batch
+
+EXAMPLES = REPO_DIR / "examples" / "paste"
+GRAVITY = 9.81
+STEEL_DENSITY = 8135.0
+PASTE = dict(density=1843.0, yield_stress=136.0, plastic_viscosity=0.7, surface=0.150)
+
+# Case F: drop heights and rebounds of an 8 mm steel ball on a steel plate [m].
+DROP_HEIGHTS = (0.095, 0.188, 0.252, 0.318, 0.398)
+MEASURED_REBOUNDS = (0.0370, 0.0720, 0.0909, 0.1180, 0.1469)
+# Case D: ball sizes and fall heights above the paste surface [m].
+BALL_DIAMETERS = (0.008, 0.0126, 0.016)
+FALL_HEIGHTS = (0.0, 0.105, 0.150, 0.255, 0.405, 0.555)
+
+
+# ---- drop test (case F) -------------------------------------------------------------------------
+def rebound_height(fall: float, tsuji: float | None = None, dt: float | None = None) -> float:
+    """Rebound of the deck's 8 mm ball dropped from `fall` onto the plate [m]."""
+    variables = {"fall": fall}
+    if tsuji is not None:
+        variables["tsuji"] = tsuji
+    if dt is not None:
+        variables["dt"] = dt
+    return run_batch(EXAMPLES / "in.drop_test", variables).results["rebound"]
+
+
+def simulated_restitution(tsuji: float | None = None, fall: float = 0.252) -> float:
+    return math.sqrt(rebound_height(fall, tsuji) / fall)
+
+
+def tsuji_for_restitution(target: float, tolerance: float = 1e-5) -> float:
+    """The `damping tsuji` input whose simulated drop rebounds with restitution `target`.
+
+    Under Hertz contact with Tsuji damping the restitution depends on the damping input alone (not on
+    the impact speed), and it grows with the input, so one bisection on the drop deck maps it."""
+    if not 0.05 < target < 0.95:
+        raise ValueError(f"target restitution must lie in (0.05, 0.95), got {target}")
+    return brentq(lambda c: simulated_restitution(c) - target, 0.02, 0.98, xtol=tolerance)
+
+
+@dataclass
+class DropRow:
+    fall: float
+    measured: float
+    simulated: float
+
+    @property
+    def error(self) -> float:
+        return self.simulated / self.measured - 1.0
+
+
+def drop_study(out_dir: Path) -> list[DropRow]:
+    """Rebounds of the five drops of case F with the contacts of steel.lmp: table and figure."""
+    rows = [DropRow(h, m, rebound_height(h)) for h, m in zip(DROP_HEIGHTS, MEASURED_REBOUNDS)]
+    out_dir.mkdir(parents=True, exist_ok=True)
+    with open(out_dir / "drop_test.csv", "w", newline="") as f:
+        writer = csv.writer(f)
+        writer.writerow(["fall_m", "rebound_measured_m", "rebound_simulated_m", "relative_error"])
+        for r in rows:
+            writer.writerow([r.fall, r.measured, f"{r.simulated:.6g}", f"{r.error:+.4f}"])
+    _plot_drops(rows, out_dir / "drop_test.png")
+    return rows
+
+
+def _plot_drops(rows: list[DropRow], path: Path) -> None:
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    e = restitution_from_drops(DROP_HEIGHTS, MEASURED_REBOUNDS).mean
+    falls = np.array([r.fall for r in rows]) * 1e3
+    fig, ax = plt.subplots(figsize=(5.5, 4))
+    ax.plot(falls, [r.measured * 1e3 for r in rows], "ko", label="measured (Zhang & Li 2024)")
+    ax.plot(falls, [r.simulated * 1e3 for r in rows], "s", mfc="none", ms=9, label="simulated (steel.lmp)")
+    ax.plot(falls, e * e * falls, "k:", lw=1, label=f"e^2 H_f, e = {e:.3f}")
+    ax.set(xlabel="drop height H_f [mm]", ylabel="rebound height H_r [mm]", title="8 mm steel ball on a steel plate")
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+
+
+# ---- a ball dropped into the paste (case D) ----------------------------------------------------
+@dataclass
+class BallDrop:
+    diameter: float
+    fall: float
+    submergence: bool
+    depth: float        # settling distance: depth of the ball's lowest point below the surface at rest
+    t_rest: float       # time from release to rest [s]
+    creep: float        # |z| change over the hold after rest [m]
+    final_speed: float
+    wall_seconds: float
+
+
+def drop_ball(diameter: float, fall: float, submergence: bool = True, dt: float = 1e-5,
+              trace: Path | None = None) -> BallDrop:
+    variables = {"d": diameter, "fall": fall, "submergence": "yes" if submergence else "no", "dt": dt}
+    if trace is not None:
+        variables.update(trace="yes", trace_file=Path(trace).resolve())
+    out = run_batch(EXAMPLES / "in.ball_in_paste", variables)
+    r = out.results
+    if r["stuck"] != 1:
+        raise RuntimeError(f"the {diameter * 1e3:g} mm ball dropped from {fall} m did not come to rest")
+    return BallDrop(diameter, fall, submergence, r["depth"], r["t_rest"], r["creep"], abs(r["vz"]),
+                    out.wall_seconds)
+
+
+def ball_study(out_dir: Path, diameters=BALL_DIAMETERS, falls=FALL_HEIGHTS, progress: bool = True) -> list[BallDrop]:
+    """Every ball from every fall height, with and without partial submergence: table and figure."""
+    from tqdm import tqdm
+
+    plan = [(d, h, sub) for sub in (True, False) for d in diameters for h in falls]
+    drops = [drop_ball(d, h, sub) for d, h, sub in tqdm(plan, desc="balls", unit="run", disable=not progress)]
+    out_dir.mkdir(parents=True, exist_ok=True)
+    with open(out_dir / "ball_in_paste.csv", "w", newline="") as f:
+        writer = csv.DictWriter(f, fieldnames=list(asdict(drops[0])))
+        writer.writeheader()
+        for drop in drops:
+            writer.writerow(asdict(drop))
+    _plot_balls(drops, out_dir / "ball_in_paste.png")
+    return drops
+
+
+def _plot_balls(drops: list[BallDrop], path: Path) -> None:
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(6, 4.3))
+    for i, d in enumerate(sorted({b.diameter for b in drops})):
+        for sub, style in ((True, "o-"), (False, "s--")):
+            sel = sorted((b for b in drops if b.diameter == d and b.submergence == sub), key=lambda b: b.fall)
+            ax.plot([b.fall * 1e3 for b in sel], [b.depth * 1e3 for b in sel], style, color=f"C{i}",
+                    mfc="none" if not sub else None,
+                    label=f"d = {d * 1e3:g} mm" + ("" if sub else ", no partial submergence"))
+    ax.set(xlabel="fall height above the paste [mm]", ylabel="settling distance [mm]",
+           title="Steel balls into paste backfill (tau_y 136 Pa, eta_B 0.7 Pa s)")
+    ax.legend(fontsize=7)
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+
+
+@dataclass
+class EnergyBalance:
+    mechanical_loss: float    # (potential + kinetic) at release minus at rest [J]
+    buoyancy_work: float      # work done on the ball by buoyancy [J] (negative while it sinks)
+    drag_work: float          # work done by the paste's drag and yield resistance [J]
+
+    @property
+    def residual(self) -> float:
+        """(loss + work of the fluid forces) / loss: zero when the work of the fluid accounts for it."""
+        return (self.mechanical_loss + self.buoyancy_work + self.drag_work) / self.mechanical_loss
+
+
+def energy_balance(diameter: float, fall: float, dt: float = 1e-5, law: str = "zhang-li") -> EnergyBalance:
+    """Runs one drop with a per-step trace and integrates the fluid forces along it (trapezoid rule),
+    with the law's force curve and the submerged fractions from the physics core: an account kept
+    apart from the integrator's own step. The mould is deep enough that the ball never touches it."""
+    with tempfile.TemporaryDirectory() as tmp:
+        trace = Path(tmp) / "trace.txt"
+        drop = drop_ball(diameter, fall, dt=dt, trace=trace)
+        t, z, vz = np.loadtxt(trace, comments="#", unpack=True)
+    if drop.depth > PASTE["surface"] - diameter:
+        raise RuntimeError("the ball reached the mould's bottom: contact work is not accounted for")
+    r = diameter / 2
+    mass = STEEL_DENSITY * math.pi / 6 * diameter**3
+    model = _core.DragModel(law, PASTE["density"], PASTE["plastic_viscosity"], PASTE["yield_stress"])
+    subs = [_core.submergence(r, zc - PASTE["surface"]) for zc in z]
+    speed = np.abs(vz)
+    drag = np.array([model.force(diameter, s, area=sub["area"], wetted=sub["wetted"]) if s > 0 and sub["volume"] > 0
+                     else 0.0 for s, sub in zip(speed, subs)])
+    buoyancy = np.array([PASTE["density"] * GRAVITY * math.pi / 6 * diameter**3 * sub["volume"] for sub in subs])
+    energy = mass * GRAVITY * z + 0.5 * mass * vz**2
+    return EnergyBalance(energy[0] - energy[-1], float(np.trapz(buoyancy * vz, t)),
+                         float(-np.trapz(drag * speed, t)))

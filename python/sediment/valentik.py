@@ -1,0 +1,138 @@
+"""Spheres settling in Bingham clay suspensions (Valentik & Whitmore 1965; case C).
+
+Runs examples/valentik_whitmore/in.sphere for every row of a CSV with the columns
+suspension, rho_f, eta_B, tau_y, d, rho_p, v_ter_measured (SI units), and compares the simulated
+terminal velocity with the law's analytic one (a check of the code) and with the measured one
+(a property of the law).
+"""
+from __future__ import annotations
+
+import csv
+import math
+from dataclasses import dataclass
+from pathlib import Path
+
+from . import _core
+from .paths import REPO_DIR
+from .run import run_batch
+
+DECK = REPO_DIR / "examples" / "valentik_whitmore" / "in.sphere"
+COLUMNS = ("suspension", "rho_f", "eta_B", "tau_y", "d", "rho_p", "v_ter_measured")
+GRAVITY = 9.81
+
+
+@dataclass
+class Sphere:
+    suspension: str
+    rho_f: float
+    eta_B: float
+    tau_y: float
+    d: float
+    rho_p: float
+    measured: float
+
+
+@dataclass
+class Settling:
+    sphere: Sphere
+    law: str
+    analytic: float     # terminal velocity of the law [m/s]
+    regime: str         # 'moving', 'at_rest' or 'at_jump'
+    simulated: float    # speed at the end of the run [m/s]
+
+    @property
+    def code_error(self) -> float:
+        """(simulated - analytic) / analytic (0 when both are at rest)."""
+        return 0.0 if self.analytic == 0 else self.simulated / self.analytic - 1.0
+
+    @property
+    def law_error(self) -> float:
+        """(analytic - measured) / measured."""
+        return self.analytic / self.sphere.measured - 1.0
+
+
+def read_spheres(path: Path) -> list[Sphere]:
+    path = Path(path)
+    if not path.is_file():
+        raise FileNotFoundError(f"{path}: no such file")
+    with open(path, newline="") as f:
+        reader = csv.DictReader(f)
+        missing = [c for c in COLUMNS if c not in (reader.fieldnames or [])]
+        if missing:
+            raise ValueError(f"{path}: missing column(s) {', '.join(missing)} (expected {', '.join(COLUMNS)})")
+        spheres = []
+        for line, row in enumerate(reader, start=2):
+            try:
+                values = {c: float(row[c]) for c in COLUMNS[1:]}
+            except (TypeError, ValueError):
+                raise ValueError(f"{path}, line {line}: a value is not a number: {row}") from None
+            bad = [c for c, v in values.items() if not (math.isfinite(v) and (v > 0 or (c == "tau_y" and v == 0)))]
+            if bad:
+                raise ValueError(f"{path}, line {line}: {', '.join(bad)} must be > 0")
+            if values["rho_p"] <= values["rho_f"]:
+                raise ValueError(f"{path}, line {line}: the sphere (rho_p {values['rho_p']}) does not sink "
+                                 f"in the suspension (rho_f {values['rho_f']})")
+            spheres.append(Sphere(row["suspension"], values["rho_f"], values["eta_B"], values["tau_y"], values["d"],
+                                  values["rho_p"], values["v_ter_measured"]))
+    if not spheres:
+        raise ValueError(f"{path}: no spheres")
+    return spheres
+
+
+def settle(sphere: Sphere, law: str = "zhang-li", steps: int = 2000) -> Settling:
+    """Runs the deck for five times the law's time to 99 % of the terminal speed (or 1 s at rest)."""
+    args = (law, sphere.rho_f, sphere.eta_B, sphere.tau_y, sphere.d, sphere.rho_p, GRAVITY)
+    speed, regime = _core.terminal_velocity(*args)
+    t_end = 5 * _core.time_to_fraction(*args, 0.99) if speed > 0 else 1.0
+    out = run_batch(DECK, {"d": sphere.d, "rho_p": sphere.rho_p, "rho_f": sphere.rho_f, "tau_y": sphere.tau_y,
+                           "eta_B": sphere.eta_B, "law": law, "t_end": t_end, "steps": steps})
+    return Settling(sphere, law, speed, regime, out.results["speed"])
+
+
+def study(csv_path: Path, out_dir: Path, laws=("zhang-li", "zhang-li/smooth"), progress: bool = True) -> list[Settling]:
+    from tqdm import tqdm
+
+    spheres = read_spheres(csv_path)
+    plan = [(s, law) for law in laws for s in spheres]
+    results = [settle(s, law) for s, law in tqdm(plan, desc="spheres", unit="run", disable=not progress)]
+    out_dir.mkdir(parents=True, exist_ok=True)
+    with open(out_dir / "terminal_velocities.csv", "w", newline="") as f:
+        writer = csv.writer(f)
+        writer.writerow(["law", *COLUMNS, "v_law", "regime", "v_simulated", "simulated_vs_law", "law_vs_measured"])
+        for r in results:
+            s = r.sphere
+            writer.writerow([r.law, s.suspension, s.rho_f, s.eta_B, s.tau_y, s.d, s.rho_p, s.measured,
+                             f"{r.analytic:.6g}", r.regime, f"{r.simulated:.6g}", f"{r.code_error:+.2e}",
+                             f"{r.law_error:+.4f}"])
+    plot(results, out_dir / "terminal_velocities.png")
+    return results
+
+
+def plot(results: list[Settling], path: Path) -> None:
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    laws = sorted({r.law for r in results})
+    fig, axes = plt.subplots(1, len(laws), figsize=(5.2 * len(laws), 4.6), squeeze=False)
+    suspensions = sorted({r.sphere.suspension for r in results})
+    markers = "osD^v<>ph*"
+    for ax, law in zip(axes[0], laws):
+        top = 0.0
+        for i, name in enumerate(suspensions):
+            sel = [r for r in results if r.law == law and r.sphere.suspension == name]
+            if not sel:
+                continue
+            s = sel[0].sphere
+            ax.plot([r.sphere.measured for r in sel], [r.simulated for r in sel], markers[i % len(markers)],
+                    mfc="none", ms=7, label=f"{name}: tau_y {s.tau_y:g} Pa, eta_B {s.eta_B:g} Pa s")
+            top = max(top, *(r.sphere.measured for r in sel), *(r.simulated for r in sel))
+        ax.plot([0, 1.1 * top], [0, 1.1 * top], "k-", lw=0.8, label="simulated = measured")
+        for factor in (0.7, 1.3):
+            ax.plot([0, 1.1 * top], [0, 1.1 * top * factor], "k:", lw=0.6, label="+-30 %" if factor > 1 else None)
+        ax.set(xlabel="measured terminal velocity [m/s]", ylabel="simulated terminal velocity [m/s]",
+               title=f"Valentik & Whitmore (1965), law {law}", xlim=(0, 1.1 * top), ylim=(0, 1.1 * top))
+        ax.legend(fontsize=7, title="suspension", title_fontsize=7)
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)

@@ -1,0 +1,44 @@
+"""Valentik & Whitmore spheres through examples/valentik_whitmore/in.sphere (sediment.valentik)."""
+import os
+from pathlib import Path
+
+import pytest
+
+from sediment import cli, valentik
+
+SHARED = Path(os.environ.get("SEDIMENT_SHARED", Path(__file__).resolve().parents[3] / "shared"))
+DEV_CSV = SHARED / "data" / "vw1965_dev.csv"
+
+
+def test_every_development_sphere_reaches_the_law_terminal_velocity(tmp_path):
+    results = valentik.study(DEV_CSV, tmp_path, laws=("zhang-li",), progress=False)
+    assert len(results) == len(valentik.read_spheres(DEV_CSV))
+    for r in results:
+        assert abs(r.code_error) < 0.005, r
+    assert (tmp_path / "terminal_velocities.csv").is_file() and (tmp_path / "terminal_velocities.png").is_file()
+
+
+def test_a_sphere_held_by_the_yield_stress_stays_at_rest():
+    sphere = valentik.Sphere("1", 1280, 0.0131, 30.5, 0.02, 1500, 0.1)
+    result = valentik.settle(sphere)
+    assert result.regime == "at_rest" and result.simulated == 0.0
+
+
+@pytest.mark.parametrize("text, message", [
+    ("suspension,rho_f,eta_B,tau_y,d,rho_p\n1,1280,0.0131,30.5,0.019,6513\n", "missing column"),
+    ("suspension,rho_f,eta_B,tau_y,d,rho_p,v_ter_measured\n1,1280,x,30.5,0.019,6513,0.65\n", "not a number"),
+    ("suspension,rho_f,eta_B,tau_y,d,rho_p,v_ter_measured\n1,1280,-0.01,30.5,0.019,6513,0.65\n", "eta_B must be > 0"),
+    ("suspension,rho_f,eta_B,tau_y,d,rho_p,v_ter_measured\n1,1280,0.01,30.5,0.019,1000,0.65\n", "does not sink"),
+    ("suspension,rho_f,eta_B,tau_y,d,rho_p,v_ter_measured\n", "no spheres"),
+    ("", "missing column"),
+])
+def test_malformed_csv_is_refused_with_the_reason(tmp_path, text, message):
+    path = tmp_path / "spheres.csv"
+    path.write_text(text)
+    with pytest.raises(ValueError, match=message):
+        valentik.read_spheres(path)
+
+
+def test_cli_reports_a_missing_file(tmp_path, capsys):
+    assert cli.main(["spheres", str(tmp_path / "none.csv"), "--out", str(tmp_path)]) == 2
+    assert "none.csv: no such file" in capsys.readouterr().err
