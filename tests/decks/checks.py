@@ -140,6 +140,23 @@ def case_c(np_ranks: int):
         report(f"case C {law}: worst |sim - law| / law = {worst:.1e}")
 
 
+# ---- cases D and F: steel ball into paste, drop test (examples/paste) -------------------------
+PASTE_DECKS = HERE.parents[1] / "examples" / "paste"
+
+
+@check
+def paste(np_ranks: int):
+    out = run_deck(PASTE_DECKS / "in.drop_test", {"fall": 0.252}, np_ranks, cwd=PASTE_DECKS)
+    e = math.sqrt(out.results["rebound"] / 0.252)
+    report(f"drop test from 252 mm: rebound {out.results['rebound'] * 1e3:.2f} mm, e = {e:.4f}")
+    assert abs(e - 0.612) < 1e-3
+    out = run_deck(PASTE_DECKS / "in.ball_in_paste", {"d": 0.0126, "fall": 0.255}, np_ranks, cwd=PASTE_DECKS)
+    r = out.results
+    report(f"12.6 mm ball from 255 mm: at rest {r['depth'] * 1e3:.3f} mm below the surface after {r['t_rest']} s, "
+           f"creep over the hold {r['creep']}, speed {r['vz']}")
+    assert r["stuck"] == 1 and r["creep"] == 0 and r["vz"] == 0 and 0 < r["depth"] < 0.150 - 0.0126
+
+
 # ---- Bingham hard cases -----------------------------------------------------------------------
 CLAY = dict(rho_f=1280.0, eta=0.0131, tau_y=30.5)
 D_BALL = 0.02
