@@ -88,7 +88,7 @@ FixFluidDrag::FixFluidDrag(LAMMPS *lmp, int narg, char **arg) :
     error->all(FLERR, "Fix fluid/drag: rotation yes requires atom attributes omega and torque");
 
   vector_flag = 1;
-  size_vector = 4;
+  size_vector = 6;
   global_freq = 1;
   extvector = 1;
 }
@@ -153,6 +153,11 @@ sediment::SphereDrag FixFluidDrag::sphere_drag(int i) const
   return drag;
 }
 
+bool FixFluidDrag::fraction_capped(int i) const
+{
+  return concentration && concentration->vector_atom[i] > max_fraction;
+}
+
 double FixFluidDrag::rotation_rate(int i, const sediment::SphereDrag &drag) const
 {
   if (!rotation || !drag.model) return 0.0;
@@ -176,7 +181,11 @@ void FixFluidDrag::post_force(int /*vflag*/)
   for (int i = 0; i < nlocal; ++i) {
     if (!(mask[i] & groupbit) || (mask[i] & implicit_groupbit)) continue;
     const sediment::SphereDrag drag = sphere_drag(i);
-    if (!drag.model) continue;
+    if (!drag.model) {
+      totals[OUTSIDE] += 1.0;
+      continue;
+    }
+    if (fraction_capped(i)) totals[CAPPED] += 1.0;
     const double w[3] = {v[i][0] - u[0], v[i][1] - u[1], v[i][2] - u[2]};
     const double speed = sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]);
     if (speed > 0.0) {
@@ -220,6 +229,7 @@ int FixFluidDrag::count_unstable_explicit()
 
 double FixFluidDrag::compute_vector(int n)
 {
+  // Vector: fx fy fz, spheres with dt > 2 tau, spheres outside the fluid, capped local fractions.
   if (n == 3) return count_unstable_explicit();
-  return totals.total(n, world);
+  return totals.total(n < 3 ? n : n - 1, world);
 }

@@ -37,6 +37,8 @@ class FixFluidDrag : public Fix {
   void prepare_step();
   // The drag on local atom i during this step (model nullptr if it is not in the group/fluid).
   sediment::SphereDrag sphere_drag(int i) const;
+  // True if the local solid fraction of atom i exceeds max_fraction (its drag uses max_fraction).
+  bool fraction_capped(int i) const;
   // Linear rate of the rotational drag torque, torque = -rate * I * omega (0 if off).
   double rotation_rate(int i, const sediment::SphereDrag &drag) const;
 
@@ -51,7 +53,9 @@ class FixFluidDrag : public Fix {
   double max_fraction;             // local fractions are capped here
   int rotation;
   int implicit_groupbit;    // atoms advanced by fix nve/sphere/fluid: no explicit drag
-  RankSums<3> totals;      // drag force on the explicitly integrated atoms
+  // Explicitly integrated atoms: drag force (x, y, z), spheres outside the fluid, capped fractions.
+  enum { FX, FY, FZ, OUTSIDE, CAPPED, NTOTALS };
+  RankSums<NTOTALS> totals;
 
   int count_unstable_explicit();
   void refresh_concentration();

@@ -17,6 +17,7 @@
 #include "modify.h"
 #include "update.h"
 
+#include <cmath>
 #include <cstring>
 
 using namespace LAMMPS_NS;
@@ -48,7 +49,7 @@ FixNVESphereFluid::FixNVESphereFluid(LAMMPS *lmp, int narg, char **arg) :
   time_integrate = 1;
   dynamic_group_allow = 1;
   vector_flag = 1;
-  size_vector = 2;
+  size_vector = NCOUNTS;
   global_freq = 1;
   extvector = 1;
   maxexchange = NCOLS;
@@ -114,17 +115,20 @@ void FixNVESphereFluid::initial_integrate(int /*vflag*/)
       sphere = candidate;
       flow = drag->fluid_fix()->velocity();
       spin_rate = drag->rotation_rate(i, sphere);
+      if (drag->fraction_capped(i)) counts[CAPPED] += 1.0;
     }
 
     const double mass = rmass[i];
     double *w = weights[i];
     w[IN_FLUID] = sphere.model ? 1.0 : 0.0;
     if (!sphere.model) {
+      counts[OUTSIDE] += 1.0;
       nve_sphere_half_step(i);
       x[i][0] += dt * v[i][0];
       x[i][1] += dt * v[i][1];
       x[i][2] += dt * v[i][2];
       settle_on_floor(i);
+      check_finite(i);
       continue;
     }
 
@@ -134,8 +138,8 @@ void FixNVESphereFluid::initial_integrate(int /*vflag*/)
     x[i][0] += dx[0];
     x[i][1] += dx[1];
     x[i][2] += dx[2];
-    if (corr.state == sediment::SlipState::Stuck) counts[0] += 1.0;
-    if (corr.state == sediment::SlipState::HeldAtJump) counts[1] += 1.0;
+    if (corr.state == sediment::SlipState::Stuck) counts[STUCK] += 1.0;
+    if (corr.state == sediment::SlipState::HeldAtJump) counts[AT_JUMP] += 1.0;
 
     const double inertia = INERTIA * mass * radius[i] * radius[i];
     const double alpha[3] = {ftm2v * torque[i][0] / inertia, ftm2v * torque[i][1] / inertia,
@@ -147,6 +151,7 @@ void FixNVESphereFluid::initial_integrate(int /*vflag*/)
     w[DIRY] = corr.dir[1];
     w[DIRZ] = corr.dir[2];
     settle_on_floor(i);
+    check_finite(i);
   }
 }
 
@@ -168,6 +173,7 @@ void FixNVESphereFluid::final_integrate()
     if (w[IN_FLUID] == 0.0) {
       nve_sphere_half_step(i);
       settle_on_floor(i);
+      check_finite(i);
       continue;
     }
     const double mass = rmass[i];
@@ -185,7 +191,18 @@ void FixNVESphereFluid::final_integrate()
     omega[i][1] += spin * torque[i][1];
     omega[i][2] += spin * torque[i][2];
     settle_on_floor(i);
+    check_finite(i);
   }
+}
+
+void FixNVESphereFluid::check_finite(int i) const
+{
+  // A NaN or inf spreads through contacts and grids without a trace: stop at the first one.
+  const double *x = atom->x[i], *v = atom->v[i], *f = atom->f[i];
+  if (std::isfinite(x[0] + x[1] + x[2] + v[0] + v[1] + v[2])) return;
+  error->one(FLERR, "Fix nve/sphere/fluid: atom {} has a non-finite position or velocity at step {} "
+             "(x {} {} {}, v {} {} {}, f {} {} {}); check the forces acting on it and the timestep",
+             atom->tag[i], update->ntimestep, x[0], x[1], x[2], v[0], v[1], v[2], f[0], f[1], f[2]);
 }
 
 void FixNVESphereFluid::settle_on_floor(int i)

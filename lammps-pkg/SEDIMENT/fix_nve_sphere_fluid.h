@@ -48,7 +48,11 @@ class FixNVESphereFluid : public Fix {
   double floor_level;     // spheres stop with their lowest point here
   void settle_on_floor(int i);
 
-  RankSums<2> counts;    // spheres stuck by the yield stress, held at a Cd jump
+  // Diagnostics of the last step (compute_vector): spheres stuck by the yield stress, held at a
+  // Cd jump, outside every fluid, and with their local solid fraction capped (hindered drag).
+  enum { STUCK, AT_JUMP, OUTSIDE, CAPPED, NCOUNTS };
+  RankSums<NCOUNTS> counts;
+  void check_finite(int i) const;
 };
 
 }    // namespace LAMMPS_NS

@@ -517,6 +517,125 @@ def layers_hdf5(np_ranks: int):
         assert rank_diff < 1e-12
 
 
+@check
+def restart_state(np_ranks: int):
+    """2N steps in one run vs N steps + write_restart + read_restart in a new process + N steps."""
+    from sediment.layers import read_layers
+
+    with tempfile.TemporaryDirectory() as tmp:
+        tmp = Path(tmp)
+        run_deck("restart_state.lmp", {"phase": "whole", "state": tmp / "whole.dump", "layers": tmp / "whole.h5"},
+                 np_ranks, cwd=tmp)
+        run_deck("restart_state.lmp", {"phase": "first", "restart": tmp / "pile.restart", "layers": tmp / "split.h5"},
+                 np_ranks, cwd=tmp)
+        run_deck("restart_state.lmp", {"phase": "second", "restart": tmp / "pile.restart", "state": tmp / "split.dump",
+                                       "layers": tmp / "split.h5"}, np_ranks, cwd=tmp)
+        whole, split = np.loadtxt(tmp / "whole.dump", skiprows=9), np.loadtxt(tmp / "split.dump", skiprows=9)
+        frames_whole, frames_split = read_layers(tmp / "whole.h5"), read_layers(tmp / "split.h5")
+    assert whole.shape == split.shape and np.array_equal(whole[:, 0], split[:, 0])
+    scale = {"position": 1e-3, "velocity": np.abs(whole[:, 4:7]).max(), "spin": np.abs(whole[:, 7:10]).max()}
+    diffs = {name: float(np.abs(whole[:, cols] - split[:, cols]).max() / scale[name])
+             for name, cols in (("position", slice(1, 4)), ("velocity", slice(4, 7)), ("spin", slice(7, 10)))}
+    layer_diff = float(np.max(np.abs(frames_whole.fraction - frames_split.fraction)))
+    report(f"restart: {len(whole)} spheres with contacts, drag and the grid; split vs whole max difference "
+           f"(relative to d, max speed, max spin): {', '.join(f'{k} {v:.1e}' for k, v in diffs.items())}; "
+           f"layer frames {frames_split.step.tolist()} vs {frames_whole.step.tolist()}, fractions {layer_diff:.1e}")
+    assert all(v < 1e-9 for v in diffs.values())
+    assert frames_split.step.tolist() == frames_whole.step.tolist() == list(range(0, 3001, 500))
+    assert layer_diff < 1e-12
+
+
+# ---- numerical guards and lost atoms ---------------------------------------------------------
+GUARD_SCENE = """units si
+atom_style sphere
+atom_modify map array
+boundary p p f
+region box block -0.01 0.01 -0.01 0.01 -0.05 0.05
+create_box 1 box
+create_atoms 1 single 0 0 0.01
+create_atoms 1 single 0.005 0 -0.01
+set atom * diameter 1e-3 density 2500
+comm_modify cutoff 0.001
+fix grav all gravity 9.81 vector 0 0 -1
+fix water all fluid density 1000 viscosity 1e-3 surface z 0
+fix buoy all fluid/buoyancy water
+"""
+
+
+def guard_deck(tmp: Path, name: str, body: str) -> Path:
+    deck = tmp / f"{name}.lmp"
+    deck.write_text(GUARD_SCENE + body + "\n")
+    return deck
+
+
+@check
+def guards(np_ranks: int):
+    with tempfile.TemporaryDirectory() as tmp:
+        tmp = Path(tmp)
+        # A sphere in the air above the free surface: counted, and it falls exactly as under nve/sphere.
+        out = run_deck(guard_deck(tmp, "outside", """fix drag all fluid/drag water law stokes
+fix step all nve/sphere/fluid
+timestep 1e-4
+run 10
+print "RESULT outside $(f_step[3]) stuck $(f_step[1]) capped $(f_step[4]) vz1 $(vz[1]:%.17g) vz2 $(vz[2]:%.17g)"
+"""), {}, np_ranks, cwd=tmp)
+        r = out.results
+        report(f"guards: outside-the-fluid count {r['outside']:.0f}; the sphere in the air falls at {r['vz1']:.17g} m/s "
+               f"(g t = {-G * 1e-3:.17g}), the immersed one at {r['vz2']:.6g}")
+        assert r["outside"] == 1 and r["stuck"] == 0 and r["capped"] == 0
+        assert abs(r["vz1"] + G * 1e-3) < 1e-15 and -G * 1e-3 < r["vz2"] < 0
+        # The same spheres integrated explicitly: fluid/drag counts its own.
+        out = run_deck(guard_deck(tmp, "explicit", """set atom 2 diameter 1e-4 density 2500
+fix drag all fluid/drag water law stokes
+fix step all nve/sphere
+timestep 1e-2
+run 1
+print "RESULT unstable $(f_drag[4]) outside $(f_drag[5])"
+"""), {}, np_ranks, cwd=tmp)
+        report(f"guards: explicit drag at dt = 0.01 s (tau of the immersed sphere 1.4 ms): {out.results['unstable']:.0f} sphere(s) with dt > 2 tau, "
+               f"{out.results['outside']:.0f} outside the fluid")
+        assert out.results == {"unstable": 1.0, "outside": 1.0}
+        assert "have dt > 2 tau under explicit drag" in out.text
+        # Local solid fraction above max_fraction: counted, drag evaluated at the cap.
+        out = run_deck(guard_deck(tmp, "capped", """compute conc all concentration/grid layers z 10 bounds -0.05 0.05
+fix drag all fluid/drag water law difelice concentration c_conc max_fraction 1e-6
+fix step all nve/sphere/fluid
+timestep 1e-4
+run 2
+print "RESULT capped $(f_step[4]) outside $(f_step[3])"
+"""), {}, np_ranks, cwd=tmp)
+        report(f"guards: local fraction above max_fraction 1e-6: {out.results['capped']:.0f} sphere(s)")
+        assert out.results == {"capped": 1.0, "outside": 1.0}
+        # A force that overflows: stopped at once, naming the atom, instead of NaN spreading.
+        out = run_deck(guard_deck(tmp, "overflow", """fix drag all fluid/drag water law stokes
+fix step all nve/sphere/fluid
+fix push all addforce 0 0 1e308
+timestep 1e-4
+run 10
+"""), {}, np_ranks, expect_failure=True, cwd=tmp)
+        assert "Fix nve/sphere/fluid: atom 1 has a non-finite position or velocity at step 1" in out.text
+        # Spheres leaving the box: LAMMPS's lost-atom policy applies, the fixes carry on with the rest.
+        leave = """fix drag all fluid/drag water law stokes
+fix step all nve/sphere/fluid
+velocity all set 0 0 0
+set atom 1 vz 30
+timestep 1e-4
+thermo_style custom step atoms f_step[3]
+thermo 10
+{policy}
+run 100
+print "RESULT atoms $(atoms) outside $(f_step[3])"
+"""
+        out = run_deck(guard_deck(tmp, "lost_ignore", leave.format(policy="thermo_modify lost ignore")), {}, np_ranks,
+                       cwd=tmp)
+        report(f"guards: a sphere shot out of the box with 'lost ignore': {out.results['atoms']:.0f} atom left, "
+               f"{out.results['outside']:.0f} outside the fluid")
+        assert out.results == {"atoms": 1.0, "outside": 0.0}
+        out = run_deck(guard_deck(tmp, "lost_error", leave.format(policy="")), {}, np_ranks, expect_failure=True,
+                       cwd=tmp)
+        assert "ERROR: Lost atoms: original 2 current 1" in out.text
+
+
 # ---- bad input ----------------------------------------------------------------------------------
 BAD_INPUT = [
     ("fix f all fluid density -1 viscosity 1e-3", "density must be finite and > 0"),
