@@ -1,6 +1,6 @@
 # SEDIMENT: the two commands of the README, and their steps.
 #   make demo   installs what is missing, builds, runs the main example and says where its output is
-#   make test   installs what is missing, builds, runs every test
+#   make test   installs what is missing, builds, runs every test (also under the sanitizers)
 BUILD   ?= build
 PYTHON  := /usr/bin/python3
 JOBS    ?= 2
@@ -9,7 +9,7 @@ export OMPI_ALLOW_RUN_AS_ROOT := 1
 export OMPI_ALLOW_RUN_AS_ROOT_CONFIRM := 1
 export OMP_NUM_THREADS := 1
 
-.PHONY: deps build demo test test-cpp test-python bench clean
+.PHONY: deps build demo test test-cpp test-python check-sanitize bench clean
 
 deps:
 	@scripts/install-deps.sh
@@ -32,11 +32,22 @@ test-cpp: build
 test-python: build
 	PYTHONPATH=python SEDIMENT_LMP=$(abspath $(BUILD))/lmp_sediment $(PYTHON) -m pytest -q tests/python
 
-test: test-cpp test-python
+# The C++ and deck tests again, built with AddressSanitizer and UndefinedBehaviorSanitizer. No Python
+# module there: the deck harness imports the one of $(BUILD). Leak checks are off (LAMMPS and Open MPI
+# keep allocations until exit); any memory error or undefined behaviour aborts the test that hit it.
+SANITIZE_BUILD ?= build-sanitize
+check-sanitize: build
+	cmake -S . -B $(SANITIZE_BUILD) -DCMAKE_BUILD_TYPE=RelWithDebInfo -DSEDIMENT_SANITIZE=ON \
+	      -DSEDIMENT_BUILD_PYTHON=OFF -DLAMMPS_SOURCE_DIR=$(abspath $(BUILD))/lammps-headers
+	cmake --build $(SANITIZE_BUILD) -j $(JOBS)
+	cd $(SANITIZE_BUILD) && ASAN_OPTIONS=detect_leaks=0:abort_on_error=1 \
+	  UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1 ctest -j $(JOBS) --output-on-failure
+
+test: test-cpp test-python check-sanitize
 
 # Cost of each effect per particle-step, as ratios measured in one run (not part of make test).
 bench: build
 	$(PYTHON) benchmarks/cost.py
 
 clean:
-	rm -rf $(BUILD) $(OUT) python/sediment/_core*.so
+	rm -rf $(BUILD) $(SANITIZE_BUILD) $(OUT) python/sediment/_core*.so

@@ -52,6 +52,8 @@ ComputeConcentrationGrid::ComputeConcentrationGrid(LAMMPS *lmp, int narg, char *
       // LO HI along the layer axis, or xlo xhi ylo yhi [zlo zhi] for cells; read after the grid.
       while (iarg + 1 + nbounds < narg && utils::is_double(arg[iarg + 1 + nbounds]) && nbounds < 2 * dimension) {
         bounds[nbounds / 2][nbounds % 2] = utils::numeric(FLERR, arg[iarg + 1 + nbounds], false, lmp);
+        if (!std::isfinite(bounds[nbounds / 2][nbounds % 2]))
+          error->all(FLERR, "Compute concentration/grid: bounds must be finite");
         ++nbounds;
       }
       has_bounds = 1;
@@ -63,8 +65,9 @@ ComputeConcentrationGrid::ComputeConcentrationGrid(LAMMPS *lmp, int narg, char *
       if (class_edges.empty())
         error->all(FLERR, "Compute concentration/grid: 'classes' needs at least one diameter");
       for (size_t k = 0; k < class_edges.size(); ++k)
-        if (!(class_edges[k] > 0.0) || (k > 0 && !(class_edges[k] > class_edges[k - 1])))
-          error->all(FLERR, "Compute concentration/grid: class diameters must be positive and increasing");
+        if (!(class_edges[k] > 0.0) || !std::isfinite(class_edges[k]) ||
+            (k > 0 && !(class_edges[k] > class_edges[k - 1])))
+          error->all(FLERR, "Compute concentration/grid: class diameters must be finite, positive and increasing");
     } else if (strcmp(keyword, "types") == 0) {
       if (iarg + 1 >= narg) error->all(FLERR, "Compute concentration/grid: 'types' needs yes or no");
       if (strcmp(arg[iarg + 1], "yes") == 0) by_type = 1;
@@ -74,12 +77,14 @@ ComputeConcentrationGrid::ComputeConcentrationGrid(LAMMPS *lmp, int narg, char *
     } else if (strcmp(keyword, "thickness") == 0) {
       if (iarg + 1 >= narg) error->all(FLERR, "Compute concentration/grid: 'thickness' needs a value");
       thickness = utils::numeric(FLERR, arg[iarg + 1], false, lmp);
-      if (!(thickness > 0.0)) error->all(FLERR, "Compute concentration/grid: thickness must be > 0");
+      if (!(thickness > 0.0) || !std::isfinite(thickness))
+        error->all(FLERR, "Compute concentration/grid: thickness must be finite and > 0");
       iarg += 2;
     } else if (strcmp(keyword, "smooth") == 0) {
       if (iarg + 1 >= narg) error->all(FLERR, "Compute concentration/grid: 'smooth' needs a width");
       smooth_width = utils::numeric(FLERR, arg[iarg + 1], false, lmp);
-      if (!(smooth_width > 0.0)) error->all(FLERR, "Compute concentration/grid: smooth width must be > 0");
+      if (!(smooth_width > 0.0) || !std::isfinite(smooth_width))
+        error->all(FLERR, "Compute concentration/grid: smooth width must be finite and > 0");
       iarg += 2;
     } else if (strcmp(keyword, "weight") == 0) {
       if (iarg + 1 >= narg || strncmp(arg[iarg + 1], "d_", 2) != 0 || !arg[iarg + 1][2])

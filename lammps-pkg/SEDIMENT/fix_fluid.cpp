@@ -107,6 +107,8 @@ FixFluid::FixFluid(LAMMPS *lmp, int narg, char **arg) :
     if (!std::isfinite(flow[k])) error->all(FLERR, "Fix fluid: velocity must be finite");
   if (has_surface && !std::isfinite(surface_offset))
     error->all(FLERR, "Fix fluid: surface position must be finite");
+  if (domain->dimension == 2 && has_surface && surface_normal[2] != 0.0)
+    error->all(FLERR, "Fix fluid: a 2d simulation needs a surface normal in the xy plane");
 }
 
 FixFluid::~FixFluid()
@@ -131,8 +133,6 @@ void FixFluid::init()
     if (iregion < 0) error->all(FLERR, "Fix fluid: region '{}' does not exist", region_id);
     region = domain->regions[iregion];
   }
-  if (domain->dimension == 2 && has_surface && surface_normal[2] != 0.0)
-    error->all(FLERR, "Fix fluid: a 2d simulation needs a surface normal in the xy plane");
 }
 
 void FixFluid::prepare()

@@ -14,6 +14,7 @@
 #include "modify.h"
 #include "update.h"
 
+#include <cmath>
 #include <cstring>
 
 using namespace LAMMPS_NS;
@@ -38,7 +39,8 @@ FixFluidBuoyancy::FixFluidBuoyancy(LAMMPS *lmp, int narg, char **arg) :
       delete[] mixture_id;
       mixture_id = utils::strdup(arg[iarg + 1]);
       solid_density = utils::numeric(FLERR, arg[iarg + 2], false, lmp);
-      if (!(solid_density > 0.0)) error->all(FLERR, "Fix fluid/buoyancy: mixture solid density must be > 0");
+      if (!(solid_density > 0.0) || !std::isfinite(solid_density))
+        error->all(FLERR, "Fix fluid/buoyancy: mixture solid density must be finite and > 0");
       iarg += 3;
     } else {
       error->all(FLERR, "Fix fluid/buoyancy: unknown keyword '{}' (expected gravity or mixture)", arg[iarg]);

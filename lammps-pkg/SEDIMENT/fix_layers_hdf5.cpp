@@ -15,6 +15,7 @@
 
 #include <hdf5.h>
 
+#include <cmath>
 #include <cstring>
 #include <mpi.h>
 #include <stdexcept>
@@ -146,7 +147,8 @@ FixLayersHDF5::FixLayersHDF5(LAMMPS *lmp, int narg, char **arg) :
       fluid_id = utils::strdup(arg[iarg + 1]);
     } else if (strcmp(arg[iarg], "particle_density") == 0) {
       particle_density = utils::numeric(FLERR, arg[iarg + 1], false, lmp);
-      if (!(particle_density > 0.0)) error->all(FLERR, "Fix layers/hdf5: particle_density must be > 0");
+      if (!(particle_density > 0.0) || !std::isfinite(particle_density))
+        error->all(FLERR, "Fix layers/hdf5: particle_density must be finite and > 0");
     } else {
       error->all(FLERR, "Fix layers/hdf5: unknown keyword '{}' (expected fluid or particle_density)", arg[iarg]);
     }

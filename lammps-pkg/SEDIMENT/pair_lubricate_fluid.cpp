@@ -71,7 +71,8 @@ void PairLubricateFluid::settings(int narg, char **arg)
       range.outer = utils::numeric(FLERR, value, false, lmp);
     } else if (strcmp(keyword, "repulsion") == 0) {
       repulsion_scale = utils::numeric(FLERR, value, false, lmp);
-      if (!(repulsion_scale > 0.0)) error->all(FLERR, "Pair lubricate/fluid: repulsion force scale must be > 0");
+      if (!(repulsion_scale > 0.0) || !std::isfinite(repulsion_scale))
+        error->all(FLERR, "Pair lubricate/fluid: repulsion force scale must be finite and > 0");
     } else if (strcmp(keyword, "limit") == 0) {
       if (strcmp(value, "yes") == 0) limit = 1;
       else if (strcmp(value, "no") == 0) limit = 0;
@@ -81,7 +82,7 @@ void PairLubricateFluid::settings(int narg, char **arg)
     }
     iarg += 2;
   }
-  if (!(range.inner > 0.0) || !(range.outer > range.inner))
+  if (!(range.inner > 0.0) || !(range.outer > range.inner) || !std::isfinite(range.outer))
     error->all(FLERR, "Pair lubricate/fluid: need 0 < inner < outer (gaps in units of the effective radius)");
 }
 

@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import argparse
+import math
 import sys
 from dataclasses import replace
 from pathlib import Path
@@ -12,10 +13,37 @@ from . import _core
 from .readout import SCHEDULES as SCHEDULE_NAMES
 
 
+def finite(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"must be a number, got '{text}'") from None
+    if not math.isfinite(value):
+        raise argparse.ArgumentTypeError(f"must be finite, got {text}")
+    return value
+
+
 def positive(text: str) -> float:
-    value = float(text)
+    value = finite(text)
     if not value > 0:
         raise argparse.ArgumentTypeError(f"must be > 0, got {text}")
+    return value
+
+
+def nonnegative(text: str) -> float:
+    value = finite(text)
+    if value < 0:
+        raise argparse.ArgumentTypeError(f"must be >= 0, got {text}")
+    return value
+
+
+def count(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"must be a whole number, got '{text}'") from None
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"must be >= 1, got {text}")
     return value
 
 
@@ -199,7 +227,7 @@ def build_parser() -> argparse.ArgumentParser:
     terminal.add_argument("--fluid-density", type=positive, default=998.2, help="[kg/m3] (water at 20 C)")
     terminal.add_argument("--viscosity", type=positive, default=1.002e-3,
                           help="viscosity, or plastic viscosity of a Bingham fluid [Pa s]")
-    terminal.add_argument("--yield-stress", type=float, default=0.0, help="Bingham yield stress [Pa]")
+    terminal.add_argument("--yield-stress", type=nonnegative, default=0.0, help="Bingham yield stress [Pa]")
     terminal.add_argument("--gravity", type=positive, default=9.81, help="[m/s2]")
     terminal.set_defaults(func=cmd_terminal)
 
@@ -221,8 +249,8 @@ def build_parser() -> argparse.ArgumentParser:
                         "diameters; the slab spans the cylinder)")
     sample.add_argument("--mass", type=positive, default=0.060, help="dry sample mass [kg]")
     sample.add_argument("--particle-density", type=positive, default=2650.0, help="[kg/m3]")
-    sample.add_argument("--classes", type=int, default=40, help="log-spaced size classes (eq. 15)")
-    sample.add_argument("--particles", type=int, default=20000,
+    sample.add_argument("--classes", type=count, default=40, help="log-spaced size classes (eq. 15)")
+    sample.add_argument("--particles", type=count, default=20000,
                         help="simulated particles, as parcels of equal real mass (weights)")
     sample.add_argument("--real-grains", action="store_true",
                         help="one atom per real grain at the real concentration (eq. 15 counts, at least one "
@@ -231,7 +259,7 @@ def build_parser() -> argparse.ArgumentParser:
     sample.add_argument("--hindered", action="store_true", help="Di Felice drag on the local concentration")
     sample.add_argument("--contacts", action="store_true", help="Hertz contacts between grains and with the floor")
     sample.add_argument("--lubrication", action="store_true", help="squeeze-film lubrication (with contacts)")
-    sample.add_argument("--layers", type=int, default=400, help="layers of the concentration grid")
+    sample.add_argument("--layers", type=count, default=400, help="layers of the concentration grid")
     sample.add_argument("--t-end", type=positive, default=86400.0, help="simulated time [s] (default 24 h)")
     sample.add_argument("--courant", type=positive, default=1.0,
                         help="layers the fastest grain in suspension may cross per step")
@@ -240,7 +268,7 @@ def build_parser() -> argparse.ArgumentParser:
 
     run = sub.add_parser("run", help="run a deck with lmp_sediment (serial or mpirun) with a progress bar")
     run.add_argument("deck", type=Path, help="LAMMPS input deck (e.g. from `sediment sample`)")
-    run.add_argument("--np", type=int, default=1, help="MPI ranks")
+    run.add_argument("--np", type=count, default=1, help="MPI ranks")
     run.add_argument("--var", nargs=2, action="append", metavar=("NAME", "VALUE"), help="LAMMPS -var")
     run.add_argument("--quiet", action="store_true", help="no progress bar")
     run.set_defaults(func=cmd_run)
@@ -260,7 +288,7 @@ def build_parser() -> argparse.ArgumentParser:
     readout.add_argument("--height", type=positive, default=0.36, help="preview column height [m]")
     readout.add_argument("--concentration", type=positive, default=50.0, help="preview solids [g/L]")
     readout.add_argument("--particle-density", type=positive, default=2650.0, help="preview [kg/m3]")
-    readout.add_argument("--surface", type=float, help="free-surface coordinate [m] (default: top of the layers)")
+    readout.add_argument("--surface", type=finite, help="free-surface coordinate [m] (default: top of the layers)")
     readout.add_argument("--sphere-depth", type=positive, help="buoyancy sphere centre depth [m] (default 0.3 H)")
     readout.add_argument("--pipette-depth", type=positive, default=0.10, help="[m]")
     readout.add_argument("--pipette-volume", type=positive, default=25e-6, help="[m3]")
@@ -300,11 +328,11 @@ def build_parser() -> argparse.ArgumentParser:
         study.add_argument("--out", type=Path, default=Path("out/paste"), help="output folder")
     energy = studies.add_parser("energy", help="energy balance of one ball entering the paste")
     energy.add_argument("--diameter", type=positive, default=0.0126, help="[m]")
-    energy.add_argument("--fall", type=float, default=0.255, help="fall height above the paste [m]")
+    energy.add_argument("--fall", type=nonnegative, default=0.255, help="fall height above the paste [m]")
     energy.add_argument("--dt", type=positive, default=1e-5, help="[s]")
     pour = studies.add_parser("funnel", help="68 balls poured from a funnel, several random packings")
-    pour.add_argument("--runs", type=int, default=15)
-    pour.add_argument("--jobs", type=int, default=2, help="runs at a time")
+    pour.add_argument("--runs", type=count, default=15)
+    pour.add_argument("--jobs", type=count, default=2, help="runs at a time")
     pour.add_argument("--dt", type=positive, default=1e-6, help="[s]")
     pour.add_argument("--out", type=Path, default=Path("out/paste"), help="output folder")
     paste.set_defaults(func=cmd_paste)

@@ -57,6 +57,9 @@ class PSD:
         return np.interp(np.log(np.asarray(diameter, float)), np.log(self.diameter), self.percent_finer)
 
 
+MIN_DIAMETER_UM = 0.01    # below this a diameter_um column was written in another unit
+
+
 def read_psd(path: str | Path) -> PSD:
     """Reads a CSV with columns diameter_um, percent_finer (as in shared/data/psd)."""
     path = Path(path)
@@ -75,6 +78,10 @@ def read_psd(path: str | Path) -> PSD:
         values = np.array([[float(row[0]), float(row[1])] for row in body])
     except (ValueError, IndexError):
         raise PSDError(f"{path}: every row needs two numbers (diameter in um, percent finer)") from None
+    smallest = float(np.nanmin(values[:, 0])) if np.isfinite(values[:, 0]).any() else float("nan")
+    if 0 < smallest < MIN_DIAMETER_UM:
+        raise PSDError(f"{path}: the diameter_um column starts at {smallest:g} um, below {MIN_DIAMETER_UM} um "
+                       "(10 nm): write micrometres, not metres or millimetres")
     return PSD(values[:, 0] * 1e-6, values[:, 1], name=str(path))
 
 

@@ -14,7 +14,7 @@ from pathlib import Path
 
 import numpy as np
 
-from harness import HERE, report, run_deck
+from harness import HERE, report, run_batch, run_deck
 
 from sediment import _core  # noqa: E402  (harness puts python/ on the path)
 
@@ -665,13 +665,13 @@ BAD_INPUT = [
     ("fix n all nve/sphere/fluid floor z", "'floor' needs an axis and a coordinate"),
     ("fix n all nve/sphere/fluid floor w 0", "floor axis must be x, y or z, not 'w'"),
     ("fix f all fluid density 1000 viscosity 1e-3\nfix b all fluid/buoyancy f mixture c_c", "'mixture' needs c_ID and the solid density"),
-    ("fix f all fluid density 1000 viscosity 1e-3\nfix b all fluid/buoyancy f mixture c_c -5", "mixture solid density must be > 0"),
+    ("fix f all fluid density 1000 viscosity 1e-3\nfix b all fluid/buoyancy f mixture c_c -5", "mixture solid density must be finite and > 0"),
     ("fix f all fluid density 1000 viscosity 1e-3\nfix b all fluid/buoyancy f mixture c_c 2650\nrun 0", "compute 'c' does not exist"),
     ("pair_style lubricate/fluid", "needs the ID of a fix fluid"),
     ("pair_style lubricate/fluid w inner 0.5 outer 0.1", "need 0 < inner < outer"),
     ("pair_style lubricate/fluid w squeeze 2", "unknown keyword 'squeeze'"),
     ("pair_style lubricate/fluid w limit maybe", "limit must be yes or no, not 'maybe'"),
-    ("pair_style lubricate/fluid w repulsion -1", "repulsion force scale must be > 0"),
+    ("pair_style lubricate/fluid w repulsion -1", "repulsion force scale must be finite and > 0"),
     ("pair_style lubricate/fluid w\npair_coeff * * 1.0", "pair_coeff takes the two types only"),
     ("fix w all fluid density 1000 viscosity 1e-3\npair_style lubricate/fluid w\npair_coeff * *\nrun 0",
      "use 'comm_modify vel yes'"),
@@ -686,7 +686,7 @@ BAD_INPUT = [
     ("compute c all concentration/grid layers z 10 bounds 1 0", "bounds need LO < HI along z"),
     ("compute c all concentration/grid layers z 10 classes 2 1", "positive and increasing"),
     ("compute c all concentration/grid layers z 10 thickness 1", "'thickness' is for 2d simulations only"),
-    ("compute c all concentration/grid layers z 10 smooth -1", "smooth width must be > 0"),
+    ("compute c all concentration/grid layers z 10 smooth -1", "smooth width must be finite and > 0"),
     ("compute c all concentration/grid layers z 10 sieve 3", "unknown keyword 'sieve'"),
     ("compute c all concentration/grid layers z 10 weight w", "'weight' needs a per-atom property d_NAME"),
     ("compute c all concentration/grid layers z 10 weight d_w\nrun 0", "weight d_w is not a per-atom floating-point vector"),
@@ -725,6 +725,46 @@ def bad_input(np_ranks: int):
         out = run_deck(deck, {}, np_ranks, expect_failure=True, cwd=Path(tmp))
         assert "requires atom attributes radius and rmass" in out.text
     report(f"bad input: {len(BAD_INPUT) + 3} malformed decks each stopped with the expected error message")
+
+
+@check
+def fuzz_input(np_ranks: int):
+    """Every malformed command of tests/decks/fuzz.py ends with a LAMMPS error; valid ones run."""
+    import subprocess
+    from concurrent.futures import ThreadPoolExecutor
+
+    import fuzz
+
+    def outcome(case_and_dir):
+        case, folder = case_and_dir
+        deck = folder / "deck.lmp"
+        deck.write_text(case.deck)
+        try:
+            out = run_batch(deck, {}, np_ranks, cwd=folder, timeout=60, check=False)
+        except subprocess.TimeoutExpired:
+            return case, "hang"
+        refused = out.returncode != 0 and out.error is not None and out.error.startswith("ERROR")
+        ran = out.returncode == 0 and out.error is None and "Loop time" in out.text
+        if refused:
+            return case, "refused" if not case.valid else "valid input refused: " + out.error
+        if ran:
+            return case, "ran" if case.valid else "silently accepted"
+        return case, f"crash (exit {out.returncode})"
+
+    cases = fuzz.cases()
+    with tempfile.TemporaryDirectory() as tmp:
+        folders = [Path(tmp) / f"case{k}" for k in range(len(cases))]
+        for folder in folders:
+            folder.mkdir()
+        with ThreadPoolExecutor(max_workers=2) as pool:
+            results = list(pool.map(outcome, zip(cases, folders)))
+    bad = [(case, result) for case, result in results if result not in ("refused", "ran")]
+    for case, result in bad:
+        report(f"  {result}: {case.style}: {case.what}")
+    refused = sum(result == "refused" for _, result in results)
+    report(f"fuzz: {len(cases)} generated decks over {len(fuzz.STYLES)} command forms: {refused} malformed ones "
+           f"refused with a LAMMPS error, {len(cases) - refused - len(bad)} valid ones ran, {len(bad)} wrong")
+    assert not bad
 
 
 def main() -> None:

@@ -1,4 +1,5 @@
 """The sediment command line."""
+import argparse
 import subprocess
 from pathlib import Path
 
@@ -80,3 +81,37 @@ def test_readout_measured_hydrometer_option(tmp_path):
     a = np.genfromtxt(tmp_path / "a" / "hydrometer.csv", delimiter=",", skip_header=1)
     b = np.genfromtxt(tmp_path / "b" / "hydrometer.csv", delimiter=",", skip_header=1)
     assert np.allclose(a, b, rtol=1e-9, atol=1e-9)
+
+
+def _typed_options():
+    """(command words, option, type) of every option of every sub-command that converts a value."""
+    def walk(parser, words):
+        for action in parser._actions:
+            if isinstance(action, argparse._SubParsersAction):
+                for name, sub in action.choices.items():
+                    yield from walk(sub, words + [name])
+            elif action.option_strings and action.type in (cli.positive, cli.nonnegative, cli.finite, cli.count,
+                                                           float, int):
+                yield words, action.option_strings[-1], action.type
+    return list(walk(cli.build_parser(), []))
+
+
+@pytest.mark.parametrize("bad", ["nan", "inf", "-1", "abc", ""])
+def test_every_numeric_option_refuses_malformed_values(bad, capsys):
+    options = _typed_options()
+    assert len(options) > 40 and not [o for o in options if o[2] is float]
+    for words, option, kind in options:
+        if kind in (cli.finite, int) and bad == "-1":
+            continue    # a signed value (a coordinate, a seed): -1 is valid
+        with pytest.raises(SystemExit) as exit_info:
+            cli.main(words + [option, bad])
+        err = capsys.readouterr().err
+        assert exit_info.value.code == 2, (words, option, bad)
+        assert "Traceback" not in err and option.lstrip("-") in err.replace("_", "-"), (words, option, bad, err)
+
+
+def test_psd_in_metres_is_refused(tmp_path, capsys):
+    psd = tmp_path / "metres.csv"
+    psd.write_text("diameter_um,percent_finer\n2.5e-6,0\n7e-5,100\n")
+    assert cli.main(["sample", str(psd), "--out", str(tmp_path / "out")]) == 2
+    assert "write micrometres, not metres" in capsys.readouterr().err
