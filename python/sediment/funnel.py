@@ -16,6 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
+from . import figures
 from .paste import EXAMPLES, PASTE
 from .run import run_batch
 
@@ -119,9 +120,7 @@ def presence_probability(pours: list[Pour], plane: float, cell: float = 0.0025) 
 
 
 def plot_positions(pours: list[Pour], path: Path) -> None:
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = figures.pyplot()
 
     depth = np.concatenate([PASTE["surface"] - p.positions[:, 2] for p in pours]) * 1e3
     fig, (side, hist) = plt.subplots(1, 2, figsize=(10, 4.5), gridspec_kw={"width_ratios": [1, 1.2]})
@@ -138,15 +137,11 @@ def plot_positions(pours: list[Pour], path: Path) -> None:
     hist.set(xlabel="balls per run", ylabel="depth of the centre [mm]",
              title=f"Vertical distribution: {depth.min():.0f} to {depth.max():.0f} mm")
     hist.invert_yaxis()
-    fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
+    figures.save(fig, path)
 
 
 def plot_presence(pours: list[Pour], path: Path, spacing: float = 0.01) -> None:
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = figures.pyplot()
 
     tops = [PASTE["surface"] - p.positions[:, 2].max() for p in pours]
     bottoms = [PASTE["surface"] - p.positions[:, 2].min() for p in pours]
@@ -166,5 +161,4 @@ def plot_presence(pours: list[Pour], path: Path, spacing: float = 0.01) -> None:
         ax.axis("off")
     fig.colorbar(image, ax=axes, shrink=0.6, label="probability of presence")
     fig.suptitle(f"Balls on horizontal planes every {spacing * 1e3:.0f} mm ({len(pours)} runs)")
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    figures.save(fig, path, dpi=110, tight=False)

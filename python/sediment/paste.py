@@ -15,7 +15,7 @@ from pathlib import Path
 import numpy as np
 from scipy.optimize import brentq
 
-from . import _core
+from . import _core, figures
 from .calibrate import restitution_from_drops
 from .paths import REPO_DIR
 from .run import run_batch
@@ -83,9 +83,7 @@ def drop_study(out_dir: Path) -> list[DropRow]:
 
 
 def _plot_drops(rows: list[DropRow], path: Path) -> None:
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = figures.pyplot()
 
     e = restitution_from_drops(DROP_HEIGHTS, MEASURED_REBOUNDS).mean
     falls = np.array([r.fall for r in rows]) * 1e3
@@ -95,9 +93,7 @@ def _plot_drops(rows: list[DropRow], path: Path) -> None:
     ax.plot(falls, e * e * falls, "k:", lw=1, label=f"e^2 H_f, e = {e:.3f}")
     ax.set(xlabel="drop height H_f [mm]", ylabel="rebound height H_r [mm]", title="8 mm steel ball on a steel plate")
     ax.legend(fontsize=8)
-    fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
+    figures.save(fig, path)
 
 
 # ---- a ball dropped into the paste (case D) ----------------------------------------------------
@@ -143,9 +139,7 @@ def ball_study(out_dir: Path, diameters=BALL_DIAMETERS, falls=FALL_HEIGHTS, prog
 
 
 def _plot_balls(drops: list[BallDrop], path: Path) -> None:
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = figures.pyplot()
 
     fig, ax = plt.subplots(figsize=(6, 4.3))
     for i, d in enumerate(sorted({b.diameter for b in drops})):
@@ -157,9 +151,7 @@ def _plot_balls(drops: list[BallDrop], path: Path) -> None:
     ax.set(xlabel="fall height above the paste [mm]", ylabel="settling distance [mm]",
            title="Steel balls into paste backfill (tau_y 136 Pa, eta_B 0.7 Pa s)")
     ax.legend(fontsize=7)
-    fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
+    figures.save(fig, path)
 
 
 @dataclass

@@ -10,6 +10,7 @@ from pathlib import Path
 
 import numpy as np
 
+from . import figures
 from .paths import REPO_DIR
 from .run import run_batch
 
@@ -50,10 +51,7 @@ SHOWN = {("implicit", 1e-3), ("implicit", 1e-2), ("explicit", 1e-5), ("explicit"
 
 
 def plot_case_a(runs: list[Run], path: Path) -> None:
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = figures.pyplot()
 
     fig, (ax_v, ax_e) = plt.subplots(1, 2, figsize=(11, 4.2))
     t_fine = np.linspace(0, max(r.time[-1] for r in runs), 400)
@@ -74,10 +72,7 @@ def plot_case_a(runs: list[Run], path: Path) -> None:
     ax_e.axvline(2.0, color="r", ls=":", label="explicit limit dt = 2 tau")
     ax_e.set(xlabel="dt / tau", ylabel="max |v - v_exact| / v_t", title="Velocity error vs time step")
     ax_e.legend(fontsize=8)
-    fig.tight_layout()
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
+    figures.save(fig, path)
 
 
 def case_a_study(out_dir: Path) -> list[Run]:

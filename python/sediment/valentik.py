@@ -12,7 +12,7 @@ import math
 from dataclasses import dataclass
 from pathlib import Path
 
-from . import _core
+from . import _core, figures
 from .paths import REPO_DIR
 from .run import run_batch
 
@@ -109,9 +109,7 @@ def study(csv_path: Path, out_dir: Path, laws=("zhang-li", "zhang-li/smooth"), p
 
 
 def plot(results: list[Settling], path: Path) -> None:
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = figures.pyplot()
 
     laws = sorted({r.law for r in results})
     fig, axes = plt.subplots(1, len(laws), figsize=(5.2 * len(laws), 4.6), squeeze=False)
@@ -133,6 +131,4 @@ def plot(results: list[Settling], path: Path) -> None:
         ax.set(xlabel="measured terminal velocity [m/s]", ylabel="simulated terminal velocity [m/s]",
                title=f"Valentik & Whitmore (1965), law {law}", xlim=(0, 1.1 * top), ylim=(0, 1.1 * top))
         ax.legend(fontsize=7, title="suspension", title_fontsize=7)
-    fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
+    figures.save(fig, path)
