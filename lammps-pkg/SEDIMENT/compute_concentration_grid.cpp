@@ -3,7 +3,7 @@
 ------------------------------------------------------------------------- */
 
 #include "compute_concentration_grid.h"
-#include "sediment_axis.h"
+#include "sediment_args.h"
 
 #include "atom.h"
 #include "domain.h"
@@ -76,15 +76,11 @@ ComputeConcentrationGrid::ComputeConcentrationGrid(LAMMPS *lmp, int narg, char *
       iarg += 2;
     } else if (strcmp(keyword, "thickness") == 0) {
       if (iarg + 1 >= narg) error->all(FLERR, "Compute concentration/grid: 'thickness' needs a value");
-      thickness = utils::numeric(FLERR, arg[iarg + 1], false, lmp);
-      if (!(thickness > 0.0) || !std::isfinite(thickness))
-        error->all(FLERR, "Compute concentration/grid: thickness must be finite and > 0");
+      thickness = sediment_positive(lmp, arg[iarg + 1], "Compute concentration/grid: thickness");
       iarg += 2;
     } else if (strcmp(keyword, "smooth") == 0) {
       if (iarg + 1 >= narg) error->all(FLERR, "Compute concentration/grid: 'smooth' needs a width");
-      smooth_width = utils::numeric(FLERR, arg[iarg + 1], false, lmp);
-      if (!(smooth_width > 0.0) || !std::isfinite(smooth_width))
-        error->all(FLERR, "Compute concentration/grid: smooth width must be finite and > 0");
+      smooth_width = sediment_positive(lmp, arg[iarg + 1], "Compute concentration/grid: smooth width");
       iarg += 2;
     } else if (strcmp(keyword, "weight") == 0) {
       if (iarg + 1 >= narg || strncmp(arg[iarg + 1], "d_", 2) != 0 || !arg[iarg + 1][2])

@@ -3,7 +3,7 @@
 ------------------------------------------------------------------------- */
 
 #include "fix_fluid.h"
-#include "sediment_axis.h"
+#include "sediment_args.h"
 
 #include "domain.h"
 #include "error.h"
@@ -35,27 +35,19 @@ FixFluid::FixFluid(LAMMPS *lmp, int narg, char **arg) :
     const char *keyword = arg[iarg];
     if (strcmp(keyword, "density") == 0) {
       need(1, keyword);
-      fluid.density = utils::numeric(FLERR, arg[iarg + 1], false, lmp);
-      if (!(fluid.density > 0.0) || !std::isfinite(fluid.density))
-        error->all(FLERR, "Fix fluid: density must be finite and > 0");
+      fluid.density = sediment_positive(lmp, arg[iarg + 1], "Fix fluid: density");
       has_density = true;
       iarg += 2;
     } else if (strcmp(keyword, "viscosity") == 0) {
       need(1, keyword);
-      fluid.viscosity = utils::numeric(FLERR, arg[iarg + 1], false, lmp);
-      if (!(fluid.viscosity > 0.0) || !std::isfinite(fluid.viscosity))
-        error->all(FLERR, "Fix fluid: viscosity must be finite and > 0");
+      fluid.viscosity = sediment_positive(lmp, arg[iarg + 1], "Fix fluid: viscosity");
       has_viscosity = true;
       iarg += 2;
     } else if (strcmp(keyword, "bingham") == 0) {
       need(2, keyword);
-      fluid.yield_stress = utils::numeric(FLERR, arg[iarg + 1], false, lmp);
-      fluid.viscosity = utils::numeric(FLERR, arg[iarg + 2], false, lmp);
-      if (!(fluid.yield_stress > 0.0) || !std::isfinite(fluid.yield_stress))
-        error->all(FLERR, "Fix fluid: bingham yield stress must be finite and > 0 (use viscosity "
-                          "for a Newtonian fluid)");
-      if (!(fluid.viscosity > 0.0) || !std::isfinite(fluid.viscosity))
-        error->all(FLERR, "Fix fluid: bingham plastic viscosity must be finite and > 0");
+      fluid.yield_stress = sediment_positive(lmp, arg[iarg + 1], "Fix fluid: bingham yield stress",
+                                             " (use viscosity for a Newtonian fluid)");
+      fluid.viscosity = sediment_positive(lmp, arg[iarg + 2], "Fix fluid: bingham plastic viscosity");
       has_bingham = true;
       iarg += 3;
     } else if (strcmp(keyword, "surface") == 0) {

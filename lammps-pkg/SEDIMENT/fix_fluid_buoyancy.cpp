@@ -4,6 +4,7 @@
 ------------------------------------------------------------------------- */
 
 #include "fix_fluid_buoyancy.h"
+#include "sediment_args.h"
 
 #include "compute_concentration_grid.h"
 #include "fix_fluid.h"
@@ -14,7 +15,6 @@
 #include "modify.h"
 #include "update.h"
 
-#include <cmath>
 #include <cstring>
 
 using namespace LAMMPS_NS;
@@ -38,9 +38,7 @@ FixFluidBuoyancy::FixFluidBuoyancy(LAMMPS *lmp, int narg, char **arg) :
         error->all(FLERR, "Fix fluid/buoyancy: keyword 'mixture' needs c_ID and the solid density");
       delete[] mixture_id;
       mixture_id = utils::strdup(arg[iarg + 1]);
-      solid_density = utils::numeric(FLERR, arg[iarg + 2], false, lmp);
-      if (!(solid_density > 0.0) || !std::isfinite(solid_density))
-        error->all(FLERR, "Fix fluid/buoyancy: mixture solid density must be finite and > 0");
+      solid_density = sediment_positive(lmp, arg[iarg + 2], "Fix fluid/buoyancy: mixture solid density");
       iarg += 3;
     } else {
       error->all(FLERR, "Fix fluid/buoyancy: unknown keyword '{}' (expected gravity or mixture)", arg[iarg]);

@@ -3,6 +3,7 @@
 ------------------------------------------------------------------------- */
 
 #include "fix_layers_hdf5.h"
+#include "sediment_args.h"
 
 #include "compute_concentration_grid.h"
 #include "fix_fluid.h"
@@ -15,7 +16,6 @@
 
 #include <hdf5.h>
 
-#include <cmath>
 #include <cstring>
 #include <mpi.h>
 #include <stdexcept>
@@ -146,9 +146,7 @@ FixLayersHDF5::FixLayersHDF5(LAMMPS *lmp, int narg, char **arg) :
       delete[] fluid_id;
       fluid_id = utils::strdup(arg[iarg + 1]);
     } else if (strcmp(arg[iarg], "particle_density") == 0) {
-      particle_density = utils::numeric(FLERR, arg[iarg + 1], false, lmp);
-      if (!(particle_density > 0.0) || !std::isfinite(particle_density))
-        error->all(FLERR, "Fix layers/hdf5: particle_density must be finite and > 0");
+      particle_density = sediment_positive(lmp, arg[iarg + 1], "Fix layers/hdf5: particle_density");
     } else {
       error->all(FLERR, "Fix layers/hdf5: unknown keyword '{}' (expected fluid or particle_density)", arg[iarg]);
     }

@@ -4,7 +4,7 @@
 ------------------------------------------------------------------------- */
 
 #include "fix_nve_sphere_fluid.h"
-#include "sediment_axis.h"
+#include "sediment_args.h"
 
 #include "fix_fluid.h"
 #include "fix_fluid_drag.h"

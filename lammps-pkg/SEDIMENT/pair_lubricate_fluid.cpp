@@ -3,6 +3,7 @@
 ------------------------------------------------------------------------- */
 
 #include "pair_lubricate_fluid.h"
+#include "sediment_args.h"
 
 #include "fix_fluid.h"
 
@@ -70,9 +71,7 @@ void PairLubricateFluid::settings(int narg, char **arg)
     } else if (strcmp(keyword, "outer") == 0) {
       range.outer = utils::numeric(FLERR, value, false, lmp);
     } else if (strcmp(keyword, "repulsion") == 0) {
-      repulsion_scale = utils::numeric(FLERR, value, false, lmp);
-      if (!(repulsion_scale > 0.0) || !std::isfinite(repulsion_scale))
-        error->all(FLERR, "Pair lubricate/fluid: repulsion force scale must be finite and > 0");
+      repulsion_scale = sediment_positive(lmp, value, "Pair lubricate/fluid: repulsion force scale");
     } else if (strcmp(keyword, "limit") == 0) {
       if (strcmp(value, "yes") == 0) limit = 1;
       else if (strcmp(value, "no") == 0) limit = 0;

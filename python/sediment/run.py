@@ -18,6 +18,15 @@ import numpy as np
 from .paths import lmp_executable, mpirun_prefix
 
 
+def _launch(deck: str, log: str, ranks: int, variables: dict[str, object] | None) -> tuple[list[str], dict[str, str]]:
+    """The command line and environment that run `deck` with lmp_sediment on `ranks` MPI ranks."""
+    cmd = mpirun_prefix(ranks) + [lmp_executable(), "-in", deck, "-log", log, "-nocite"]
+    for name, value in (variables or {}).items():
+        cmd += ["-var", name, str(value)]
+    env = dict(os.environ, OMP_NUM_THREADS="1", OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
+    return cmd, env
+
+
 @dataclass
 class RunResult:
     deck: Path
@@ -34,10 +43,7 @@ def run_deck(deck: Path, ranks: int = 1, variables: dict[str, str] | None = None
     if not deck.is_file():
         raise FileNotFoundError(f"{deck}: no such deck")
     log = deck.parent / "log.lammps"
-    cmd = mpirun_prefix(ranks) + [lmp_executable(), "-in", deck.name, "-log", log.name, "-nocite"]
-    for name, value in (variables or {}).items():
-        cmd += ["-var", name, str(value)]
-    env = dict(os.environ, OMP_NUM_THREADS="1", OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
+    cmd, env = _launch(deck.name, log.name, ranks, variables)
     start = time.monotonic()
     total_steps, t_end, step, now, errors, tail = 0, 0.0, 0, 0.0, [], deque(maxlen=5)
     bar = None
@@ -96,10 +102,7 @@ def run_batch(deck: Path, variables: dict[str, object] | None = None, ranks: int
     deck = Path(deck).resolve()
     if not deck.is_file():
         raise FileNotFoundError(f"{deck}: no such deck")
-    cmd = mpirun_prefix(ranks) + [lmp_executable(), "-in", str(deck), "-log", "none", "-nocite"]
-    for name, value in (variables or {}).items():
-        cmd += ["-var", name, str(value)]
-    env = dict(os.environ, OMP_NUM_THREADS="1", OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
+    cmd, env = _launch(str(deck), "none", ranks, variables)
     start = time.monotonic()
     proc = subprocess.run(cmd, capture_output=True, text=True, cwd=cwd or deck.parent, timeout=timeout, env=env)
     wall = time.monotonic() - start
