@@ -59,17 +59,21 @@ def cmd_terminal(args: argparse.Namespace) -> int:
         t99 = _core.time_to_fraction(args.law, args.fluid_density, args.viscosity, args.yield_stress,
                                      args.diameter, args.particle_density, args.gravity, 0.99)
         print(f"time to 99 % of it from rest: {t99:.6g} s")
+    if args.youngs_modulus:
+        rayleigh = _core.rayleigh_time(0.5 * args.diameter, args.particle_density, args.youngs_modulus,
+                                       args.poisson_ratio)
+        print(f"Rayleigh time: {rayleigh:.6g} s (the 20 % rule: dt = {0.2 * rayleigh:.3g} s)")
     return 0
 
 
 def cmd_case_a(args: argparse.Namespace) -> int:
-    from .single_sphere import RELAXATION_TIME, case_a_study
+    from . import sweep
+    from .single_sphere import case_a_study
 
-    runs = case_a_study(args.out)
-    print(f"{'integrator':10s} {'dt [s]':>9s} {'dt/tau':>8s} {'max err/v_t':>12s} {'wall [s]':>9s}")
-    for r in runs:
-        print(f"{r.integrator:10s} {r.dt:9.2g} {r.dt / RELAXATION_TIME:8.3g} {r.error:12.2e} {r.wall_seconds:9.3f}")
-    print(f"figure: {args.out / 'case_a_velocity.png'}\ntable:  {args.out / 'case_a_errors.csv'}")
+    result = case_a_study(args.out)
+    print(sweep.table(result), end="")
+    print("\n".join(sweep.summary(result, 0.01)))
+    print(f"figures: {args.out / 'case_a_velocity.png'}, {args.out / 'sweep.png'}\ntable:   {args.out / 'sweep.csv'}")
     return 0
 
 
@@ -215,6 +219,24 @@ def cmd_spheres(args: argparse.Namespace) -> int:
     return 0
 
 
+def positive_list(text: str) -> list[float]:
+    return [positive(word) for word in text.split(",")]
+
+
+def cmd_sweep(args: argparse.Namespace) -> int:
+    from . import sweep
+
+    references = dict(sweep.parse_reference(r) for r in args.reference or [])
+    integrators = args.integrator.split(",") if args.integrator else None
+    result = sweep.run_sweep(args.deck, args.dt, args.observe, integrators, args.parameter, references,
+                             dict(args.var or []), args.np, args.out / "runs", args.tau, args.rayleigh)
+    paths = sweep.write(result, args.out, args.tolerance, args.title)
+    print(sweep.table(result), end="")
+    print("\n".join(sweep.summary(result, args.tolerance)))
+    print(f"wrote {paths[0]} and {paths[1]}")
+    return 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="sediment", description="SEDIMENT: settling of DEM spheres in "
                                      "fluids with LAMMPS, and sedimentation-test readouts.")
@@ -229,6 +251,8 @@ def build_parser() -> argparse.ArgumentParser:
                           help="viscosity, or plastic viscosity of a Bingham fluid [Pa s]")
     terminal.add_argument("--yield-stress", type=nonnegative, default=0.0, help="Bingham yield stress [Pa]")
     terminal.add_argument("--gravity", type=positive, default=9.81, help="[m/s2]")
+    terminal.add_argument("--youngs-modulus", type=positive, help="[Pa]: also print the Rayleigh time")
+    terminal.add_argument("--poisson-ratio", type=finite, default=0.3, help="for the Rayleigh time")
     terminal.set_defaults(func=cmd_terminal)
 
     case_a = sub.add_parser("case-a", help="single-sphere validation (case A): velocity curves and "
@@ -344,6 +368,31 @@ def build_parser() -> argparse.ArgumentParser:
                          choices=["zhang-li", "zhang-li/smooth"])
     spheres.add_argument("--out", type=Path, default=Path("out/spheres"), help="output folder")
     spheres.set_defaults(func=cmd_spheres)
+
+    sweep = sub.add_parser("sweep", help="accuracy vs cost: a deck at several time steps (and integrators), "
+                           "errors against a reference, loop times, table and figure",
+                           description="Runs DECK with -var dt VALUE for each value (and -var integrator "
+                           "nve/sphere/fluid|nve/sphere), reads the observables it prints (RESULT name value; "
+                           "SERIES name x y) or the readout curves of the layer file it writes, and scores "
+                           "each run against --reference or the finest run. See docs/sweep.md.")
+    sweep.add_argument("deck", type=Path, help="LAMMPS deck with 'variable dt index ...'")
+    sweep.add_argument("--dt", type=positive_list, required=True, help="comma-separated values of the swept variable")
+    sweep.add_argument("--parameter", default="dt", help="the deck variable swept (default dt; e.g. courant for a "
+                       "deck written by `sediment sample`)")
+    sweep.add_argument("--integrator", help="comma-separated: implicit (nve/sphere/fluid), explicit (nve/sphere)")
+    sweep.add_argument("--observe", nargs="+", required=True, metavar="NAME",
+                       help="RESULT or SERIES names the deck prints, or hydrometer, buoyancy, pipette")
+    sweep.add_argument("--reference", action="append", metavar="NAME=EXPR",
+                       help="analytic reference: a number, or an expression of x for a series "
+                       "(numpy exp, log, sqrt, ...); default: the finest run")
+    sweep.add_argument("--tolerance", type=positive, default=0.01, help="relative error to meet (default 1 %%)")
+    sweep.add_argument("--tau", type=positive, help="drag relaxation time [s]: marks the explicit limit 2 tau")
+    sweep.add_argument("--rayleigh", type=positive, help="Rayleigh time [s]: marks the 20 %% rule")
+    sweep.add_argument("--var", nargs=2, action="append", metavar=("NAME", "VALUE"), help="LAMMPS -var for every run")
+    sweep.add_argument("--np", type=count, default=1, help="MPI ranks per run")
+    sweep.add_argument("--title", default="", help="figure title")
+    sweep.add_argument("--out", type=Path, default=Path("out/sweep"), help="output folder")
+    sweep.set_defaults(func=cmd_sweep)
     return parser
 
 

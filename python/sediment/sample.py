@@ -321,11 +321,13 @@ def _deck(scene: Scene, data: str, layer_file: str) -> str:
         "#   sediment run in.sedimentation        (or: lmp_sediment -in in.sedimentation)",
         f"variable        layers_file index {layer_file}",
         f"variable        t_end equal {scene.t_end:.12g}",
+        "variable        dt_scale index 1    # multiplies every stage's time step (sediment sweep ... --parameter dt_scale)",
         "",
         "units           si",
         f"dimension       {scene.dimension}",
         "atom_style      sphere",
         f"boundary        {'p f p' if slab else 'p p f'}",
+        f"processors      {'* 1 1' if slab else '* * 1'}    # ranks side by side: each keeps its share as the grains settle",
         "fix             weights all property/atom d_weight    # real grains each atom stands for",
         f"read_data       {data} fix weights NULL Weights",
         f"neighbor        {d_max:.6g} bin",
@@ -360,16 +362,16 @@ def _deck(scene: Scene, data: str, layer_file: str) -> str:
     else:
         lines.append(f"fix             step all nve/sphere/fluid floor {up} 0.0")
     lines += [
-        f"fix             layers all layers/hdf5 {frames_every} ${{layers_file}} c_conc fluid water "
-        f"particle_density {f.particle_density:.12g}",
+        f"fix             layers all layers/hdf5 $(round({frames_every}/v_dt_scale)+(round({frames_every}/v_dt_scale)<1)) "
+        f"${{layers_file}} c_conc fluid water particle_density {f.particle_density:.12g}",
         "",
         "thermo_style    custom step time dt f_layers",
         f"thermo          {frames_every * 5}",
         "thermo_modify   norm no",
-        f'print           "SEDIMENT plan steps {total_steps} t_end {scene.t_end:.12g}"',
+        f'print           "SEDIMENT plan steps $(ceil({total_steps}/v_dt_scale)) t_end {scene.t_end:.12g}"',
     ]
     for dt, steps in stages:
-        lines += [f"timestep        {dt:.17g}", f"run             {steps} post no"]
+        lines += [f"timestep        $({dt:.17g}*v_dt_scale)", f"run             $(ceil({steps}/v_dt_scale)) post no"]
     return "\n".join(lines) + "\n"
 
 

@@ -85,7 +85,7 @@ def settle(sphere: Sphere, law: str = "zhang-li", steps: int = 2000) -> Settling
     speed, regime = _core.terminal_velocity(*args)
     t_end = 5 * _core.time_to_fraction(*args, 0.99) if speed > 0 else 1.0
     out = run_batch(DECK, {"d": sphere.d, "rho_p": sphere.rho_p, "rho_f": sphere.rho_f, "tau_y": sphere.tau_y,
-                           "eta_B": sphere.eta_B, "law": law, "t_end": t_end, "steps": steps})
+                           "eta_B": sphere.eta_B, "law": law, "t_end": t_end, "dt": t_end / steps})
     return Settling(sphere, law, speed, regime, out.results["speed"])
 
 

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from sediment import cli
-from sediment.single_sphere import run_case_a
+from sediment.single_sphere import case_a_sweep
 
 REPO = Path(__file__).resolve().parents[2]
 
@@ -40,10 +40,10 @@ def test_help_lists_commands():
 
 
 @pytest.mark.parametrize("integrator, bound", [("implicit", 1e-12), ("explicit", 0.2)])
-def test_case_a_runs_through_the_driver(integrator, bound):
-    run = run_case_a(integrator, 1e-3, t_end=0.01)
+def test_case_a_runs_through_the_driver(integrator, bound, tmp_path):
+    run, = case_a_sweep((1e-3,), (integrator,), t_end=0.01, work_dir=tmp_path, progress=False).runs
     assert run.error < bound
-    assert len(run.time) == 11
+    assert len(run.observations["velocity"].x) == 11
 
 
 def test_readout_preview_writes_tables_figure_and_errors(tmp_path, capsys):
