@@ -43,6 +43,18 @@ Phi phis(double z)
   return {decay, (1.0 - decay) / z, (z - 1.0 + decay) / (z * z)};
 }
 
+Phi phis(double z, double memo[PHI_MEMO_SIZE])
+{
+  if (z != memo[0]) {
+    const Phi p = phis(z);
+    memo[0] = z;
+    memo[1] = p.decay;
+    memo[2] = p.phi1;
+    memo[3] = p.phi2;
+  }
+  return {memo[1], memo[2], memo[3]};
+}
+
 double phi1(double z) { return phis(z).phi1; }
 
 double phi2(double z) { return phis(z).phi2; }
@@ -142,7 +154,7 @@ double dot(const double a[3], const double b[3]) { return a[0] * b[0] + a[1] * b
 }    // namespace
 
 StepCorrection drag_step_initial(const SphereDrag &drag, double mass, const double a[3],
-                                 const double u[3], double dt, double v[3], double dx[3])
+                                 const double u[3], double dt, double v[3], double dx[3], double *memo)
 {
   StepCorrection corr;
   const bool no_drag = drag.model == nullptr || (drag.scale.area <= 0.0 && drag.scale.wetted <= 0.0);
@@ -161,7 +173,8 @@ StepCorrection drag_step_initial(const SphereDrag &drag, double mass, const doub
   // set-valued points, in closed form.
   const double linear = drag.model->linear_coefficient(drag.diameter, drag.scale);
   if (linear > 0.0) {
-    const Phi p = phis(linear / mass * dt);
+    const double z = linear / mass * dt;
+    const Phi p = memo ? phis(z, memo) : phis(z);
     for (int k = 0; k < 3; ++k) {
       v[k] = u[k] + w[k] * p.decay + dt * (p.phi1 - p.phi2) * a[k];
       dx[k] = dt * (u[k] + p.phi1 * w[k] + dt * p.phi2 * a[k]);
@@ -214,14 +227,18 @@ StepCorrection drag_step_initial(const SphereDrag &drag, double mass, const doub
 
 void drag_step_final(const StepCorrection &corr, const double a[3], double v[3])
 {
+  if (corr.along == corr.across) {    // isotropic: linear drag, no drag, or held
+    for (int k = 0; k < 3; ++k) v[k] += corr.along * a[k];
+    return;
+  }
   const double a_par = dot(a, corr.dir);
   for (int k = 0; k < 3; ++k)
     v[k] += corr.along * a_par * corr.dir[k] + corr.across * (a[k] - a_par * corr.dir[k]);
 }
 
-double rotation_step_initial(double rate, const double alpha[3], double dt, double omega[3])
+double rotation_step_initial(double rate, const double alpha[3], double dt, double omega[3], double *memo)
 {
-  const Phi p = phis(rate * dt);
+  const Phi p = memo ? phis(rate * dt, memo) : phis(rate * dt);
   const double weight_now = dt * (p.phi1 - p.phi2);
   for (int k = 0; k < 3; ++k) omega[k] = omega[k] * p.decay + weight_now * alpha[k];
   return dt * p.phi2;

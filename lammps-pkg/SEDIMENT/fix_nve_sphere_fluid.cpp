@@ -19,14 +19,30 @@
 
 #include <cmath>
 #include <cstring>
+#include <limits>
 
 using namespace LAMMPS_NS;
 using namespace FixConst;
 
 static constexpr double INERTIA = 0.4;    // moment of inertia prefactor for a solid sphere
 
+// The kick of fix nve/sphere, written as it does, so that a scene without fluid is bitwise the
+// same as with fix nve/sphere. dtf = dt ftm2v / 2.
+static inline void nve_sphere_kick(double *v, double *omega, const double *f, const double *torque, double radius,
+                                   double rmass, double dtf)
+{
+  const double dtfm = dtf / rmass;
+  v[0] += dtfm * f[0];
+  v[1] += dtfm * f[1];
+  v[2] += dtfm * f[2];
+  const double dtirotate = dtf / INERTIA / (radius * radius * rmass);
+  omega[0] += dtirotate * torque[0];
+  omega[1] += dtirotate * torque[1];
+  omega[2] += dtirotate * torque[2];
+}
+
 FixNVESphereFluid::FixNVESphereFluid(LAMMPS *lmp, int narg, char **arg) :
-    Fix(lmp, narg, arg), weights(nullptr), floor_axis(-1), floor_level(0.0)
+    Fix(lmp, narg, arg), weights(nullptr), nmax_weights(0), floor_axis(-1), floor_level(0.0)
 {
   int iarg = 3;
   while (iarg < narg) {
@@ -101,6 +117,26 @@ void FixNVESphereFluid::initial_integrate(int /*vflag*/)
   for (FixFluidDrag *drag : drags) drag->prepare_step();
   counts.clear();
 
+  if (drags.empty()) {    // every fluid effect off: fix nve/sphere's step, no per-atom bookkeeping
+    const double dtf = 0.5 * dt * ftm2v;
+    int outside = 0;    // a local count: a store into the fix would alias the atom arrays
+    bool finite = true;    // a flag, not a running sum: no chain of dependent additions
+    for (int i = 0; i < nlocal; ++i)
+      if (mask[i] & groupbit) {
+        nve_sphere_kick(v[i], omega[i], f[i], torque[i], radius[i], rmass[i], dtf);
+        x[i][0] += dt * v[i][0];
+        x[i][1] += dt * v[i][1];
+        x[i][2] += dt * v[i][2];
+        if (floor_axis >= 0) settle_on_floor(i);
+        finite &= std::isfinite(state_sum(x[i], v[i]));
+        ++outside;
+      }
+    counts[OUTSIDE] = outside;
+    if (!finite) find_non_finite();
+    return;
+  }
+
+  bool finite = true;
   for (int i = 0; i < nlocal; ++i) {
     if (!(mask[i] & groupbit)) continue;
     sediment::SphereDrag sphere;
@@ -123,18 +159,15 @@ void FixNVESphereFluid::initial_integrate(int /*vflag*/)
     w[IN_FLUID] = sphere.model ? 1.0 : 0.0;
     if (!sphere.model) {
       counts[OUTSIDE] += 1.0;
-      nve_sphere_half_step(i);
-      x[i][0] += dt * v[i][0];
-      x[i][1] += dt * v[i][1];
-      x[i][2] += dt * v[i][2];
-      settle_on_floor(i);
-      check_finite(i);
+      drift_outside_fluid(i);
+      finite &= std::isfinite(state_sum(x[i], v[i]));
       continue;
     }
 
     const double a[3] = {ftm2v * f[i][0] / mass, ftm2v * f[i][1] / mass, ftm2v * f[i][2] / mass};
     double dx[3];
-    const sediment::StepCorrection corr = sediment::drag_step_initial(sphere, mass, a, flow, dt, v[i], dx);
+    const sediment::StepCorrection corr =
+        sediment::drag_step_initial(sphere, mass, a, flow, dt, v[i], dx, &w[DRAG_MEMO]);
     x[i][0] += dx[0];
     x[i][1] += dx[1];
     x[i][2] += dx[2];
@@ -144,15 +177,16 @@ void FixNVESphereFluid::initial_integrate(int /*vflag*/)
     const double inertia = INERTIA * mass * radius[i] * radius[i];
     const double alpha[3] = {ftm2v * torque[i][0] / inertia, ftm2v * torque[i][1] / inertia,
                              ftm2v * torque[i][2] / inertia};
-    w[SPIN] = sediment::rotation_step_initial(spin_rate, alpha, dt, omega[i]);
+    w[SPIN] = sediment::rotation_step_initial(spin_rate, alpha, dt, omega[i], &w[SPIN_MEMO]);
     w[ALONG] = corr.along;
     w[ACROSS] = corr.across;
     w[DIRX] = corr.dir[0];
     w[DIRY] = corr.dir[1];
     w[DIRZ] = corr.dir[2];
     settle_on_floor(i);
-    check_finite(i);
+    finite &= std::isfinite(state_sum(x[i], v[i]));
   }
+  if (!finite) find_non_finite();
 }
 
 void FixNVESphereFluid::final_integrate()
@@ -167,13 +201,22 @@ void FixNVESphereFluid::final_integrate()
   const int nlocal = atom->nlocal;
   const double ftm2v = force->ftm2v;
 
+  if (drags.empty()) {
+    const double dtf = 0.5 * update->dt * ftm2v;
+    for (int i = 0; i < nlocal; ++i)
+      if (mask[i] & groupbit) {
+        nve_sphere_kick(v[i], omega[i], f[i], torque[i], radius[i], rmass[i], dtf);
+        if (floor_axis >= 0) settle_on_floor(i);
+      }
+    return;
+  }
+
   for (int i = 0; i < nlocal; ++i) {
     if (!(mask[i] & groupbit)) continue;
     const double *w = weights[i];
     if (w[IN_FLUID] == 0.0) {
       nve_sphere_half_step(i);
       settle_on_floor(i);
-      check_finite(i);
       continue;
     }
     const double mass = rmass[i];
@@ -191,18 +234,21 @@ void FixNVESphereFluid::final_integrate()
     omega[i][1] += spin * torque[i][1];
     omega[i][2] += spin * torque[i][2];
     settle_on_floor(i);
-    check_finite(i);
   }
 }
 
-void FixNVESphereFluid::check_finite(int i) const
+void FixNVESphereFluid::find_non_finite() const
 {
-  // A NaN or inf spreads through contacts and grids without a trace: stop at the first one.
-  const double *x = atom->x[i], *v = atom->v[i], *f = atom->f[i];
-  if (std::isfinite(x[0] + x[1] + x[2] + v[0] + v[1] + v[2])) return;
-  error->one(FLERR, "Fix nve/sphere/fluid: atom {} has a non-finite position or velocity at step {} "
-             "(x {} {} {}, v {} {} {}, f {} {} {}); check the forces acting on it and the timestep",
-             atom->tag[i], update->ntimestep, x[0], x[1], x[2], v[0], v[1], v[2], f[0], f[1], f[2]);
+  // Some atom's state sum is not finite: name the first such atom (a sum of finite values can
+  // overflow; then none is named and the run goes on).
+  const int *mask = atom->mask;
+  for (int i = 0; i < atom->nlocal; ++i) {
+    if (!(mask[i] & groupbit) || std::isfinite(state_sum(atom->x[i], atom->v[i]))) continue;
+    const double *x = atom->x[i], *v = atom->v[i], *f = atom->f[i];
+    error->one(FLERR, "Fix nve/sphere/fluid: atom {} has a non-finite position or velocity at step {} "
+               "(x {} {} {}, v {} {} {}, f {} {} {}); check the forces acting on it and the timestep",
+               atom->tag[i], update->ntimestep, x[0], x[1], x[2], v[0], v[1], v[2], f[0], f[1], f[2]);
+  }
 }
 
 void FixNVESphereFluid::settle_on_floor(int i)
@@ -220,25 +266,22 @@ void FixNVESphereFluid::settle_on_floor(int i)
   omega[0] = omega[1] = omega[2] = 0.0;
 }
 
+void FixNVESphereFluid::drift_outside_fluid(int i)
+{
+  nve_sphere_half_step(i);
+  double *x = atom->x[i];
+  const double *v = atom->v[i];
+  const double dt = update->dt;
+  x[0] += dt * v[0];
+  x[1] += dt * v[1];
+  x[2] += dt * v[2];
+  settle_on_floor(i);
+}
+
 void FixNVESphereFluid::nve_sphere_half_step(int i)
 {
-  // The kick of fix nve/sphere, written as it does, so that a scene without fluid is bitwise
-  // the same as with fix nve/sphere.
-  const double dtf = 0.5 * update->dt * force->ftm2v;
-  const double dtfrotate = dtf / INERTIA;
-  const double dtfm = dtf / atom->rmass[i];
-  double *v = atom->v[i];
-  const double *f = atom->f[i];
-  v[0] += dtfm * f[0];
-  v[1] += dtfm * f[1];
-  v[2] += dtfm * f[2];
-  const double radius = atom->radius[i];
-  const double dtirotate = dtfrotate / (radius * radius * atom->rmass[i]);
-  double *omega = atom->omega[i];
-  const double *torque = atom->torque[i];
-  omega[0] += dtirotate * torque[0];
-  omega[1] += dtirotate * torque[1];
-  omega[2] += dtirotate * torque[2];
+  nve_sphere_kick(atom->v[i], atom->omega[i], atom->f[i], atom->torque[i], atom->radius[i], atom->rmass[i],
+                  0.5 * update->dt * force->ftm2v);
 }
 
 double FixNVESphereFluid::compute_vector(int n)
@@ -249,6 +292,10 @@ double FixNVESphereFluid::compute_vector(int n)
 void FixNVESphereFluid::grow_arrays(int nmax)
 {
   memory->grow(weights, nmax, NCOLS, "nve/sphere/fluid:weights");
+  // Empty memos for the new rows (a memo is used only when its z matches).
+  for (int i = nmax_weights; i < nmax; ++i)
+    weights[i][DRAG_MEMO] = weights[i][SPIN_MEMO] = std::numeric_limits<double>::quiet_NaN();
+  nmax_weights = nmax;
 }
 
 void FixNVESphereFluid::copy_arrays(int i, int j, int /*delflag*/)

@@ -38,11 +38,14 @@ class FixNVESphereFluid : public Fix {
  private:
   // Per atom, from the first half of the step to the second: weights of the new force along
   // and across the slip, the slip direction, the weight of the new torque, and whether the
-  // atom was in a fluid (outside, the step is fix nve/sphere's, operation for operation).
-  enum { ALONG, ACROSS, DIRX, DIRY, DIRZ, SPIN, IN_FLUID, NCOLS };
+  // atom was in a fluid (outside, the step is fix nve/sphere's, operation for operation); then
+  // the exponentials of the last step's translational and rotational drag (sediment::phis memos).
+  enum { ALONG, ACROSS, DIRX, DIRY, DIRZ, SPIN, IN_FLUID, DRAG_MEMO, SPIN_MEMO = DRAG_MEMO + 4, NCOLS = SPIN_MEMO + 4 };
   double **weights;
+  int nmax_weights;    // rows of weights with initialised memos
   std::vector<class FixFluidDrag *> drags;
   void nve_sphere_half_step(int i);
+  void drift_outside_fluid(int i);    // first half of fix nve/sphere's step, floor, finite check
 
   int floor_axis;         // -1: no floor
   double floor_level;     // spheres stop with their lowest point here
@@ -52,7 +55,11 @@ class FixNVESphereFluid : public Fix {
   // Cd jump, outside every fluid, and with their local solid fraction capped (hindered drag).
   enum { STUCK, AT_JUMP, OUTSIDE, CAPPED, NCOUNTS };
   RankSums<NCOUNTS> counts;
-  void check_finite(int i) const;
+  // A NaN or inf spreads through contacts and grids without a trace: the first half-step checks
+  // the sum of each atom's position and velocity (NaN and inf survive a sum) and stops at the
+  // first bad atom, before the forces and grids of the step see it.
+  static double state_sum(const double *x, const double *v) { return x[0] + x[1] + x[2] + v[0] + v[1] + v[2]; }
+  void find_non_finite() const;
 };
 
 }    // namespace LAMMPS_NS

@@ -30,6 +30,11 @@ struct Phi {
 };
 Phi phis(double z);
 
+// phis(z) remembered for the last z a sphere saw, in memo = {z, decay, phi1, phi2} (z NaN: empty).
+// With a fixed step and a linear drag z does not change, so the exponential is taken once.
+constexpr int PHI_MEMO_SIZE = 4;
+Phi phis(double z, double memo[PHI_MEMO_SIZE]);
+
 // The drag seen by one sphere during a step.
 struct SphereDrag {
   const DragModel *model = nullptr;    // nullptr: no drag (plain velocity Verlet)
@@ -49,15 +54,18 @@ struct StepCorrection {
 };
 
 // First half: advances x by dx and replaces v with the mid-step velocity, given the non-drag
-// acceleration a_n = f_n / m and the uniform fluid velocity u.
+// acceleration a_n = f_n / m and the uniform fluid velocity u. A memo (see phis) saves the
+// exponential of a linear drag from step to step.
 StepCorrection drag_step_initial(const SphereDrag &drag, double mass, const double a[3],
-                                 const double u[3], double dt, double v[3], double dx[3]);
+                                 const double u[3], double dt, double v[3], double dx[3],
+                                 double *memo = nullptr);
 
 // Second half: adds the weighted acceleration a_{n+1} = f_{n+1} / m.
 void drag_step_final(const StepCorrection &corr, const double a[3], double v[3]);
 
 // Rotation with a linear drag torque -k I omega: same ETD2 weights, isotropic.
 // Returns the weight of alpha_{n+1} for the second half (dt / 2 when k = 0).
-double rotation_step_initial(double rate, const double alpha[3], double dt, double omega[3]);
+double rotation_step_initial(double rate, const double alpha[3], double dt, double omega[3],
+                             double *memo = nullptr);
 
 }    // namespace sediment
