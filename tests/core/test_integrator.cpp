@@ -264,3 +264,22 @@ TEST(Integrator, PhiFunctionsAreSmoothAcrossTheSeriesSwitch)
     EXPECT_NEAR(phi2(z), static_cast<double>(p2), 4e-15) << z;
   }
 }
+
+TEST(Integrator, PhiMemoGivesTheSameStepAndFollowsTheRate)
+{
+  double memo[PHI_MEMO_SIZE] = {std::nan(""), 0.0, 0.0, 0.0};
+  for (double z : {0.3, 0.3, 2.0, 1e-9, 2.0}) {
+    const Phi direct = phis(z);
+    const Phi remembered = phis(z, memo);
+    EXPECT_EQ(remembered.decay, direct.decay) << z;
+    EXPECT_EQ(remembered.phi1, direct.phi1) << z;
+    EXPECT_EQ(remembered.phi2, direct.phi2) << z;
+    EXPECT_EQ(memo[0], z);
+  }
+  // A stale memo is never used for another z, even one that differs in the last bit.
+  const double z = 0.7;
+  phis(z, memo);
+  const double next = std::nextafter(z, 1.0);
+  EXPECT_EQ(phis(next, memo).decay, phis(next).decay);
+  EXPECT_EQ(memo[0], next);
+}
