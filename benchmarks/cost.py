@@ -8,14 +8,12 @@ which excludes start-up.
 from __future__ import annotations
 
 import argparse
-import re
-import subprocess
 import sys
 from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE.parent / "python"))
-from sediment.paths import lmp_executable  # noqa: E402
+from sediment.run import run_batch  # noqa: E402
 
 SCENES = {"plain": "nve/sphere + gravity (reference)",
           "bare": "nve/sphere/fluid + gravity, no fluid fixes (every effect off)",
@@ -27,10 +25,7 @@ SCENES = {"plain": "nve/sphere + gravity (reference)",
 
 
 def loop_time(scene: str, particles: int, steps: int) -> float:
-    out = subprocess.run([lmp_executable(), "-in", str(HERE / "in.cost"), "-log", "none", "-nocite",
-                          "-var", "scene", scene, "-var", "n", str(particles), "-var", "steps", str(steps)],
-                         capture_output=True, text=True, check=True).stdout
-    return float(re.search(r"Loop time of ([0-9.eE+-]+)", out).group(1))
+    return run_batch(HERE / "in.cost", {"scene": scene, "n": particles, "steps": steps}).loops[0][0]
 
 
 def main() -> None:

@@ -17,7 +17,6 @@ import re
 import resource
 import sys
 import tempfile
-import time
 from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
@@ -42,13 +41,9 @@ def truncated(deck: Path, stages: int) -> Path:
 
 def measure(deck: Path, ranks: int, total_steps: int) -> dict[str, float]:
     peak_before = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss
-    start = time.monotonic()
     out = run_batch(deck, ranks=ranks)
-    wall = time.monotonic() - start
     peak = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss    # kB, largest child so far
-    loops = [(float(t), int(n)) for t, n in re.findall(r"^Loop time of ([0-9.eE+-]+) on \d+ procs for (\d+) steps",
-                                                        out.text, re.MULTILINE)]
-    loop, steps = sum(t for t, _ in loops), sum(n for _, n in loops)
+    loop, steps, wall = sum(t for t, _ in out.loops), sum(n for _, n in out.loops), out.wall_seconds
     memory = max(float(m) for m in re.findall(r"memory allocation \(min/avg/max\) = [0-9.]+ \| [0-9.]+ \| ([0-9.]+) Mbytes",
                                               out.text))
     setup = wall - loop

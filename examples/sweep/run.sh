@@ -11,7 +11,9 @@ out=${1:-out/sweep}
 studies=${*:-case-a sphere paste scene}
 mkdir -p "$out"
 
-field() {   # field N of the line of `sediment terminal` output matching a pattern
+field() {   # field() PATTERN N TERMINAL-OPTIONS: field N of the `sediment terminal` line matching PATTERN
+    pattern=$1 n=$2
+    shift 2
     "$sediment" terminal "$@" | awk -v p="$pattern" -v n="$n" '$0 ~ p {print $n}'
 }
 
@@ -25,14 +27,13 @@ for study in $studies; do
     sphere)     # case C: 19 mm sphere (6513 kg/m3) in suspension 1, zhang-li law
         sphere="--law zhang-li --diameter 0.019 --particle-density 6513 --fluid-density 1280 --viscosity 0.0131
                 --yield-stress 30.5 --youngs-modulus 200e9"
-        pattern="terminal velocity" n=3; v_t=$(field $sphere)
-        pattern="Rayleigh time" n=3; t_r=$(field $sphere)
+        v_t=$(field "terminal velocity" 3 $sphere)
+        t_r=$(field "Rayleigh time" 3 $sphere)
         "$sediment" sweep "$examples/valentik_whitmore/in.sphere" --out "$out/sphere" --var t_end 9 \
             --dt 1e-5,1e-4,1e-3,3e-3,1e-2,3e-2,0.1,0.2 --observe speed distance --reference "speed=$v_t" \
             --rayleigh "$t_r" --title "Case C: 19 mm sphere in clay suspension 1 (9 s)" ;;
     paste)      # case D: 12.6 mm steel ball from 255 mm into paste, settling distance
-        pattern="Rayleigh time" n=3
-        t_r=$(field --diameter 0.0126 --particle-density 8135 --viscosity 0.7 --youngs-modulus 200e9)
+        t_r=$(field "Rayleigh time" 3 --diameter 0.0126 --particle-density 8135 --viscosity 0.7 --youngs-modulus 200e9)
         "$sediment" sweep "$examples/paste/in.ball_in_paste" --out "$out/paste" \
             --dt 1e-6,2e-6,5e-6,1e-5,2e-5,5e-5,1e-4,2e-4,5e-4,1e-3 --observe depth \
             --rayleigh "$t_r" --title "Case D: 12.6 mm ball from 255 mm into paste" ;;

@@ -41,6 +41,16 @@ static inline void nve_sphere_kick(double *v, double *omega, const double *f, co
   omega[2] += dtirotate * torque[2];
 }
 
+// The first half of fix nve/sphere's step: kick, then drift over the whole step.
+static inline void nve_sphere_kick_drift(double *x, double *v, double *omega, const double *f, const double *torque,
+                                         double radius, double rmass, double dtf, double dt)
+{
+  nve_sphere_kick(v, omega, f, torque, radius, rmass, dtf);
+  x[0] += dt * v[0];
+  x[1] += dt * v[1];
+  x[2] += dt * v[2];
+}
+
 FixNVESphereFluid::FixNVESphereFluid(LAMMPS *lmp, int narg, char **arg) :
     Fix(lmp, narg, arg), weights(nullptr), nmax_weights(0), floor_axis(-1), floor_level(0.0)
 {
@@ -117,17 +127,14 @@ void FixNVESphereFluid::initial_integrate(int /*vflag*/)
   for (FixFluidDrag *drag : drags) drag->prepare_step();
   counts.clear();
 
+  const double dtf = 0.5 * dt * ftm2v;
   if (drags.empty()) {    // every fluid effect off: fix nve/sphere's step, no per-atom bookkeeping
-    const double dtf = 0.5 * dt * ftm2v;
     int outside = 0;    // a local count: a store into the fix would alias the atom arrays
     bool finite = true;    // a flag, not a running sum: no chain of dependent additions
     for (int i = 0; i < nlocal; ++i)
       if (mask[i] & groupbit) {
-        nve_sphere_kick(v[i], omega[i], f[i], torque[i], radius[i], rmass[i], dtf);
-        x[i][0] += dt * v[i][0];
-        x[i][1] += dt * v[i][1];
-        x[i][2] += dt * v[i][2];
-        if (floor_axis >= 0) settle_on_floor(i);
+        nve_sphere_kick_drift(x[i], v[i], omega[i], f[i], torque[i], radius[i], rmass[i], dtf, dt);
+        settle_on_floor(i);
         finite &= std::isfinite(state_sum(x[i], v[i]));
         ++outside;
       }
@@ -159,7 +166,8 @@ void FixNVESphereFluid::initial_integrate(int /*vflag*/)
     w[IN_FLUID] = sphere.model ? 1.0 : 0.0;
     if (!sphere.model) {
       counts[OUTSIDE] += 1.0;
-      drift_outside_fluid(i);
+      nve_sphere_kick_drift(x[i], v[i], omega[i], f[i], torque[i], radius[i], rmass[i], dtf, dt);
+      settle_on_floor(i);
       finite &= std::isfinite(state_sum(x[i], v[i]));
       continue;
     }
@@ -201,12 +209,12 @@ void FixNVESphereFluid::final_integrate()
   const int nlocal = atom->nlocal;
   const double ftm2v = force->ftm2v;
 
+  const double dtf = 0.5 * update->dt * ftm2v;
   if (drags.empty()) {
-    const double dtf = 0.5 * update->dt * ftm2v;
     for (int i = 0; i < nlocal; ++i)
       if (mask[i] & groupbit) {
         nve_sphere_kick(v[i], omega[i], f[i], torque[i], radius[i], rmass[i], dtf);
-        if (floor_axis >= 0) settle_on_floor(i);
+        settle_on_floor(i);
       }
     return;
   }
@@ -215,7 +223,7 @@ void FixNVESphereFluid::final_integrate()
     if (!(mask[i] & groupbit)) continue;
     const double *w = weights[i];
     if (w[IN_FLUID] == 0.0) {
-      nve_sphere_half_step(i);
+      nve_sphere_kick(v[i], omega[i], f[i], torque[i], radius[i], rmass[i], dtf);
       settle_on_floor(i);
       continue;
     }
@@ -264,24 +272,6 @@ void FixNVESphereFluid::settle_on_floor(int i)
   v[0] = v[1] = v[2] = 0.0;
   double *omega = atom->omega[i];
   omega[0] = omega[1] = omega[2] = 0.0;
-}
-
-void FixNVESphereFluid::drift_outside_fluid(int i)
-{
-  nve_sphere_half_step(i);
-  double *x = atom->x[i];
-  const double *v = atom->v[i];
-  const double dt = update->dt;
-  x[0] += dt * v[0];
-  x[1] += dt * v[1];
-  x[2] += dt * v[2];
-  settle_on_floor(i);
-}
-
-void FixNVESphereFluid::nve_sphere_half_step(int i)
-{
-  nve_sphere_kick(atom->v[i], atom->omega[i], atom->f[i], atom->torque[i], atom->radius[i], atom->rmass[i],
-                  0.5 * update->dt * force->ftm2v);
 }
 
 double FixNVESphereFluid::compute_vector(int n)

@@ -44,8 +44,6 @@ class FixNVESphereFluid : public Fix {
   double **weights;
   int nmax_weights;    // rows of weights with initialised memos
   std::vector<class FixFluidDrag *> drags;
-  void nve_sphere_half_step(int i);
-  void drift_outside_fluid(int i);    // first half of fix nve/sphere's step, floor, finite check
 
   int floor_axis;         // -1: no floor
   double floor_level;     // spheres stop with their lowest point here

@@ -6,6 +6,7 @@ the steps, which cost alike whatever the time step."""
 from __future__ import annotations
 
 import os
+import re
 import subprocess
 import sys
 import time
@@ -85,6 +86,12 @@ class DeckOutput:
     wall_seconds: float
     samples: np.ndarray
     results: dict[str, float] = field(default_factory=dict)
+
+    @property
+    def loops(self) -> list[tuple[float, int]]:
+        """(seconds, steps) of each run command, from LAMMPS's "Loop time of" lines (start-up excluded)."""
+        return [(float(t), int(n)) for t, n in re.findall(r"^Loop time of ([0-9.eE+-]+) on \d+ procs for (\d+) steps",
+                                                          self.text, re.MULTILINE)]
 
     @property
     def error(self) -> str | None:

@@ -23,7 +23,7 @@ TIME_STEPS = (1e-5, 1e-4, 1e-3, 1.5e-3, 2.5e-3, 4e-3, 1e-2)
 
 
 def exact_velocity(t: np.ndarray) -> np.ndarray:
-    return TERMINAL_VELOCITY * (1.0 - np.exp(-t / RELAXATION_TIME))
+    return sweep.evaluate_reference(REFERENCE["velocity"], t)
 
 
 def case_a_sweep(time_steps=TIME_STEPS, integrators=("implicit", "explicit"), t_end: float = 0.04,

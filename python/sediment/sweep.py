@@ -197,8 +197,7 @@ def run_sweep(deck: Path, values: list[float], observables: list[str], integrato
             layers_file.unlink(missing_ok=True)
             run_vars["layers_file"] = str(layers_file)
         out = run_batch(deck, run_vars, ranks=ranks, check=False)
-        loop = sum(float(t) for t in re.findall(r"^Loop time of ([0-9.eE+-]+)", out.text, re.MULTILINE))
-        run = SweepRun(integrator, value, loop, out.wall_seconds)
+        run = SweepRun(integrator, value, sum(t for t, _ in out.loops), out.wall_seconds)
         if out.error:
             run.failure = out.error
         else:
