@@ -2,6 +2,7 @@
 
 #include "sediment/geometry.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -98,7 +99,7 @@ Exponent di_felice_exponent(double re)
 }
 
 DragModel::DragModel(DragLaw law, const Fluid &fluid, HindranceBuoyancy buoyancy) :
-    law_(law), fluid_(fluid), hindrance_offset_(buoyancy == HindranceBuoyancy::Plain ? 1.0 : 0.0)
+    law_(law), hindrance_offset_(buoyancy == HindranceBuoyancy::Plain ? 1.0 : 0.0), fluid_(fluid)
 {
 }
 
@@ -194,6 +195,17 @@ int DragModel::jumps(double d, std::array<ForceJump, max_jumps> &out, DragScale 
 double relaxation_time(const DragModel &model, double d, double particle_density)
 {
   return particle_density * sphere_volume(d) / model.tangent(d, 0.0);
+}
+
+double explicit_step_limit(const DragModel &model, double d, double speed, double mass, DragScale scale)
+{
+  const double slope = std::max(model.tangent(d, speed, scale), model.tangent(d, 0.0, scale));
+  return 2.0 * mass / slope;
+}
+
+double rotation_drag_rate(double viscosity, double d, double mass, double wetted)
+{
+  return wetted * pi * viscosity * d * d * d / sphere_inertia(mass, 0.5 * d);
 }
 
 }    // namespace sediment

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-2.0-or-later
 /* ----------------------------------------------------------------------
    SEDIMENT package: compute concentration/grid
 ------------------------------------------------------------------------- */
@@ -19,6 +20,16 @@
 
 using namespace LAMMPS_NS;
 
+namespace {
+// Values per cell: the total, one per size class (edges + 1), one per atom type.
+int ncols_for(size_t nedges, int ntypes)
+{
+  return 1 + (nedges == 0 ? 0 : static_cast<int>(nedges) + 1) + ntypes;
+}
+// The largest grid (cells x columns) a rank allocates: 2e8 values, 4.8 GB in its three copies.
+constexpr double max_grid_values = 2e8;
+}    // namespace
+
 ComputeConcentrationGrid::ComputeConcentrationGrid(LAMMPS *lmp, int narg, char **arg) :
     Compute(lmp, narg, arg), axis(-1), counts{0, 0, 0}, has_bounds(0), bounds{}, ncentres(0), by_type(0),
     thickness(0.0), smooth_width(0.0), weight_index(-1), ncols(1), grid{}, cell_volume(1.0), profiled_step(-1),
@@ -26,72 +37,56 @@ ComputeConcentrationGrid::ComputeConcentrationGrid(LAMMPS *lmp, int narg, char *
 {
   const int dimension = domain->dimension;
   int nbounds = 0;
-  int iarg = 3;
-  while (iarg < narg) {
-    const char *keyword = arg[iarg];
-    if (strcmp(keyword, "layers") == 0 || strcmp(keyword, "cells") == 0) {
-      if (counts[0] > 0) error->all(FLERR, "Compute concentration/grid: give either 'layers' or 'cells', once");
-      if (keyword[0] == 'l') {
-        if (iarg + 2 >= narg) error->all(FLERR, "Compute concentration/grid: 'layers' needs an axis and a count");
-        const char *dim = arg[iarg + 1];
-        axis = sediment_axis(dim);
-        if (axis < 0) error->all(FLERR, "Compute concentration/grid: layer axis must be x, y or z, not '{}'", dim);
+  StyleArgs args(lmp, "Compute concentration/grid", narg, arg, 3);
+  while (args.more()) {
+    int nvalues = 1;
+    if (args.is("layers") || args.is("cells")) {
+      if (counts[0] > 0) args.fail("give either 'layers' or 'cells', once");
+      if (args.is("layers")) {
+        args.need(2, "an axis and a count");
+        axis = args.axis(1, "layer axis");
         counts[0] = counts[1] = counts[2] = 1;
-        counts[axis] = utils::inumeric(FLERR, arg[iarg + 2], false, lmp);
-        iarg += 3;
+        counts[axis] = args.whole(2);
+        nvalues = 2;
       } else {
-        if (iarg + dimension >= narg)
-          error->all(FLERR, "Compute concentration/grid: 'cells' needs {} counts in a {}d simulation", dimension, dimension);
+        if (!args.has(dimension))
+          args.fail("'cells' needs {} counts in a {}d simulation", dimension, dimension);
         counts[2] = 1;
-        for (int d = 0; d < dimension; ++d) counts[d] = utils::inumeric(FLERR, arg[iarg + 1 + d], false, lmp);
-        iarg += 1 + dimension;
+        for (int d = 0; d < dimension; ++d) counts[d] = args.whole(1 + d);
+        nvalues = dimension;
       }
       for (int d = 0; d < 3; ++d)
-        if (counts[d] < 1) error->all(FLERR, "Compute concentration/grid: numbers of layers or cells must be >= 1");
-    } else if (strcmp(keyword, "bounds") == 0) {
-      // LO HI along the layer axis, or xlo xhi ylo yhi [zlo zhi] for cells; read after the grid.
-      while (iarg + 1 + nbounds < narg && utils::is_double(arg[iarg + 1 + nbounds]) && nbounds < 2 * dimension) {
-        bounds[nbounds / 2][nbounds % 2] = utils::numeric(FLERR, arg[iarg + 1 + nbounds], false, lmp);
-        if (!std::isfinite(bounds[nbounds / 2][nbounds % 2]))
-          error->all(FLERR, "Compute concentration/grid: bounds must be finite");
-        ++nbounds;
-      }
+        if (counts[d] < 1) args.fail("numbers of layers or cells must be >= 1");
+    } else if (args.is("bounds")) {
+      // LO HI along the layer axis, or xlo xhi ylo yhi [zlo zhi] for cells; checked after the grid.
+      nbounds = std::min(args.numbers_after(), 2 * dimension);
+      for (int k = 0; k < nbounds; ++k) bounds[k / 2][k % 2] = args.number(1 + k);
       has_bounds = 1;
-      iarg += 1 + nbounds;
-    } else if (strcmp(keyword, "classes") == 0) {
-      ++iarg;
-      while (iarg < narg && utils::is_double(arg[iarg]))
-        class_edges.push_back(utils::numeric(FLERR, arg[iarg++], false, lmp));
-      if (class_edges.empty())
-        error->all(FLERR, "Compute concentration/grid: 'classes' needs at least one diameter");
+      nvalues = nbounds;
+    } else if (args.is("classes")) {
+      nvalues = args.numbers_after();
+      if (nvalues == 0) args.fail("'classes' needs at least one diameter");
+      for (int k = 1; k <= nvalues; ++k) class_edges.push_back(args.number(k));
       for (size_t k = 0; k < class_edges.size(); ++k)
-        if (!(class_edges[k] > 0.0) || !std::isfinite(class_edges[k]) ||
-            (k > 0 && !(class_edges[k] > class_edges[k - 1])))
-          error->all(FLERR, "Compute concentration/grid: class diameters must be finite, positive and increasing");
-    } else if (strcmp(keyword, "types") == 0) {
-      if (iarg + 1 >= narg) error->all(FLERR, "Compute concentration/grid: 'types' needs yes or no");
-      if (strcmp(arg[iarg + 1], "yes") == 0) by_type = 1;
-      else if (strcmp(arg[iarg + 1], "no") == 0) by_type = 0;
-      else error->all(FLERR, "Compute concentration/grid: types must be yes or no, not '{}'", arg[iarg + 1]);
-      iarg += 2;
-    } else if (strcmp(keyword, "thickness") == 0) {
-      if (iarg + 1 >= narg) error->all(FLERR, "Compute concentration/grid: 'thickness' needs a value");
-      thickness = sediment_positive(lmp, arg[iarg + 1], "Compute concentration/grid: thickness");
-      iarg += 2;
-    } else if (strcmp(keyword, "smooth") == 0) {
-      if (iarg + 1 >= narg) error->all(FLERR, "Compute concentration/grid: 'smooth' needs a width");
-      smooth_width = sediment_positive(lmp, arg[iarg + 1], "Compute concentration/grid: smooth width");
-      iarg += 2;
-    } else if (strcmp(keyword, "weight") == 0) {
-      if (iarg + 1 >= narg || strncmp(arg[iarg + 1], "d_", 2) != 0 || !arg[iarg + 1][2])
-        error->all(FLERR, "Compute concentration/grid: 'weight' needs a per-atom property d_NAME "
-                          "(fix property/atom d_NAME)");
-      weight_name = arg[iarg + 1] + 2;
-      iarg += 2;
+        if (!(class_edges[k] > 0.0) || (k > 0 && !(class_edges[k] > class_edges[k - 1])))
+          args.fail("class diameters must be finite, positive and increasing");
+    } else if (args.is("types")) {
+      args.need(1, "yes or no");
+      by_type = args.yes_no(1);
+    } else if (args.is("thickness")) {
+      args.need(1, "a value");
+      thickness = args.positive(1, "thickness");
+    } else if (args.is("smooth")) {
+      args.need(1, "a width");
+      smooth_width = args.positive(1, "smooth width");
+    } else if (args.is("weight")) {
+      if (!args.has(1) || strncmp(args.text(1), "d_", 2) != 0 || !args.text(1)[2])
+        args.fail("'weight' needs a per-atom property d_NAME (fix property/atom d_NAME)");
+      weight_name = args.text(1) + 2;
     } else {
-      error->all(FLERR, "Compute concentration/grid: unknown keyword '{}' (expected layers, cells, bounds, "
-                        "classes, types, thickness, smooth or weight)", keyword);
+      args.unknown("layers, cells, bounds, classes, types, thickness, smooth or weight");
     }
+    args.next(nvalues);
   }
   if (counts[0] == 0)
     error->all(FLERR, "Compute concentration/grid: the grid is required: 'layers AXIS N' or 'cells NX NY{}'",
@@ -118,8 +113,15 @@ ComputeConcentrationGrid::ComputeConcentrationGrid(LAMMPS *lmp, int narg, char *
 
   for (int d = 0; d < 3; ++d) grid.resolved[d] = axis >= 0 ? d == axis : d < dimension;
   ncentres = axis >= 0 ? 1 : dimension;
+  ncols = ncols_for(class_edges.size(), by_type ? atom->ntypes : 0);
+  // Every rank holds the whole grid three times (local sums, their reduction, the output array):
+  // refuse sizes that cannot be held instead of failing in the allocator or overflowing the index.
+  const double values = static_cast<double>(counts[0]) * counts[1] * counts[2] * ncols;
+  if (values > max_grid_values)
+    error->all(FLERR, "Compute concentration/grid: {}x{}x{} cells x {} columns is more than {:.0e} values "
+               "(about {:.0f} GB per rank); use fewer layers, cells or classes", counts[0], counts[1], counts[2],
+               ncols, max_grid_values, 3.0 * values * sizeof(double) / 1e9);
   const int ncells = counts[0] * counts[1] * counts[2];
-  ncols = 1 + (class_edges.empty() ? 0 : static_cast<int>(class_edges.size()) + 1) + (by_type ? atom->ntypes : 0);
   array_flag = 1;
   size_array_rows = ncells;
   size_array_cols = ncentres + ncols;
@@ -171,15 +173,12 @@ double ComputeConcentrationGrid::cross_section() const
   return axis < 0 ? 0.0 : extent((axis + 1) % 3) * extent((axis + 2) % 3);
 }
 
-Compute *ComputeConcentrationGrid::find_fraction(LAMMPS *lmp, const char *reference, const char *caller)
+Compute *ComputeConcentrationGrid::find_fraction(LAMMPS *lmp, const char *reference, const std::string &caller)
 {
-  const char *name = strncmp(reference, "c_", 2) == 0 ? reference + 2 : reference;
-  const int icompute = lmp->modify->find_compute(name);
-  if (icompute < 0) lmp->error->all(FLERR, "Fix {}: compute '{}' does not exist", caller, name);
-  Compute *compute = lmp->modify->compute[icompute];
+  Compute *compute = sediment_find_compute(lmp, reference, caller);
   if (!compute->peratom_flag || compute->size_peratom_cols != 0)
-    lmp->error->all(FLERR, "Fix {}: compute '{}' does not give a per-atom vector of solid fractions "
-                           "(use compute concentration/grid)", caller, name);
+    lmp->error->all(FLERR, "{}: compute '{}' does not give a per-atom vector of solid fractions "
+                           "(use compute concentration/grid)", caller, compute->id);
   return compute;
 }
 

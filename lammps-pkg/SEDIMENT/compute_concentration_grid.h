@@ -33,7 +33,7 @@ class ComputeConcentrationGrid : public Compute {
 
   // The compute `reference` (c_ID or ID) giving a per-atom vector of solid fractions, checked;
   // errors name the style asking.
-  static Compute *find_fraction(class LAMMPS *lmp, const char *reference, const char *caller);
+  static Compute *find_fraction(class LAMMPS *lmp, const char *reference, const std::string &caller);
 
   // For fix layers/hdf5: the layers (when the grid is layers), the names of the fraction
   // columns, the class edges.

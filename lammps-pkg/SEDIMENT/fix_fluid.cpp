@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-2.0-or-later
 /* ----------------------------------------------------------------------
    SEDIMENT package: fix fluid
 ------------------------------------------------------------------------- */
@@ -26,77 +27,64 @@ FixFluid::FixFluid(LAMMPS *lmp, int narg, char **arg) :
   surface_normal[2] = 1.0;
 
   bool has_density = false, has_viscosity = false, has_bingham = false;
-  int iarg = 3;
-  auto need = [&](int n, const char *keyword) {
-    if (iarg + n >= narg)
-      error->all(FLERR, "Fix fluid: keyword '{}' needs {} value(s)", keyword, n);
-  };
-  while (iarg < narg) {
-    const char *keyword = arg[iarg];
-    if (strcmp(keyword, "density") == 0) {
-      need(1, keyword);
-      fluid.density = sediment_positive(lmp, arg[iarg + 1], "Fix fluid: density");
+  StyleArgs args(lmp, "Fix fluid", narg, arg, 3);
+  while (args.more()) {
+    int nvalues = 1;
+    if (args.is("density")) {
+      args.need(1, "1 value");
+      fluid.density = args.positive(1, "density");
       has_density = true;
-      iarg += 2;
-    } else if (strcmp(keyword, "viscosity") == 0) {
-      need(1, keyword);
-      fluid.viscosity = sediment_positive(lmp, arg[iarg + 1], "Fix fluid: viscosity");
+    } else if (args.is("viscosity")) {
+      args.need(1, "1 value");
+      fluid.viscosity = args.positive(1, "viscosity");
       has_viscosity = true;
-      iarg += 2;
-    } else if (strcmp(keyword, "bingham") == 0) {
-      need(2, keyword);
-      fluid.yield_stress = sediment_positive(lmp, arg[iarg + 1], "Fix fluid: bingham yield stress",
-                                             " (use viscosity for a Newtonian fluid)");
-      fluid.viscosity = sediment_positive(lmp, arg[iarg + 2], "Fix fluid: bingham plastic viscosity");
+    } else if (args.is("bingham")) {
+      args.need(2, "2 values");
+      fluid.yield_stress = args.positive(1, "bingham yield stress", " (use viscosity for a Newtonian fluid)");
+      fluid.viscosity = args.positive(2, "bingham plastic viscosity");
       has_bingham = true;
-      iarg += 3;
-    } else if (strcmp(keyword, "surface") == 0) {
-      need(2, keyword);
-      const char *axis = arg[iarg + 1];
+      nvalues = 2;
+    } else if (args.is("surface")) {
+      args.need(2, "an axis and a position, or plane and a point and a normal");
       double normal[3] = {0.0, 0.0, 0.0};
-      if (strcmp(axis, "plane") == 0) {
-        need(7, "surface plane");
+      if (strcmp(args.text(1), "plane") == 0) {
+        args.need(7, "plane, a point and a normal");
         double point[3];
-        for (int k = 0; k < 3; ++k) point[k] = utils::numeric(FLERR, arg[iarg + 2 + k], false, lmp);
-        for (int k = 0; k < 3; ++k) normal[k] = utils::numeric(FLERR, arg[iarg + 5 + k], false, lmp);
+        for (int k = 0; k < 3; ++k) point[k] = args.number(2 + k);
+        for (int k = 0; k < 3; ++k) normal[k] = args.number(5 + k);
         const double len = sqrt(normal[0] * normal[0] + normal[1] * normal[1] + normal[2] * normal[2]);
-        if (!(len > 0.0) || !std::isfinite(len))
-          error->all(FLERR, "Fix fluid: surface plane normal must be finite and non-zero");
+        if (!(len > 0.0)) args.fail("surface plane normal must be finite and non-zero");
         surface_offset = 0.0;
         for (int k = 0; k < 3; ++k) {
           normal[k] /= len;
           surface_offset += point[k] * normal[k];
         }
-        iarg += 8;
+        nvalues = 7;
       } else {
-        const int dim = sediment_axis(axis);
-        if (dim < 0)
-          error->all(FLERR, "Fix fluid: surface axis must be x, y, z or plane, not '{}'", axis);
+        const int dim = sediment_axis(args.text(1));
+        if (dim < 0) args.fail("surface axis must be x, y, z or plane, not '{}'", args.text(1));
         normal[dim] = 1.0;
-        surface_offset = utils::numeric(FLERR, arg[iarg + 2], false, lmp);
-        iarg += 3;
+        surface_offset = args.number(2);
+        nvalues = 2;
       }
       for (int k = 0; k < 3; ++k) surface_normal[k] = normal[k];
       has_surface = 1;
-    } else if (strcmp(keyword, "region") == 0) {
-      need(1, keyword);
+    } else if (args.is("region")) {
+      args.need(1, "a region ID");
       delete[] region_id;
-      region_id = utils::strdup(arg[iarg + 1]);
-      iarg += 2;
-    } else if (strcmp(keyword, "velocity") == 0) {
-      need(3, keyword);
-      for (int k = 0; k < 3; ++k) flow[k] = utils::numeric(FLERR, arg[iarg + 1 + k], false, lmp);
-      iarg += 4;
+      region_id = utils::strdup(args.text(1));
+    } else if (args.is("velocity")) {
+      args.need(3, "3 values");
+      for (int k = 0; k < 3; ++k) flow[k] = args.number(1 + k);
+      nvalues = 3;
     } else {
-      error->all(FLERR, "Fix fluid: unknown keyword '{}' (expected density, viscosity, bingham, "
-                        "surface, region or velocity)", keyword);
+      args.unknown("density, viscosity, bingham, surface, region or velocity");
     }
+    args.next(nvalues);
   }
   if (!has_density) error->all(FLERR, "Fix fluid: keyword 'density' is required");
   if (has_viscosity == has_bingham)
     error->all(FLERR, "Fix fluid: give exactly one of 'viscosity MU' or 'bingham TAU_Y ETA_B'");
-  for (int k = 0; k < 3; ++k)
-    if (!std::isfinite(flow[k])) error->all(FLERR, "Fix fluid: velocity must be finite");
   if (has_surface && !std::isfinite(surface_offset))
     error->all(FLERR, "Fix fluid: surface position must be finite");
   if (domain->dimension == 2 && has_surface && surface_normal[2] != 0.0)
@@ -141,13 +129,7 @@ sediment::Submergence FixFluid::immersion(const double *x, double radius) const
   return sediment::submergence(radius, height);
 }
 
-FixFluid *FixFluid::find(LAMMPS *lmp, const char *fluid_id, const char *caller)
+FixFluid *FixFluid::find(LAMMPS *lmp, const char *fluid_id, const std::string &caller)
 {
-  const int ifix = lmp->modify->find_fix(fluid_id);
-  if (ifix < 0) lmp->error->all(FLERR, "{}: fluid fix '{}' does not exist", caller, fluid_id);
-  auto fluid = dynamic_cast<FixFluid *>(lmp->modify->fix[ifix]);
-  if (!fluid)
-    lmp->error->all(FLERR, "{}: fix '{}' is a fix {}, not a fix fluid", caller, fluid_id,
-                    lmp->modify->fix[ifix]->style);
-  return fluid;
+  return sediment_find_fix<FixFluid>(lmp, fluid_id, "fluid", caller, "fluid");
 }

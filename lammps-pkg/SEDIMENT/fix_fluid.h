@@ -14,6 +14,8 @@ FixStyle(fluid,FixFluid);
 
 #include "fix.h"
 
+#include <string>
+
 #include "sediment/drag.hpp"
 #include "sediment/geometry.hpp"
 
@@ -37,7 +39,7 @@ class FixFluid : public Fix {
 
   // Finds fix ID `fluid_id` and checks that it is a fix fluid; `caller` names the style asking
   // ("Fix fluid/drag", "Pair lubricate/fluid").
-  static FixFluid *find(class LAMMPS *lmp, const char *fluid_id, const char *caller);
+  static FixFluid *find(class LAMMPS *lmp, const char *fluid_id, const std::string &caller);
 
  private:
   sediment::Fluid fluid;

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-2.0-or-later
 /* ----------------------------------------------------------------------
    SEDIMENT package: fix fluid/buoyancy
    F = -rho_f V_sub g, with V_sub the volume below the fluid's free surface.
@@ -26,23 +27,23 @@ FixFluidBuoyancy::FixFluidBuoyancy(LAMMPS *lmp, int narg, char **arg) :
 {
   if (narg < 4) error->all(FLERR, "Fix fluid/buoyancy: expected 'fix ID group fluid/buoyancy FLUID-ID'");
   fluid_id = utils::strdup(arg[3]);
-  int iarg = 4;
-  while (iarg < narg) {
-    if (strcmp(arg[iarg], "gravity") == 0) {
-      if (iarg + 1 >= narg) error->all(FLERR, "Fix fluid/buoyancy: keyword 'gravity' needs a fix ID");
+  StyleArgs args(lmp, "Fix fluid/buoyancy", narg, arg, 4);
+  while (args.more()) {
+    int nvalues = 1;
+    if (args.is("gravity")) {
+      args.need(1, "a fix ID");
       delete[] gravity_id;
-      gravity_id = utils::strdup(arg[iarg + 1]);
-      iarg += 2;
-    } else if (strcmp(arg[iarg], "mixture") == 0) {
-      if (iarg + 2 >= narg)
-        error->all(FLERR, "Fix fluid/buoyancy: keyword 'mixture' needs c_ID and the solid density");
+      gravity_id = utils::strdup(args.text(1));
+    } else if (args.is("mixture")) {
+      args.need(2, "c_ID and the solid density");
       delete[] mixture_id;
-      mixture_id = utils::strdup(arg[iarg + 1]);
-      solid_density = sediment_positive(lmp, arg[iarg + 2], "Fix fluid/buoyancy: mixture solid density");
-      iarg += 3;
+      mixture_id = utils::strdup(args.text(1));
+      solid_density = args.positive(2, "mixture solid density");
+      nvalues = 2;
     } else {
-      error->all(FLERR, "Fix fluid/buoyancy: unknown keyword '{}' (expected gravity or mixture)", arg[iarg]);
+      args.unknown("gravity or mixture");
     }
+    args.next(nvalues);
   }
   if (!atom->radius_flag)
     error->all(FLERR, "Fix fluid/buoyancy requires atom attribute radius (atom_style sphere)");
@@ -69,27 +70,19 @@ void FixFluidBuoyancy::init()
 {
   fluid = FixFluid::find(lmp, fluid_id, "Fix fluid/buoyancy");
 
+  const std::string caller = "Fix fluid/buoyancy";
   Fix *gravity_fix = nullptr;
   if (gravity_id) {
-    const int ifix = modify->find_fix(gravity_id);
-    if (ifix < 0) error->all(FLERR, "Fix fluid/buoyancy: gravity fix '{}' does not exist", gravity_id);
-    gravity_fix = modify->fix[ifix];
-    if (strcmp(gravity_fix->style, "gravity") != 0)
-      error->all(FLERR, "Fix fluid/buoyancy: fix '{}' is a fix {}, not a fix gravity", gravity_id,
-                 gravity_fix->style);
+    gravity_fix = sediment_find_fix<Fix>(lmp, gravity_id, "gravity", caller, "gravity");
   } else {
-    for (int i = 0; i < modify->nfix; ++i) {
-      if (strcmp(modify->fix[i]->style, "gravity") != 0) continue;
-      if (gravity_fix)
-        error->all(FLERR, "Fix fluid/buoyancy: several fix gravity are defined; choose one with "
-                          "keyword 'gravity'");
-      gravity_fix = modify->fix[i];
-    }
-    if (!gravity_fix)
-      error->all(FLERR, "Fix fluid/buoyancy needs a fix gravity to know the direction and "
-                        "strength of gravity");
+    const auto gravities = sediment_fixes_of_style(lmp, "gravity");
+    if (gravities.size() > 1)
+      error->all(FLERR, "Fix fluid/buoyancy: several fix gravity are defined; choose one with keyword 'gravity'");
+    if (gravities.empty())
+      error->all(FLERR, "Fix fluid/buoyancy needs a fix gravity to know the direction and strength of gravity");
+    gravity_fix = gravities.front();
   }
-  mixture = mixture_id ? ComputeConcentrationGrid::find_fraction(lmp, mixture_id, "fluid/buoyancy") : nullptr;
+  mixture = mixture_id ? ComputeConcentrationGrid::find_fraction(lmp, mixture_id, caller) : nullptr;
   int dim = 0;
   gravity = static_cast<double *>(gravity_fix->extract("gvec", dim));
   if (!gravity) error->all(FLERR, "Fix fluid/buoyancy: fix gravity does not expose its vector");
@@ -116,9 +109,9 @@ void FixFluidBuoyancy::post_force(int /*vflag*/)
     if (!(mask[i] & groupbit)) continue;
     const sediment::Submergence sub = fluid->immersion(x[i], radius[i]);
     if (!sub.any()) continue;
-    // Suspension density rho_f + (rho_s - rho_f) phi around the sphere, or the clear fluid's.
-    const double density = mixture ? rho + (solid_density - rho) * mixture->vector_atom[i] : rho;
-    const double displaced = density * sub.volume * sediment::sphere_volume(2.0 * radius[i]);
+    // The suspension around the sphere, or the clear fluid.
+    const double density = mixture ? sediment::mixture_density(rho, solid_density, mixture->vector_atom[i]) : rho;
+    const double displaced = sediment::displaced_mass(density, radius[i], sub);
     for (int k = 0; k < 3; ++k) {
       const double fb = -displaced * gravity[k];
       f[i][k] += fb;

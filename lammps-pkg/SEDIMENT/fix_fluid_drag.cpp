@@ -1,8 +1,10 @@
+// SPDX-License-Identifier: GPL-2.0-or-later
 /* ----------------------------------------------------------------------
    SEDIMENT package: fix fluid/drag
 ------------------------------------------------------------------------- */
 
 #include "fix_fluid_drag.h"
+#include "sediment_args.h"
 
 #include "compute_concentration_grid.h"
 #include "fix_fluid.h"
@@ -31,50 +33,33 @@ FixFluidDrag::FixFluidDrag(LAMMPS *lmp, int narg, char **arg) :
     error->all(FLERR, "Fix fluid/drag: expected 'fix ID group fluid/drag FLUID-ID law NAME'");
   fluid_id = utils::strdup(arg[3]);
   bool has_law = false;
-  int iarg = 4;
-  while (iarg < narg) {
-    if (strcmp(arg[iarg], "law") == 0) {
-      if (iarg + 1 >= narg) error->all(FLERR, "Fix fluid/drag: keyword 'law' needs a name");
-      const auto parsed = sediment::drag_law_from_name(arg[iarg + 1]);
-      if (!parsed)
-        error->all(FLERR, "Fix fluid/drag: unknown law '{}' (expected one of {})", arg[iarg + 1],
-                   sediment::drag_law_names());
+  StyleArgs args(lmp, "Fix fluid/drag", narg, arg, 4);
+  while (args.more()) {
+    if (args.is("law")) {
+      args.need(1, "a name");
+      const auto parsed = sediment::drag_law_from_name(args.text(1));
+      if (!parsed) args.fail("unknown law '{}' (expected one of {})", args.text(1), sediment::drag_law_names());
       law = *parsed;
       has_law = true;
-      iarg += 2;
-    } else if (strcmp(arg[iarg], "rotation") == 0) {
-      if (iarg + 1 >= narg) error->all(FLERR, "Fix fluid/drag: keyword 'rotation' needs yes or no");
-      if (strcmp(arg[iarg + 1], "yes") == 0)
-        rotation = 1;
-      else if (strcmp(arg[iarg + 1], "no") == 0)
-        rotation = 0;
-      else
-        error->all(FLERR, "Fix fluid/drag: rotation must be yes or no, not '{}'", arg[iarg + 1]);
-      iarg += 2;
-    } else if (strcmp(arg[iarg], "concentration") == 0) {
-      if (iarg + 1 >= narg) error->all(FLERR, "Fix fluid/drag: keyword 'concentration' needs a compute ID");
+    } else if (args.is("rotation")) {
+      args.need(1, "yes or no");
+      rotation = args.yes_no(1);
+    } else if (args.is("concentration")) {
+      args.need(1, "a compute ID");
       delete[] concentration_id;
-      concentration_id = utils::strdup(arg[iarg + 1]);
-      iarg += 2;
-    } else if (strcmp(arg[iarg], "buoyancy") == 0) {
-      if (iarg + 1 >= narg) error->all(FLERR, "Fix fluid/drag: keyword 'buoyancy' needs plain or mixture");
-      if (strcmp(arg[iarg + 1], "plain") == 0)
-        hindrance_buoyancy = sediment::HindranceBuoyancy::Plain;
-      else if (strcmp(arg[iarg + 1], "mixture") == 0)
-        hindrance_buoyancy = sediment::HindranceBuoyancy::Mixture;
-      else
-        error->all(FLERR, "Fix fluid/drag: buoyancy must be plain or mixture, not '{}'", arg[iarg + 1]);
-      iarg += 2;
-    } else if (strcmp(arg[iarg], "max_fraction") == 0) {
-      if (iarg + 1 >= narg) error->all(FLERR, "Fix fluid/drag: keyword 'max_fraction' needs a value");
-      max_fraction = utils::numeric(FLERR, arg[iarg + 1], false, lmp);
-      if (!(max_fraction > 0.0 && max_fraction < 1.0))
-        error->all(FLERR, "Fix fluid/drag: max_fraction must be in (0, 1)");
-      iarg += 2;
+      concentration_id = utils::strdup(args.text(1));
+    } else if (args.is("buoyancy")) {
+      args.need(1, "plain or mixture");
+      hindrance_buoyancy = args.choice(1, {"plain", "mixture"}) == 0 ? sediment::HindranceBuoyancy::Plain
+                                                                      : sediment::HindranceBuoyancy::Mixture;
+    } else if (args.is("max_fraction")) {
+      args.need(1, "a value");
+      max_fraction = args.number(1);
+      if (!(max_fraction > 0.0 && max_fraction < 1.0)) args.fail("max_fraction must be in (0, 1)");
     } else {
-      error->all(FLERR, "Fix fluid/drag: unknown keyword '{}' (expected law, rotation, concentration, "
-                        "buoyancy or max_fraction)", arg[iarg]);
+      args.unknown("law, rotation, concentration, buoyancy or max_fraction");
     }
+    args.next(1);
   }
   if (!has_law) error->all(FLERR, "Fix fluid/drag: keyword 'law' is required");
   if (law == sediment::DragLaw::DiFelice && !concentration_id)
@@ -109,11 +94,9 @@ void FixFluidDrag::init()
   fluid = FixFluid::find(lmp, fluid_id, "Fix fluid/drag");
   model = std::make_unique<sediment::DragModel>(law, fluid->properties(), hindrance_buoyancy);
   concentration =
-      concentration_id ? ComputeConcentrationGrid::find_fraction(lmp, concentration_id, "fluid/drag") : nullptr;
+      concentration_id ? ComputeConcentrationGrid::find_fraction(lmp, concentration_id, "Fix fluid/drag") : nullptr;
   implicit_groupbit = 0;
-  for (int i = 0; i < modify->nfix; ++i)
-    if (strcmp(modify->fix[i]->style, "nve/sphere/fluid") == 0)
-      implicit_groupbit |= modify->fix[i]->groupbit;
+  for (Fix *integrator : sediment_fixes_of_style(lmp, "nve/sphere/fluid")) implicit_groupbit |= integrator->groupbit;
 }
 
 void FixFluidDrag::setup(int vflag)
@@ -161,67 +144,59 @@ bool FixFluidDrag::fraction_capped(int i) const
 double FixFluidDrag::rotation_rate(int i, const sediment::SphereDrag &drag) const
 {
   if (!rotation || !drag.model) return 0.0;
-  // Stokes rotlet: torque = -pi mu d^3 omega, inertia I = m d^2 / 10 (solid sphere).
-  const double d = drag.diameter;
-  const double inertia = 0.1 * atom->rmass[i] * d * d;
-  return drag.scale.wetted * sediment::pi * fluid->properties().viscosity * d * d * d / inertia;
+  return sediment::rotation_drag_rate(fluid->properties().viscosity, drag.diameter, atom->rmass[i],
+                                      drag.scale.wetted);
+}
+
+template <class Visit> void FixFluidDrag::for_each_explicit(Visit visit)
+{
+  double **v = atom->v;
+  const int *mask = atom->mask;
+  const double *u = fluid->velocity();
+  prepare_step();
+  for (int i = 0; i < atom->nlocal; ++i) {
+    if (!(mask[i] & groupbit) || (mask[i] & implicit_groupbit)) continue;
+    const sediment::SphereDrag drag = sphere_drag(i);
+    const double slip[3] = {v[i][0] - u[0], v[i][1] - u[1], v[i][2] - u[2]};
+    visit(i, drag, slip, sqrt(slip[0] * slip[0] + slip[1] * slip[1] + slip[2] * slip[2]));
+  }
 }
 
 void FixFluidDrag::post_force(int /*vflag*/)
 {
-  double **v = atom->v;
   double **f = atom->f;
-  int *mask = atom->mask;
-  const int nlocal = atom->nlocal;
-  const double *u = fluid->velocity();
-
-  prepare_step();
   refresh_concentration();
   totals.clear();
-  for (int i = 0; i < nlocal; ++i) {
-    if (!(mask[i] & groupbit) || (mask[i] & implicit_groupbit)) continue;
-    const sediment::SphereDrag drag = sphere_drag(i);
+  for_each_explicit([&](int i, const sediment::SphereDrag &drag, const double *slip, double speed) {
     if (!drag.model) {
       totals[OUTSIDE] += 1.0;
-      continue;
+      return;
     }
     if (fraction_capped(i)) totals[CAPPED] += 1.0;
-    const double w[3] = {v[i][0] - u[0], v[i][1] - u[1], v[i][2] - u[2]};
-    const double speed = sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]);
     if (speed > 0.0) {
       // Explicit: the yield part acts only while moving, so a yield-stress fluid chatters here.
       const double coeff = model->force(drag.diameter, speed, drag.scale) / speed;
       for (int k = 0; k < 3; ++k) {
-        f[i][k] -= coeff * w[k];
-        totals[k] -= coeff * w[k];
+        f[i][k] -= coeff * slip[k];
+        totals[k] -= coeff * slip[k];
       }
     }
     const double rate = rotation_rate(i, drag);
     if (rate > 0.0) {
-      const double inertia = 0.1 * atom->rmass[i] * drag.diameter * drag.diameter;
+      const double inertia = sediment::sphere_inertia(atom->rmass[i], atom->radius[i]);
       for (int k = 0; k < 3; ++k) atom->torque[i][k] -= rate * inertia * atom->omega[i][k];
     }
-  }
+  });
 }
 
 int FixFluidDrag::count_unstable_explicit()
 {
-  // Explicit drag is stable only for dt < 2 tau, tau = m / F'(s) at the current slip.
-  double **v = atom->v;
-  int *mask = atom->mask;
-  const double *u = fluid->velocity();
-  prepare_step();
   int count = 0;
-  for (int i = 0; i < atom->nlocal; ++i) {
-    if (!(mask[i] & groupbit) || (mask[i] & implicit_groupbit)) continue;
-    const sediment::SphereDrag drag = sphere_drag(i);
-    if (!drag.model) continue;
-    const double w[3] = {v[i][0] - u[0], v[i][1] - u[1], v[i][2] - u[2]};
-    const double speed = sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]);
-    const double slope = std::max(model->tangent(drag.diameter, speed, drag.scale),
-                                  model->tangent(drag.diameter, 0.0, drag.scale));
-    if (update->dt > 2.0 * atom->rmass[i] / slope) ++count;
-  }
+  for_each_explicit([&](int i, const sediment::SphereDrag &drag, const double *, double speed) {
+    if (drag.model &&
+        update->dt > sediment::explicit_step_limit(*model, drag.diameter, speed, atom->rmass[i], drag.scale))
+      ++count;
+  });
   int count_all = 0;
   MPI_Allreduce(&count, &count_all, 1, MPI_INT, MPI_SUM, world);
   return count_all;

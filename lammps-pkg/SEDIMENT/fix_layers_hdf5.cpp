@@ -139,18 +139,18 @@ FixLayersHDF5::FixLayersHDF5(LAMMPS *lmp, int narg, char **arg) :
   if (strncmp(arg[5], "c_", 2) != 0)
     error->all(FLERR, "Fix layers/hdf5: expected a compute reference c_ID, not '{}'", arg[5]);
   compute_id = utils::strdup(arg[5] + 2);
-  int iarg = 6;
-  while (iarg < narg) {
-    if (iarg + 1 >= narg) error->all(FLERR, "Fix layers/hdf5: keyword '{}' needs a value", arg[iarg]);
-    if (strcmp(arg[iarg], "fluid") == 0) {
+  StyleArgs args(lmp, "Fix layers/hdf5", narg, arg, 6);
+  while (args.more()) {
+    args.need(1, "a value");
+    if (args.is("fluid")) {
       delete[] fluid_id;
-      fluid_id = utils::strdup(arg[iarg + 1]);
-    } else if (strcmp(arg[iarg], "particle_density") == 0) {
-      particle_density = sediment_positive(lmp, arg[iarg + 1], "Fix layers/hdf5: particle_density");
+      fluid_id = utils::strdup(args.text(1));
+    } else if (args.is("particle_density")) {
+      particle_density = args.positive(1, "particle_density");
     } else {
-      error->all(FLERR, "Fix layers/hdf5: unknown keyword '{}' (expected fluid or particle_density)", arg[iarg]);
+      args.unknown("fluid or particle_density");
     }
-    iarg += 2;
+    args.next(1);
   }
   scalar_flag = 1;
   global_freq = 1;
@@ -190,12 +190,11 @@ template <typename Action> void FixLayersHDF5::on_rank0(Action action)
 
 void FixLayersHDF5::init()
 {
-  const int icompute = modify->find_compute(compute_id);
-  if (icompute < 0) error->all(FLERR, "Fix layers/hdf5: compute '{}' does not exist", compute_id);
-  grid = dynamic_cast<ComputeConcentrationGrid *>(modify->compute[icompute]);
+  Compute *compute = sediment_find_compute(lmp, compute_id, "Fix layers/hdf5");
+  grid = dynamic_cast<ComputeConcentrationGrid *>(compute);
   if (!grid)
     error->all(FLERR, "Fix layers/hdf5: compute '{}' is a compute {}, not a compute concentration/grid",
-               compute_id, modify->compute[icompute]->style);
+               compute_id, compute->style);
   if (!grid->is_layers())
     error->all(FLERR, "Fix layers/hdf5: compute '{}' bins into 3d cells; layer files need 'layers AXIS N'", compute_id);
   fluid = fluid_id ? FixFluid::find(lmp, fluid_id, "Fix layers/hdf5") : nullptr;

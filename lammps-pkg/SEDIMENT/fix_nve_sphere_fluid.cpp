@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-2.0-or-later
 /* ----------------------------------------------------------------------
    SEDIMENT package: fix nve/sphere/fluid
    Velocity-Verlet split of the exponential (ETD2) drag step of sediment/integrator.hpp.
@@ -8,6 +9,8 @@
 
 #include "fix_fluid.h"
 #include "fix_fluid_drag.h"
+
+#include "sediment/geometry.hpp"
 
 #include "atom.h"
 #include "domain.h"
@@ -24,8 +27,6 @@
 using namespace LAMMPS_NS;
 using namespace FixConst;
 
-static constexpr double INERTIA = 0.4;    // moment of inertia prefactor for a solid sphere
-
 // The kick of fix nve/sphere, written as it does, so that a scene without fluid is bitwise the
 // same as with fix nve/sphere. dtf = dt ftm2v / 2.
 static inline void nve_sphere_kick(double *v, double *omega, const double *f, const double *torque, double radius,
@@ -35,10 +36,23 @@ static inline void nve_sphere_kick(double *v, double *omega, const double *f, co
   v[0] += dtfm * f[0];
   v[1] += dtfm * f[1];
   v[2] += dtfm * f[2];
-  const double dtirotate = dtf / INERTIA / (radius * radius * rmass);
+  const double dtirotate = dtf / sediment::solid_sphere_inertia / (radius * radius * rmass);
   omega[0] += dtirotate * torque[0];
   omega[1] += dtirotate * torque[1];
   omega[2] += dtirotate * torque[2];
+}
+
+// The per-atom arrays both halves of the step read, taken anew in each half (exchanges move them).
+struct SphereArrays {
+  double **x, **v, **f, **omega, **torque;
+  const double *radius, *rmass;
+  const int *mask;
+  int nlocal;
+};
+
+static inline SphereArrays sphere_arrays(const Atom *atom)
+{
+  return {atom->x, atom->v, atom->f, atom->omega, atom->torque, atom->radius, atom->rmass, atom->mask, atom->nlocal};
 }
 
 // The first half of fix nve/sphere's step: kick, then drift over the whole step.
@@ -54,20 +68,17 @@ static inline void nve_sphere_kick_drift(double *x, double *v, double *omega, co
 FixNVESphereFluid::FixNVESphereFluid(LAMMPS *lmp, int narg, char **arg) :
     Fix(lmp, narg, arg), weights(nullptr), nmax_weights(0), floor_axis(-1), floor_level(0.0)
 {
-  int iarg = 3;
-  while (iarg < narg) {
-    if (strcmp(arg[iarg], "floor") == 0) {
-      if (iarg + 2 >= narg) error->all(FLERR, "Fix nve/sphere/fluid: 'floor' needs an axis and a coordinate");
-      const char *dim = arg[iarg + 1];
-      floor_axis = sediment_axis(dim);
-      if (floor_axis < 0) error->all(FLERR, "Fix nve/sphere/fluid: floor axis must be x, y or z, not '{}'", dim);
-      if (floor_axis == 2 && domain->dimension == 2)
-        error->all(FLERR, "Fix nve/sphere/fluid: a floor along z in a 2d simulation");
-      floor_level = utils::numeric(FLERR, arg[iarg + 2], false, lmp);
-      iarg += 3;
+  StyleArgs args(lmp, "Fix nve/sphere/fluid", narg, arg, 3);
+  while (args.more()) {
+    if (args.is("floor")) {
+      args.need(2, "an axis and a coordinate");
+      floor_axis = args.axis(1, "floor axis");
+      if (floor_axis == 2 && domain->dimension == 2) args.fail("a floor along z in a 2d simulation");
+      floor_level = args.number(2);
     } else {
-      error->all(FLERR, "Fix nve/sphere/fluid: unknown keyword '{}' (expected floor)", arg[iarg]);
+      args.unknown("floor");
     }
+    args.next(2);
   }
   if (!atom->sphere_flag)
     error->all(FLERR, "Fix nve/sphere/fluid requires atom_style sphere");
@@ -98,9 +109,7 @@ int FixNVESphereFluid::setmask()
 void FixNVESphereFluid::init()
 {
   drags.clear();
-  for (int i = 0; i < modify->nfix; ++i)
-    if (strcmp(modify->fix[i]->style, "fluid/drag") == 0)
-      drags.push_back(static_cast<FixFluidDrag *>(modify->fix[i]));
+  for (Fix *drag : sediment_fixes_of_style(lmp, "fluid/drag")) drags.push_back(static_cast<FixFluidDrag *>(drag));
 
   double *radius = atom->radius;
   int *mask = atom->mask;
@@ -111,15 +120,7 @@ void FixNVESphereFluid::init()
 
 void FixNVESphereFluid::initial_integrate(int /*vflag*/)
 {
-  double **x = atom->x;
-  double **v = atom->v;
-  double **f = atom->f;
-  double **omega = atom->omega;
-  double **torque = atom->torque;
-  double *radius = atom->radius;
-  double *rmass = atom->rmass;
-  int *mask = atom->mask;
-  const int nlocal = atom->nlocal;
+  const auto [x, v, f, omega, torque, radius, rmass, mask, nlocal] = sphere_arrays(atom);
   const double dt = update->dt;
   const double ftm2v = force->ftm2v;
   static const double no_flow[3] = {0.0, 0.0, 0.0};
@@ -182,7 +183,7 @@ void FixNVESphereFluid::initial_integrate(int /*vflag*/)
     if (corr.state == sediment::SlipState::Stuck) counts[STUCK] += 1.0;
     if (corr.state == sediment::SlipState::HeldAtJump) counts[AT_JUMP] += 1.0;
 
-    const double inertia = INERTIA * mass * radius[i] * radius[i];
+    const double inertia = sediment::sphere_inertia(mass, radius[i]);
     const double alpha[3] = {ftm2v * torque[i][0] / inertia, ftm2v * torque[i][1] / inertia,
                              ftm2v * torque[i][2] / inertia};
     w[SPIN] = sediment::rotation_step_initial(spin_rate, alpha, dt, omega[i], &w[SPIN_MEMO]);
@@ -199,14 +200,7 @@ void FixNVESphereFluid::initial_integrate(int /*vflag*/)
 
 void FixNVESphereFluid::final_integrate()
 {
-  double **v = atom->v;
-  double **f = atom->f;
-  double **omega = atom->omega;
-  double **torque = atom->torque;
-  double *radius = atom->radius;
-  double *rmass = atom->rmass;
-  int *mask = atom->mask;
-  const int nlocal = atom->nlocal;
+  const auto [x, v, f, omega, torque, radius, rmass, mask, nlocal] = sphere_arrays(atom);
   const double ftm2v = force->ftm2v;
 
   const double dtf = 0.5 * update->dt * ftm2v;
@@ -237,7 +231,7 @@ void FixNVESphereFluid::final_integrate()
     const double a[3] = {ftm2v * f[i][0] / mass, ftm2v * f[i][1] / mass, ftm2v * f[i][2] / mass};
     sediment::drag_step_final(corr, a, v[i]);
 
-    const double spin = w[SPIN] * ftm2v / (INERTIA * mass * radius[i] * radius[i]);
+    const double spin = w[SPIN] * ftm2v / sediment::sphere_inertia(mass, radius[i]);
     omega[i][0] += spin * torque[i][0];
     omega[i][1] += spin * torque[i][1];
     omega[i][2] += spin * torque[i][2];

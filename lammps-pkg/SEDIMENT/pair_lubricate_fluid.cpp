@@ -61,27 +61,23 @@ void PairLubricateFluid::settings(int narg, char **arg)
   range = sediment::LubricationRange{};
   repulsion_scale = 0.0;
   limit = 1;
-  int iarg = 1;
-  while (iarg < narg) {
-    const char *keyword = arg[iarg];
-    if (iarg + 1 >= narg) error->all(FLERR, "Pair lubricate/fluid: '{}' needs a value", keyword);
-    const char *value = arg[iarg + 1];
-    if (strcmp(keyword, "inner") == 0) {
-      range.inner = utils::numeric(FLERR, value, false, lmp);
-    } else if (strcmp(keyword, "outer") == 0) {
-      range.outer = utils::numeric(FLERR, value, false, lmp);
-    } else if (strcmp(keyword, "repulsion") == 0) {
-      repulsion_scale = sediment_positive(lmp, value, "Pair lubricate/fluid: repulsion force scale");
-    } else if (strcmp(keyword, "limit") == 0) {
-      if (strcmp(value, "yes") == 0) limit = 1;
-      else if (strcmp(value, "no") == 0) limit = 0;
-      else error->all(FLERR, "Pair lubricate/fluid: limit must be yes or no, not '{}'", value);
+  StyleArgs args(lmp, "Pair lubricate/fluid", narg, arg, 1);
+  while (args.more()) {
+    args.need(1, "a value");
+    if (args.is("inner")) {
+      range.inner = args.number(1);
+    } else if (args.is("outer")) {
+      range.outer = args.number(1);
+    } else if (args.is("repulsion")) {
+      repulsion_scale = args.positive(1, "repulsion force scale");
+    } else if (args.is("limit")) {
+      limit = args.yes_no(1);
     } else {
-      error->all(FLERR, "Pair lubricate/fluid: unknown keyword '{}' (expected inner, outer, repulsion or limit)", keyword);
+      args.unknown("inner, outer, repulsion or limit");
     }
-    iarg += 2;
+    args.next(1);
   }
-  if (!(range.inner > 0.0) || !(range.outer > range.inner) || !std::isfinite(range.outer))
+  if (!(range.inner > 0.0) || !(range.outer > range.inner))
     error->all(FLERR, "Pair lubricate/fluid: need 0 < inner < outer (gaps in units of the effective radius)");
 }
 

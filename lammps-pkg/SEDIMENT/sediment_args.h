@@ -1,17 +1,25 @@
+// SPDX-License-Identifier: GPL-2.0-or-later
 /* ----------------------------------------------------------------------
-   SEDIMENT package: reading the input arguments the styles share.
+   SEDIMENT package: one reader for the styles' arguments, so that every
+   style checks arity, numbers, yes/no, choices and axes the same way and
+   every message starts with the style's full name ("Fix fluid/drag: ...").
 ------------------------------------------------------------------------- */
 
 #ifndef LMP_SEDIMENT_ARGS_H
 #define LMP_SEDIMENT_ARGS_H
 
+#include "compute.h"
 #include "error.h"
+#include "fix.h"
 #include "lammps.h"
+#include "modify.h"
 #include "utils.h"
 
 #include <cmath>
 #include <cstring>
+#include <initializer_list>
 #include <string>
+#include <vector>
 
 namespace LAMMPS_NS {
 
@@ -23,13 +31,138 @@ inline int sediment_axis(const char *name)
   return -1;
 }
 
-// An argument that must be a finite number > 0, or the error "<what> must be finite and > 0<hint>".
-// utils::numeric turns 1e400 into inf, so finiteness is checked here, once for every style.
-inline double sediment_positive(LAMMPS *lmp, const char *text, const std::string &what, const char *hint = "")
+class StyleArgs {
+ public:
+  // `style` is the style's full name as the user wrote it ("Fix fluid/drag", "Pair lubricate/fluid");
+  // keywords start at arg[first].
+  StyleArgs(LAMMPS *lmp, std::string style, int narg, char **arg, int first) :
+      lmp(lmp), style(std::move(style)), narg(narg), arg(arg), iarg(first)
+  {
+  }
+
+  const std::string &name() const { return style; }
+  bool more() const { return iarg < narg; }
+  int position() const { return iarg; }
+  const char *keyword() const { return arg[iarg]; }
+  bool is(const char *name) const { return strcmp(arg[iarg], name) == 0; }
+  // Whether the keyword has at least n values after it.
+  bool has(int n) const { return iarg + n < narg; }
+  // The k-th value after the current keyword (k = 1 is the first).
+  const char *text(int k) const { return arg[iarg + k]; }
+  // How many words follow the keyword, up to the first that is not a number.
+  int numbers_after() const
+  {
+    int n = 0;
+    while (iarg + 1 + n < narg && utils::is_double(arg[iarg + 1 + n])) ++n;
+    return n;
+  }
+  // Moves past the keyword and its n values.
+  void next(int n) { iarg += 1 + n; }
+
+  // Stops unless the keyword has n values; `what` says what they are ("a value", "an axis and a count").
+  void need(int n, const char *what) const
+  {
+    if (!has(n)) fail("keyword '{}' needs {}", arg[iarg], what);
+  }
+
+  double number(int k) const
+  {
+    const double value = utils::numeric(FLERR, arg[iarg + k], false, lmp);
+    // utils::numeric turns 1e400 into inf: finiteness is checked here, once for every style.
+    if (!std::isfinite(value)) fail("{} must be finite, not '{}'", arg[iarg], arg[iarg + k]);
+    return value;
+  }
+  // A finite number > 0, or "<Style>: <what> must be finite and > 0<hint>".
+  double positive(int k, const std::string &what, const char *hint = "") const
+  {
+    return positive_value(lmp, style, arg[iarg + k], what, hint);
+  }
+  int whole(int k) const { return utils::inumeric(FLERR, arg[iarg + k], false, lmp); }
+  bool yes_no(int k) const
+  {
+    const char *word = arg[iarg + k];
+    if (strcmp(word, "yes") == 0) return true;
+    if (strcmp(word, "no") != 0) fail("{} must be yes or no, not '{}'", arg[iarg], word);
+    return false;
+  }
+  // Index of the k-th value in `names`, or an error listing them.
+  int choice(int k, std::initializer_list<const char *> names) const
+  {
+    int index = 0;
+    std::string listed;
+    for (const char *name : names) {
+      if (strcmp(arg[iarg + k], name) == 0) return index;
+      listed += (index == 0 ? "" : index + 1 == static_cast<int>(names.size()) ? " or " : ", ");
+      listed += name;
+      ++index;
+    }
+    fail("{} must be {}, not '{}'", arg[iarg], listed, arg[iarg + k]);
+  }
+  // 0, 1, 2 for x, y, z; `what` names the axis in the error ("floor axis").
+  int axis(int k, const char *what) const
+  {
+    const int dim = sediment_axis(arg[iarg + k]);
+    if (dim < 0) fail("{} must be x, y or z, not '{}'", what, arg[iarg + k]);
+    return dim;
+  }
+  [[noreturn]] void unknown(const char *expected) const
+  {
+    fail("unknown keyword '{}' (expected {})", arg[iarg], expected);
+  }
+
+  template <typename... Args> [[noreturn]] void fail(const std::string &format, Args &&...args) const
+  {
+    lmp->error->all(FLERR, style + ": " + format, std::forward<Args>(args)...);
+    __builtin_unreachable();    // error->all exits or throws; its formatting overload is not marked so
+  }
+
+  static double positive_value(LAMMPS *lmp, const std::string &style, const char *text, const std::string &what,
+                               const char *hint = "")
+  {
+    const double value = utils::numeric(FLERR, text, false, lmp);
+    if (!(value > 0.0) || !std::isfinite(value))
+      lmp->error->all(FLERR, "{}: {} must be finite and > 0{}", style, what, hint);
+    return value;
+  }
+
+ private:
+  LAMMPS *lmp;
+  std::string style;
+  int narg;
+  char **arg;
+  int iarg;
+};
+
+// The fixes of a given style (e.g. every "fluid/drag").
+inline std::vector<Fix *> sediment_fixes_of_style(LAMMPS *lmp, const char *style)
 {
-  const double value = utils::numeric(FLERR, text, false, lmp);
-  if (!(value > 0.0) || !std::isfinite(value)) lmp->error->all(FLERR, "{} must be finite and > 0{}", what, hint);
-  return value;
+  std::vector<Fix *> found;
+  for (int i = 0; i < lmp->modify->nfix; ++i)
+    if (strcmp(lmp->modify->fix[i]->style, style) == 0) found.push_back(lmp->modify->fix[i]);
+  return found;
+}
+
+// Fix `id`, which must be of class T (style `style`); `caller` names the style asking ("Fix fluid/drag")
+// and `role` what the fix is for ("fluid", "gravity").
+template <class T>
+T *sediment_find_fix(LAMMPS *lmp, const char *id, const char *style, const std::string &caller, const char *role)
+{
+  const int ifix = lmp->modify->find_fix(id);
+  if (ifix < 0) lmp->error->all(FLERR, "{}: {} fix '{}' does not exist", caller, role, id);
+  Fix *fix = lmp->modify->fix[ifix];
+  auto typed = dynamic_cast<T *>(fix);
+  if (!typed || strcmp(fix->style, style) != 0)
+    lmp->error->all(FLERR, "{}: fix '{}' is a fix {}, not a fix {}", caller, id, fix->style, style);
+  return typed;
+}
+
+// Compute `id` (a leading "c_" is dropped); `caller` names the style asking.
+inline Compute *sediment_find_compute(LAMMPS *lmp, const char *id, const std::string &caller)
+{
+  const char *name = strncmp(id, "c_", 2) == 0 ? id + 2 : id;
+  const int icompute = lmp->modify->find_compute(name);
+  if (icompute < 0) lmp->error->all(FLERR, "{}: compute '{}' does not exist", caller, name);
+  return lmp->modify->compute[icompute];
 }
 
 }    // namespace LAMMPS_NS

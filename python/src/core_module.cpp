@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-2.0-or-later
 // sediment._core: the C++ physics core and the LAMMPS style registration, for Python.
 
 #include "sediment/drag.hpp"
@@ -147,6 +148,33 @@ PYBIND11_MODULE(_core, m)
   m.def("critical_yield_number", [](const std::string &law) {
     return critical_yield_number(DragModel(parse_law(law), Fluid{1.0, 1.0, 1.0}));
   }, py::arg("law") = "zhang-li", "Y = tau_y / ((rho_p - rho_f) g d) at which a sphere stops.");
+
+  m.def("explicit_step_limit",
+        [](const std::string &law, double density, double viscosity, double yield_stress, double d,
+           double particle_density, double speed) {
+          if (!(d > 0.0) || !(particle_density > 0.0)) throw py::value_error("diameter and particle density must be > 0");
+          if (!(speed >= 0.0)) throw py::value_error("speed must be >= 0");
+          const DragModel model(parse_law(law), make_fluid(density, viscosity, yield_stress));
+          return explicit_step_limit(model, d, speed, particle_density * sphere_volume(d));
+        },
+        py::arg("law"), py::arg("density"), py::arg("viscosity"), py::arg("yield_stress"), py::arg("d"),
+        py::arg("particle_density"), py::arg("speed") = 0.0,
+        "Largest step [s] at which explicit drag is stable at a slip speed (2 tau for Stokes).");
+
+  m.def("rotation_drag_rate",
+        [](double viscosity, double d, double particle_density, double wetted) {
+          if (!(viscosity > 0.0) || !(d > 0.0) || !(particle_density > 0.0))
+            throw py::value_error("viscosity, diameter and particle density must be > 0");
+          return rotation_drag_rate(viscosity, d, particle_density * sphere_volume(d), wetted);
+        },
+        py::arg("viscosity"), py::arg("d"), py::arg("particle_density"), py::arg("wetted") = 1.0,
+        "Rate k [1/s] of the Stokes rotlet torque -pi mu d^3 omega = -k I omega of a solid sphere.");
+
+  m.def("sphere_inertia", &sphere_inertia, py::arg("mass"), py::arg("radius"),
+        "Moment of inertia 2/5 m r^2 of a solid sphere [kg m2].");
+
+  m.def("mixture_density", &mixture_density, py::arg("fluid_density"), py::arg("solid_density"),
+        py::arg("fraction"), "Suspension density rho_f + (rho_s - rho_f) phi [kg/m3].");
 
   m.def("rayleigh_time", &rayleigh_time, py::arg("radius"), py::arg("density"), py::arg("youngs_modulus"),
         py::arg("poisson_ratio"), "Rayleigh time [s].");

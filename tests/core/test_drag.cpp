@@ -189,3 +189,30 @@ TEST(DiFelice, LowReynoldsHinderedSettlingFollowsRichardsonZaki)
     EXPECT_NEAR(hindered / single, expected[k], 0.03 * expected[k]) << phis[k];
   }
 }
+
+TEST(ExplicitStep, StokesLimitIsTwoRelaxationTimes)
+{
+  const DragModel model(DragLaw::Stokes, Fluid{1000.0, 1e-3, 0.0});
+  const double d = 1e-4, rho_p = 2700.0, mass = rho_p * sphere_volume(d);
+  const double tau = rho_p * d * d / (18 * 1e-3);
+  for (double speed : {0.0, 1e-3, 1.0}) EXPECT_NEAR(explicit_step_limit(model, d, speed, mass), 2 * tau, 1e-14 * tau);
+}
+
+TEST(ExplicitStep, NonlinearLimitFollowsTheSteeperTangent)
+{
+  // Dallavalle stiffens with speed: the limit shrinks as the slip grows, and is the at-rest one at 0.
+  const DragModel model(DragLaw::Dallavalle, Fluid{1000.0, 1e-3, 0.0});
+  const double d = 1e-3, mass = 2650.0 * sphere_volume(d);
+  const double at_rest = explicit_step_limit(model, d, 0.0, mass);
+  EXPECT_DOUBLE_EQ(at_rest, 2 * mass / model.tangent(d, 0.0));
+  EXPECT_LT(explicit_step_limit(model, d, 0.1, mass), at_rest);
+  EXPECT_DOUBLE_EQ(explicit_step_limit(model, d, 0.1, mass), 2 * mass / model.tangent(d, 0.1));
+}
+
+TEST(RotationDrag, RotletOverInertia)
+{
+  // torque = -pi mu d^3 omega = -k I omega with I = m d^2 / 10: k = 10 pi mu d / m.
+  const double mu = 1.2e-3, d = 2e-4, mass = 2500.0 * sphere_volume(d);
+  EXPECT_NEAR(rotation_drag_rate(mu, d, mass), 10 * pi * mu * d / mass, 1e-13 * 10 * pi * mu * d / mass);
+  EXPECT_DOUBLE_EQ(rotation_drag_rate(mu, d, mass, 0.25), 0.25 * rotation_drag_rate(mu, d, mass));
+}

@@ -51,3 +51,21 @@ TEST(RayleighTime, ZhangLiExample)
   // d = 0.1 mm, rho = 2700, E = 30 GPa, nu = 0.25 -> 8.12e-8 s
   EXPECT_NEAR(rayleigh_time(0.05e-3, 2700.0, 30e9, 0.25), 8.12e-8, 0.005e-8);
 }
+
+TEST(Sphere, InertiaIsTwoFifthsMassRadiusSquared)
+{
+  // I = 2/5 m r^2 = m d^2 / 10: the two spellings the styles once used agree.
+  const double m = 3.1e-9, d = 1.3e-4;
+  EXPECT_DOUBLE_EQ(sphere_inertia(m, 0.5 * d), 0.1 * m * d * d);
+}
+
+TEST(Buoyancy, MixtureDensityAndDisplacedMass)
+{
+  EXPECT_DOUBLE_EQ(mixture_density(1000.0, 2650.0, 0.0), 1000.0);
+  EXPECT_DOUBLE_EQ(mixture_density(1000.0, 2650.0, 1.0), 2650.0);
+  EXPECT_DOUBLE_EQ(mixture_density(1000.0, 2650.0, 0.2), 1330.0);
+  const double r = 2e-5;
+  EXPECT_DOUBLE_EQ(displaced_mass(998.2, r, submergence(r, -3 * r)), 998.2 * sphere_volume(2 * r));
+  EXPECT_DOUBLE_EQ(displaced_mass(998.2, r, submergence(r, 0.0)), 0.5 * 998.2 * sphere_volume(2 * r));
+  EXPECT_EQ(displaced_mass(998.2, r, submergence(r, 3 * r)), 0.0);
+}

@@ -98,4 +98,12 @@ class DragModel {
 // Linear relaxation time m / F'(0) of a sphere of density rho_p (Stokes: rho_p d^2 / (18 mu)).
 double relaxation_time(const DragModel &model, double d, double particle_density);
 
+// Largest time step at which explicit (forward) drag on a sphere of mass m at slip speed s is
+// stable: 2 m / F', with F' the steeper of the tangents at s and at rest (2 tau for Stokes).
+double explicit_step_limit(const DragModel &model, double d, double speed, double mass, DragScale scale = {});
+
+// Rate k of the Stokes rotlet torque -pi mu d^3 omega on a solid sphere of mass m, written as
+// torque = -k I omega, scaled by the wetted fraction of its surface.
+double rotation_drag_rate(double viscosity, double d, double mass, double wetted = 1.0);
+
 }    // namespace sediment
