@@ -13,7 +13,7 @@ from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE.parent / "python"))
-from sediment.run import run_batch  # noqa: E402
+from sediment.sim.run import run_batch  # noqa: E402
 
 SCENES = {"plain": "nve/sphere + gravity (reference)",
           "bare": "nve/sphere/fluid + gravity, no fluid fixes (every effect off)",

@@ -21,9 +21,9 @@ from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE.parent / "python"))
-from sediment.psd import read_psd  # noqa: E402
-from sediment.run import run_batch  # noqa: E402
-from sediment.sample import plan, write  # noqa: E402
+from sediment.lab.psd import read_psd  # noqa: E402
+from sediment.sim.run import run_batch  # noqa: E402
+from sediment.sim.scene import plan, write  # noqa: E402
 
 PSD = HERE.parent / "examples" / "granulometry" / "psd" / "sample5.csv"
 

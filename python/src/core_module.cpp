@@ -7,6 +7,7 @@
 #include "sediment/terminal.hpp"
 #include "sediment_styles.h"
 
+#include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
@@ -126,6 +127,10 @@ PYBIND11_MODULE(_core, m)
         py::arg("particle_density"), py::arg("g") = 9.81,
         "Terminal speed [m/s] and regime ('moving', 'at_rest', 'at_jump').");
 
+  m.def("stokes_velocity", py::vectorize(stokes_velocity), py::arg("particle_density"), py::arg("fluid_density"),
+        py::arg("viscosity"), py::arg("g"), py::arg("d"),
+        "Stokes' terminal speed (rho_p - rho_f) g d^2 / (18 mu) [m/s] (numpy arrays too).");
+
   m.def("time_to_fraction",
         [](const std::string &law, double density, double viscosity, double yield_stress, double d,
            double particle_density, double g, double fraction) {
@@ -173,8 +178,8 @@ PYBIND11_MODULE(_core, m)
   m.def("sphere_inertia", &sphere_inertia, py::arg("mass"), py::arg("radius"),
         "Moment of inertia 2/5 m r^2 of a solid sphere [kg m2].");
 
-  m.def("mixture_density", &mixture_density, py::arg("fluid_density"), py::arg("solid_density"),
-        py::arg("fraction"), "Suspension density rho_f + (rho_s - rho_f) phi [kg/m3].");
+  m.def("mixture_density", py::vectorize(mixture_density), py::arg("fluid_density"), py::arg("solid_density"),
+        py::arg("fraction"), "Suspension density rho_f + (rho_s - rho_f) phi [kg/m3] (numpy arrays too).");
 
   m.def("rayleigh_time", &rayleigh_time, py::arg("radius"), py::arg("density"), py::arg("youngs_modulus"),
         py::arg("poisson_ratio"), "Rayleigh time [s].");

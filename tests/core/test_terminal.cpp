@@ -86,3 +86,13 @@ TEST(Terminal, RisingSphereUsesTheMagnitude)
   const DragModel model(DragLaw::Stokes, Fluid{1000.0, 1e-3, 0.0});
   EXPECT_NEAR(terminal_velocity(model, 1e-4, 500.0, 9.81).speed, 500.0 * 9.81 * 1e-8 / 18e-3, 1e-14);
 }
+
+TEST(Terminal, StokesLawIsTheStokesDragBalance)
+{
+  const DragModel model(DragLaw::Stokes, Fluid{998.2, 1.002e-3, 0.0});
+  for (double d : {2.5e-6, 2e-5, 7e-5}) {
+    const double v = stokes_velocity(2650.0, 998.2, 1.002e-3, 9.81, d);
+    EXPECT_NEAR(terminal_velocity(model, d, 2650.0, 9.81).speed, v, 1e-12 * v);
+  }
+  EXPECT_LT(stokes_velocity(700.0, 1000.0, 1e-3, 9.81, 1e-4), 0.0);
+}

@@ -8,7 +8,6 @@ from __future__ import annotations
 import argparse
 import csv
 import math
-import os
 import tempfile
 from pathlib import Path
 
@@ -19,7 +18,7 @@ from harness import HERE, report, run_batch, run_deck
 from sediment import _core  # noqa: E402  (harness puts python/ on the path)
 
 G = 9.81
-SHARED = Path(os.environ.get("SEDIMENT_SHARED", HERE.parents[2] / "shared"))    # ../shared beside the clone
+DATA = HERE.parent / "data"    # the validation data the checks compare with (tests/data)
 CHECKS = {}
 
 
@@ -114,10 +113,7 @@ def case_c_deck(rows: list[dict], path: Path, law: str) -> None:
 
 @check
 def case_c(np_ranks: int):
-    data = SHARED / "data" / "vw1965_dev.csv"
-    if not data.is_file():
-        raise FileNotFoundError(f"{data} not found: the project's shared/ folder must sit beside the "
-                                "repository (or set SEDIMENT_SHARED)")
+    data = DATA / "vw1965_dev.csv"
     with open(data) as f:
         rows = [{k: float(v) for k, v in r.items()} for r in csv.DictReader(f)]
     for law in ("zhang-li", "zhang-li/smooth"):
@@ -486,7 +482,7 @@ EXAMPLES = HERE.parents[1] / "examples"
 
 @check
 def layers_hdf5(np_ranks: int):
-    from sediment.layers import read_layers
+    from sediment.sim.layers import read_layers
 
     deck = EXAMPLES / "polydisperse" / "in.polydisperse"
     with tempfile.TemporaryDirectory() as tmp:
@@ -520,7 +516,7 @@ def layers_hdf5(np_ranks: int):
 @check
 def restart_state(np_ranks: int):
     """2N steps in one run vs N steps + write_restart + read_restart in a new process + N steps."""
-    from sediment.layers import read_layers
+    from sediment.sim.layers import read_layers
 
     with tempfile.TemporaryDirectory() as tmp:
         tmp = Path(tmp)

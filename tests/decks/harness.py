@@ -10,7 +10,7 @@ from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE.parents[1] / "python"))
-from sediment.run import DeckOutput, run_batch  # noqa: E402
+from sediment.sim.run import DeckOutput, run_batch  # noqa: E402
 
 
 def run_deck(deck: str | Path, variables: dict[str, object] | None = None, np_ranks: int = 1,

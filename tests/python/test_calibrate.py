@@ -2,7 +2,8 @@
 import numpy as np
 import pytest
 
-from sediment import calibrate, cli
+from sediment import cli
+from sediment.lab import calibrate
 
 
 def test_slump_gives_the_appendix_yield_stresses():

@@ -7,7 +7,8 @@ import numpy as np
 import pytest
 
 from sediment import cli
-from sediment.single_sphere import case_a_sweep
+from sediment.cli import types
+from sediment.studies.single_sphere import case_a_sweep
 
 REPO = Path(__file__).resolve().parents[2]
 
@@ -47,7 +48,7 @@ def test_case_a_runs_through_the_driver(integrator, bound, tmp_path):
 
 
 def test_readout_preview_writes_tables_figure_and_errors(tmp_path, capsys):
-    psd = REPO.parent / "shared" / "data" / "psd" / "sample5.csv"
+    psd = REPO / "examples" / "granulometry" / "psd" / "sample5.csv"
     assert cli.main(["readout", "--psd", str(psd), "--stokes-preview", "--out", str(tmp_path)]) == 0
     for name in ("hydrometer.csv", "buoyancy.csv", "pipette.csv", "errors.csv", "granulometry.png", "granulometry.pdf"):
         assert (tmp_path / name).stat().st_size > 0
@@ -70,8 +71,8 @@ def test_readout_bad_inputs_are_clear(tmp_path, capsys):
 
 def test_readout_measured_hydrometer_option(tmp_path):
     """The nominal 152H given as a measured instrument (--hydrometer) reads the same."""
-    from sediment.readout import Hydrometer
-    psd = REPO.parent / "shared" / "data" / "psd" / "sample5.csv"
+    from sediment.lab.readout import Hydrometer
+    psd = REPO / "examples" / "granulometry" / "psd" / "sample5.csv"
     h = Hydrometer.astm_152h()
     measured = [h.bulb_length, h.bulb_volume, float(np.sqrt(4 * h.stem_area / np.pi)), h.mass, h.scale_zero,
                 h.scale_zero - 50 * h.scale_step]
@@ -90,8 +91,8 @@ def _typed_options():
             if isinstance(action, argparse._SubParsersAction):
                 for name, sub in action.choices.items():
                     yield from walk(sub, words + [name])
-            elif action.option_strings and action.type in (cli.positive, cli.nonnegative, cli.finite, cli.count,
-                                                           float, int):
+            elif action.option_strings and action.type in (types.positive, types.nonnegative, types.finite,
+                                                           types.count, float, int):
                 yield words, action.option_strings[-1], action.type
     return list(walk(cli.build_parser(), []))
 
@@ -101,7 +102,7 @@ def test_every_numeric_option_refuses_malformed_values(bad, capsys):
     options = _typed_options()
     assert len(options) > 40 and not [o for o in options if o[2] is float]
     for words, option, kind in options:
-        if kind in (cli.finite, int) and bad == "-1":
+        if kind in (types.finite, int) and bad == "-1":
             continue    # a signed value (a coordinate, a seed): -1 is valid
         with pytest.raises(SystemExit) as exit_info:
             cli.main(words + [option, bad])

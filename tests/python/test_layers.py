@@ -6,7 +6,7 @@ import pytest
 
 h5py = pytest.importorskip("h5py")
 
-from sediment.layers import LayerFileError, read_layers  # noqa: E402
+from sediment.sim.layers import LayerFileError, read_layers  # noqa: E402
 
 
 def write_layer_file(path: Path, frames: int = 3, version: int = 1, schema: str = "sediment-layers",

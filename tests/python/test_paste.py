@@ -5,9 +5,9 @@ import math
 import numpy as np
 import pytest
 
-from sediment import funnel, paste
-from sediment.calibrate import restitution_from_drops
-from sediment.run import run_batch
+from sediment.studies import funnel, paste
+from sediment.lab.calibrate import restitution_from_drops
+from sediment.sim.run import run_batch
 
 MEASURED_E = restitution_from_drops(paste.DROP_HEIGHTS, paste.MEASURED_REBOUNDS).mean
 

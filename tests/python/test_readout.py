@@ -6,16 +6,16 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from sediment.psd import PSD, PSDError, discretise, read_psd
-from sediment.readout import SCHEDULES, BuoyancySphere, Column, Fluid, Hydrometer, Pipette, R_FACTOR
-from sediment.synthetic import stokes_column
+from sediment.lab.psd import PSD, PSDError, discretise, read_psd
+from sediment.lab.readout import SCHEDULES, BuoyancySphere, Column, Hydrometer, Pipette, R_FACTOR, Suspension
+from sediment.lab.synthetic import stokes_column
 
-SHARED = Path(__file__).resolve().parents[3] / "shared" / "data" / "psd"
+PSDS = Path(__file__).resolve().parents[2] / "examples" / "granulometry" / "psd"
 
 
-def uniform(concentration: float, height: float = 0.36, fluid: Fluid = Fluid()) -> Column:
-    phi = concentration / fluid.particle_density
-    return Column(np.linspace(0, height, 361), np.array([0.0, 1.0]), np.full((2, 360), phi), fluid)
+def uniform(concentration: float, height: float = 0.36, suspension: Suspension = Suspension()) -> Column:
+    phi = concentration / suspension.particle_density
+    return Column(np.linspace(0, height, 361), np.array([0.0, 1.0]), np.full((2, 360), phi), suspension)
 
 
 def test_152h_geometry_matches_d422():
@@ -55,10 +55,10 @@ def recovered_error(readings, psd: PSD, lo: float, hi: float) -> float:
 
 @pytest.fixture(scope="module")
 def sample5():
-    psd = read_psd(SHARED / "sample5.csv")
+    psd = read_psd(PSDS / "sample5.csv")
     times = np.array(sorted(set(SCHEDULES["d422"] + SCHEDULES["d7928"] + SCHEDULES["bravo"]))) * 60.0
-    fluid = Fluid(particle_density=2650.0)
-    column = stokes_column(psd, 0.36, np.concatenate([[0.0], times]), 50.0, fluid)
+    suspension = Suspension(particle_density=2650.0)
+    column = stokes_column(psd, 0.36, np.concatenate([[0.0], times]), 50.0, suspension)
     return psd, column, times
 
 
@@ -97,7 +97,7 @@ def test_psd_validation(tmp_path):
 
 
 def test_discretisation_keeps_every_class_and_reports_the_simulated_psd():
-    psd = read_psd(SHARED / "sample1.csv")    # 60 % fines, a plateau, 40 % coarse
+    psd = read_psd(PSDS / "sample1.csv")    # 60 % fines, a plateau, 40 % coarse
     classes = discretise(psd, 60, sample_mass=0.06, particle_density=2500, volume_fraction=1e-7)
     assert np.all(classes.count[classes.mass_fraction > 0] >= 1)
     assert classes.mass_fraction.sum() == pytest.approx(1.0)
@@ -128,7 +128,7 @@ def test_pipette_in_a_slab_samples_the_circle_of_its_sphere():
     radius = (3 * 25e-6 / (4 * np.pi)) ** (1 / 3)
     step = 0.10 + 0.5 * radius                  # suspension above, clear water below
     fraction = np.where(edges[:-1] < step, 0.02, 0.0)
-    column = Column(edges, np.array([0.0, 1.0]), np.vstack([np.full(36000, 0.02), fraction]), Fluid(),
+    column = Column(edges, np.array([0.0, 1.0]), np.vstack([np.full(36000, 0.02), fraction]), Suspension(),
                     slab_thickness=7e-5)
     reading = Pipette(0.10).read(column, [1.0])
     u = np.linspace(-radius, radius, 200001)     # chord weights, by direct summation

@@ -6,11 +6,12 @@ from pathlib import Path
 
 import pytest
 
-from sediment import cli, sweep
-from sediment.psd import read_psd
-from sediment.sample import plan, write
+from sediment import cli
+from sediment.studies import sweep
+from sediment.lab.psd import read_psd
+from sediment.sim.scene import plan, write
 
-SHARED = Path(__file__).resolve().parents[3] / "shared" / "data" / "psd"
+PSDS = Path(__file__).resolve().parents[2] / "examples" / "granulometry" / "psd"
 
 # A deck without atoms whose observables are known functions of dt and whose cost is 1000/dt empty
 # steps; it fails for dt > 0.5.
@@ -47,10 +48,10 @@ def test_errors_against_the_finest_run_and_failed_runs_are_kept(toy, tmp_path):
     assert "no_such_command" in failed.failure and math.isinf(failed.error)
     assert finest.loop_seconds > coarse.loop_seconds > coarser.loop_seconds > 0
     assert result.cheapest(0.05) is finest and result.cheapest(0.1) is coarse and result.cheapest(1.0) is coarser
-    rows = sweep.table(result).splitlines()
+    rows = result.table().csv().splitlines()
     assert rows[0].startswith("integrator,dt,loop_s,wall_s,status,y_value,s_value,y_error,s_error,max_error")
     assert len(rows) == 5 and "failed: ERROR" in rows[4] and rows[1].split(",")[4] == "ok"
-    paths = sweep.write(result, tmp_path / "out", tolerance=0.01)
+    paths = result.save(tmp_path / "out", tolerance=0.01)
     assert all(p.stat().st_size > 0 for p in paths)
 
 
@@ -61,8 +62,9 @@ def test_analytic_references_for_a_scalar_and_a_series(toy, tmp_path):
     for run in result.runs:
         assert run.errors["y"] == pytest.approx(run.value**2, rel=1e-12)
         assert run.errors["s"] == pytest.approx(run.value, rel=1e-12)
-    assert sweep.summary(result, 0.15)[1].startswith("runs: cheapest within 15 %: dt = 0.1 ")
-    assert sweep.summary(result, 0.05)[1] == "runs: no run within 5 %"
+    assert result.summary(0.15)[1].startswith("runs: cheapest within 15 %: dt = 0.1 ")
+    assert result.summary(0.05)[1] == "runs: no run within 5 %"
+    assert result.table(0.05).text().rstrip().endswith("runs: no run within 5 %")
 
 
 def test_bad_input_is_refused_with_the_reason(toy, tmp_path):
@@ -91,7 +93,8 @@ def test_cli_prints_table_and_cheapest_step(toy, tmp_path, capsys):
     assert cli.main(["sweep", str(toy), "--dt", "0.01,0.1,0.2", "--observe", "y", "--out", str(out),
                      "--rayleigh", "0.5", "--tau", "0.1"]) == 0
     text = capsys.readouterr().out
-    assert "dt_over_rayleigh_time,dt_over_tau" in text
+    assert "dt_over_rayleigh_time dt_over_tau" in " ".join(text.split())
+    assert (out / "sweep.csv").read_text().startswith("integrator,dt,dt_over_rayleigh_time,dt_over_tau,")
     assert "runs: cheapest within 1 %: dt = 0.1 " in text and "the 20 % Rayleigh-time step" in text
     assert (out / "sweep.png").stat().st_size > 0
     with pytest.raises(SystemExit):
@@ -103,7 +106,7 @@ def test_cli_prints_table_and_cheapest_step(toy, tmp_path, capsys):
 def test_readout_curves_of_a_scene_barely_move_with_the_step(tmp_path):
     """A small sedimentation scene at its planned steps and four times them: the readout curves are
     the observables (percent finer, as a fraction of the sample)."""
-    scene = plan(read_psd(SHARED / "sample5.csv"), particles=1500, t_end=7200.0)
+    scene = plan(read_psd(PSDS / "sample5.csv"), particles=1500, t_end=7200.0)
     deck = write(scene, tmp_path / "scene")[1]
     result = sweep.run_sweep(deck, [1, 4], ["hydrometer", "pipette"], parameter="dt_scale",
                              work_dir=tmp_path / "w", progress=False)

@@ -1,21 +1,22 @@
 """Valentik & Whitmore spheres through examples/valentik_whitmore/in.sphere (sediment.valentik)."""
-import os
 from pathlib import Path
 
 import pytest
 
-from sediment import cli, valentik
+from sediment import cli
+from sediment.studies import valentik
 
-SHARED = Path(os.environ.get("SEDIMENT_SHARED", Path(__file__).resolve().parents[3] / "shared"))
-DEV_CSV = SHARED / "data" / "vw1965_dev.csv"
+DEV_CSV = Path(__file__).resolve().parents[1] / "data" / "vw1965_dev.csv"
 
 
 def test_every_development_sphere_reaches_the_law_terminal_velocity(tmp_path):
-    results = valentik.study(DEV_CSV, tmp_path, laws=("zhang-li",), progress=False)
-    assert len(results) == len(valentik.read_spheres(DEV_CSV))
-    for r in results:
+    result = valentik.study(DEV_CSV, laws=("zhang-li",), progress=False)
+    assert len(result.results) == len(valentik.read_spheres(DEV_CSV))
+    for r in result.results:
         assert abs(r.code_error) < 0.005, r
-    assert (tmp_path / "terminal_velocities.csv").is_file() and (tmp_path / "terminal_velocities.png").is_file()
+    assert result.save(tmp_path) == [tmp_path / "terminal_velocities.csv", tmp_path / "terminal_velocities.png"]
+    assert all(p.stat().st_size > 0 for p in result.save(tmp_path))
+    assert "worst |simulated/law - 1|" in result.table().text()
 
 
 def test_a_sphere_held_by_the_yield_stress_stays_at_rest():

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-2.0-or-later
 // Terminal (steady settling) velocity of a sphere under a drag law.
 #pragma once
 
@@ -15,6 +16,13 @@ struct TerminalState {
   double speed;
   TerminalRegime regime;
 };
+
+// Stokes' law: terminal speed (rho_p - rho_f) g d^2 / (18 mu) of a sphere at Re << 1 (negative: rising).
+// The readouts of the sedimentation tests invert it for the largest diameter left at a depth.
+inline double stokes_velocity(double particle_density, double fluid_density, double viscosity, double g, double d)
+{
+  return (particle_density - fluid_density) * g * d * d / (18.0 * viscosity);
+}
 
 // Net weight (rho_p - rho_f) g V of a fully immersed sphere; g is the magnitude of gravity.
 double net_weight(const Fluid &fluid, double d, double particle_density, double g);

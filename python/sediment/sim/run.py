@@ -30,6 +30,8 @@ def _launch(deck: str, log: str, ranks: int, variables: dict[str, object] | None
 
 @dataclass
 class RunResult:
+    """What a run of a deck did: steps, simulated and wall time, its log."""
+
     deck: Path
     log: Path
     wall_seconds: float

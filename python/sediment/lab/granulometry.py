@@ -1,12 +1,16 @@
 """The granulometry report of a sedimentation test: each instrument's readings, its PSD next to the
-input PSD, and the error per size range (sedimentation-tests.md section 6)."""
+input PSD, and the error per size range (docs/sedimentation-tests.md section 6)."""
 from __future__ import annotations
 
+from dataclasses import dataclass, field
 from functools import partial
 from pathlib import Path
 
 import numpy as np
 
+from .. import figures
+from ..constants import D422_CYLINDER_AREA
+from ..results import Table, write_atomic, write_text
 from .psd import PSD
 from .readout import SCHEDULES, BuoyancySphere, Column, Hydrometer, Pipette, Readings
 
@@ -15,12 +19,12 @@ SIZE_RANGES_UM = [(0.0, 5.0), (5.0, 20.0), (20.0, 75.0)]
 
 def read_all(column: Column, instruments: list[str], schedule: str = "d422", sphere_depth: float | None = None,
              pipette_depth: float = 0.10, pipette_volume: float = 25e-6,
-             cylinder_area: float = 27.8e-4, hydrometer: Hydrometer | None = None) -> tuple[list[Readings], list[str]]:
+             cylinder_area: float = D422_CYLINDER_AREA, hydrometer: Hydrometer | None = None) -> tuple[list[Readings], list[str]]:
     """Readings of the chosen instruments at the schedule's times that the frames cover (the
     hydrometer: the nominal 152H unless another is given); returns them with notes on the inputs
     and the times left out."""
-    f = column.fluid
-    notes = [f"readout inputs: Gs = {f.specific_gravity:.4g}, water {f.density:.6g} kg/m3, viscosity "
+    f = column.suspension
+    notes = [f"readout inputs: Gs = {f.specific_gravity:.4g}, water {f.fluid_density:.6g} kg/m3, viscosity "
              f"{f.viscosity:.4g} Pa s, c0 = {column.initial_concentration():.4g} kg/m3, column {column.height:.4g} m"]
     results = []
     for name in instruments:
@@ -32,7 +36,7 @@ def read_all(column: Column, instruments: list[str], schedule: str = "d422", sph
             times = np.array(SCHEDULES["bravo" if schedule == "d422" else schedule]) * 60.0
         else:
             pipette = Pipette(pipette_depth, pipette_volume)
-            read, times = pipette.read, pipette.default_times(column.fluid)
+            read, times = pipette.read, pipette.default_times(column.suspension)
         covered = times[(times > column.time[0]) & (times <= column.time[-1])]
         if len(covered) < len(times):
             notes.append(f"{name}: {len(times) - len(covered)} of {len(times)} reading times lie beyond the "
@@ -54,24 +58,50 @@ def error_summary(readings: list[Readings], psd: PSD) -> list[tuple[str, str, in
     return rows
 
 
-def write_report(readings: list[Readings], out: Path, psd: PSD | None = None, simulated: PSD | None = None,
-                 title: str = "") -> list[Path]:
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+@dataclass
+class Granulometry:
+    """A sedimentation test read out: the instruments' readings, notes on the inputs, and the PSDs
+    (input and simulated) they are compared with."""
 
-    out.mkdir(parents=True, exist_ok=True)
-    written = []
-    for r in readings:
-        path = out / f"{r.instrument}.csv"
-        path.write_text(r.table())
-        written.append(path)
-    references = [(name, curve) for name, curve in (("input", psd), ("simulated", simulated)) if curve is not None]
-    if references:
-        path = out / "errors.csv"
-        path.write_text("reference,instrument,size_range,readings,mean_abs_error_points\n" + "".join(
-            f"{name},{a},{b},{n},{e:.4g}\n" for name, curve in references for a, b, n, e in error_summary(readings, curve)))
-        written.append(path)
+    readings: list[Readings]
+    notes: list[str] = field(default_factory=list)
+    psd: PSD | None = None
+    simulated: PSD | None = None
+    title: str = ""
+
+    def references(self) -> list[tuple[str, PSD]]:
+        """The PSDs given to compare with, by name ("input", "simulated")."""
+        return [(name, curve) for name, curve in (("input", self.psd), ("simulated", self.simulated))
+                if curve is not None]
+
+    def table(self) -> Table:
+        """Mean |P - PSD| per reference, instrument and size range; the notes give the inputs."""
+        table = Table(["reference", "instrument", "size_range", "readings", "mean_abs_error_points"],
+                      notes=list(self.notes))
+        for name, curve in self.references():
+            for instrument, size_range, count, error in error_summary(self.readings, curve):
+                table.add(name, instrument, size_range, count, f"{error:.4g}")
+        return table
+
+    def save(self, folder: Path) -> list[Path]:
+        """<instrument>.csv per instrument, errors.csv (with a reference PSD) and granulometry.png/.pdf."""
+        folder = Path(folder)
+        written = [path for r in self.readings for path in r.save(folder)]
+        if self.references():
+            written.append(write_text(folder / "errors.csv", self.table().csv()))
+        return written + _plot(self, folder)
+
+
+def granulometry(column: Column, instruments: list[str], psd: PSD | None = None, simulated: PSD | None = None,
+                 title: str = "", **options) -> Granulometry:
+    """`read_all` (same options) as a result to tabulate and save, compared with the PSDs given."""
+    readings, notes = read_all(column, instruments, **options)
+    return Granulometry(readings, notes, psd, simulated, title)
+
+
+def _plot(report: Granulometry, folder: Path) -> list[Path]:
+    plt = figures.pyplot()
+    psd, simulated, readings, title = report.psd, report.simulated, report.readings, report.title
     fig, ax = plt.subplots(figsize=(7, 4.5))
     for curve, style, label in ((psd, "k-", "input PSD"), (simulated, "k--", "simulated PSD")):
         if curve is not None:
@@ -90,8 +120,7 @@ def write_report(readings: list[Readings], out: Path, psd: PSD | None = None, si
     if title:
         ax.set_title(title)
     fig.tight_layout()
-    for ext in ("png", "pdf"):
-        fig.savefig(out / f"granulometry.{ext}", dpi=150)
-        written.append(out / f"granulometry.{ext}")
+    written = [write_atomic(folder / f"granulometry.{ext}", lambda tmp, ext=ext: fig.savefig(tmp, dpi=150, format=ext))
+               for ext in ("png", "pdf")]
     plt.close(fig)
     return written

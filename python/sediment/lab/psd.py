@@ -100,6 +100,7 @@ class SizeClasses:
         return float(np.sum(self.count * self.weight))
 
     def simulated_mass_fraction(self) -> np.ndarray:
+        """Mass fraction of each class among the grains the simulation stands for."""
         mass = self.count * self.weight * self.diameter ** 3
         return mass / mass.sum()
 

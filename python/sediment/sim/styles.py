@@ -3,7 +3,7 @@ from __future__ import annotations
 
 from typing import Any, Sequence
 
-from . import _core
+from .. import _core
 
 
 def register_styles(lmp: Any) -> Any:

@@ -7,7 +7,6 @@ of the plane lies inside a ball.
 """
 from __future__ import annotations
 
-import csv
 import math
 import tempfile
 from concurrent.futures import ThreadPoolExecutor
@@ -16,9 +15,10 @@ from pathlib import Path
 
 import numpy as np
 
-from . import figures
+from .. import figures
+from ..results import Table, write_text
+from ..sim.run import run_batch
 from .paste import EXAMPLES, PASTE
-from .run import run_batch
 
 BALLS = 68
 DIAMETER = 0.0126
@@ -51,6 +51,7 @@ def random_packing(seed: int, balls: int = BALLS, diameter: float = DIAMETER, ma
 
 
 def write_packing(centres: np.ndarray, path: Path) -> None:
+    """Writes the ball centres as create_atoms commands for in.funnel."""
     lines = [f"# {len(centres)} balls at random in the funnel"]
     lines += [f"create_atoms 1 single {x:.9g} {y:.9g} {z:.9g}" for x, y, z in centres]
     path.write_text("\n".join(lines) + "\n")
@@ -58,6 +59,8 @@ def write_packing(centres: np.ndarray, path: Path) -> None:
 
 @dataclass
 class Pour:
+    """One pour of the 68 balls and where they ended."""
+
     seed: int
     placed: int
     balls: int               # in the mould at the end
@@ -80,23 +83,44 @@ def pour(seed: int, dt: float = 1e-6, settle: float = 0.4) -> Pour:
                 r["pour_time"], out.wall_seconds)
 
 
-def funnel_study(out_dir: Path, runs: int = 15, jobs: int = 2, dt: float = 1e-6, progress: bool = True) -> list[Pour]:
-    """`runs` pours with seeds 1..runs, `jobs` at a time: positions table and figures."""
+@dataclass
+class FunnelStudy:
+    """Several pours of case E, one per random packing in the funnel."""
+
+    pours: list[Pour]
+
+    def table(self) -> Table:
+        """Per pour: balls in the mould, spilled, depth range of the centres, pour and wall time."""
+        table = Table(["seed", "placed", "in mould", "spilled", "shallowest [mm]", "deepest [mm]", "pour [s]",
+                       "wall [s]"])
+        for p in self.pours:
+            depth = PASTE["surface"] - p.positions[:, 2]
+            table.add(p.seed, p.placed, p.balls, p.spilled, f"{depth.min() * 1e3:.1f}", f"{depth.max() * 1e3:.1f}",
+                      f"{p.pour_time:.3f}", f"{p.wall_seconds:.1f}")
+        depths = np.concatenate([PASTE["surface"] - p.positions[:, 2] for p in self.pours])
+        table.notes.append(f"all runs: centres {depths.min() * 1e3:.1f} to {depths.max() * 1e3:.1f} mm below the "
+                           f"surface, {sum(p.spilled for p in self.pours)} spilled")
+        return table
+
+    def save(self, folder: Path) -> list[Path]:
+        """funnel_positions.csv (every ball of every pour), funnel_positions.png, funnel_presence.png."""
+        folder = Path(folder)
+        positions = Table(["seed", "ball", "x_m", "y_m", "z_m", "depth_below_surface_m"])
+        for p in self.pours:
+            for i, (x, y, z) in enumerate(p.positions, start=1):
+                positions.add(p.seed, i, x, y, z, PASTE["surface"] - z)
+        return [write_text(folder / "funnel_positions.csv", positions.csv()),
+                plot_positions(self.pours, folder / "funnel_positions.png"),
+                plot_presence(self.pours, folder / "funnel_presence.png")]
+
+
+def funnel_study(runs: int = 15, jobs: int = 2, dt: float = 1e-6, progress: bool = True) -> FunnelStudy:
+    """`runs` pours with seeds 1..runs, `jobs` at a time."""
     from tqdm import tqdm
 
     with ThreadPoolExecutor(max_workers=jobs) as pool:
-        pours = list(tqdm(pool.map(lambda s: pour(s, dt), range(1, runs + 1)), total=runs, desc="pours",
-                          unit="run", disable=not progress))
-    out_dir.mkdir(parents=True, exist_ok=True)
-    with open(out_dir / "funnel_positions.csv", "w", newline="") as f:
-        writer = csv.writer(f)
-        writer.writerow(["seed", "ball", "x_m", "y_m", "z_m", "depth_below_surface_m"])
-        for p in pours:
-            for i, (x, y, z) in enumerate(p.positions, start=1):
-                writer.writerow([p.seed, i, f"{x:.6g}", f"{y:.6g}", f"{z:.6g}", f"{PASTE['surface'] - z:.6g}"])
-    plot_positions(pours, out_dir / "funnel_positions.png")
-    plot_presence(pours, out_dir / "funnel_presence.png")
-    return pours
+        return FunnelStudy(list(tqdm(pool.map(lambda s: pour(s, dt), range(1, runs + 1)), total=runs, desc="pours",
+                                     unit="run", disable=not progress)))
 
 
 def presence_probability(pours: list[Pour], plane: float, cell: float = 0.0025) -> tuple[np.ndarray, np.ndarray]:
@@ -119,7 +143,8 @@ def presence_probability(pours: list[Pour], plane: float, cell: float = 0.0025) 
     return centres, probability
 
 
-def plot_positions(pours: list[Pour], path: Path) -> None:
+def plot_positions(pours: list[Pour], path: Path) -> Path:
+    """Vertical distribution of the final centres over every pour."""
     plt = figures.pyplot()
 
     depth = np.concatenate([PASTE["surface"] - p.positions[:, 2] for p in pours]) * 1e3
@@ -137,10 +162,11 @@ def plot_positions(pours: list[Pour], path: Path) -> None:
     hist.set(xlabel="balls per run", ylabel="depth of the centre [mm]",
              title=f"Vertical distribution: {depth.min():.0f} to {depth.max():.0f} mm")
     hist.invert_yaxis()
-    figures.save(fig, path)
+    return figures.save(fig, path)
 
 
-def plot_presence(pours: list[Pour], path: Path, spacing: float = 0.01) -> None:
+def plot_presence(pours: list[Pour], path: Path, spacing: float = 0.01) -> Path:
+    """Probability of presence per cell on horizontal planes `spacing` apart (the paper's figure 22)."""
     plt = figures.pyplot()
 
     tops = [PASTE["surface"] - p.positions[:, 2].max() for p in pours]
@@ -161,4 +187,4 @@ def plot_presence(pours: list[Pour], path: Path, spacing: float = 0.01) -> None:
         ax.axis("off")
     fig.colorbar(image, ax=axes, shrink=0.6, label="probability of presence")
     fig.suptitle(f"Balls on horizontal planes every {spacing * 1e3:.0f} mm ({len(pours)} runs)")
-    figures.save(fig, path, dpi=110, tight=False)
+    return figures.save(fig, path, dpi=110, tight=False)

@@ -16,9 +16,10 @@ from pathlib import Path
 
 import numpy as np
 
-from . import _core
-from .psd import PSD, SizeClasses, class_edges, discretise
-from .readout import Fluid
+from .. import _core
+from ..constants import BRAVO_CYLINDER_HEIGHT, BRAVO_CYLINDER_WIDTH, D422_CYLINDER_AREA, D422_CYLINDER_HEIGHT
+from ..lab.psd import PSD, SizeClasses, class_edges, discretise
+from ..lab.readout import Suspension
 
 GEOMETRIES = ("column", "slab")
 
@@ -27,16 +28,17 @@ GEOMETRIES = ("column", "slab")
 class Cylinder:
     """The sedimentation cylinder: inner cross-section and suspension height."""
 
-    area: float = 27.8e-4       # m2, ASTM D422 (inner diameter 5.95 cm)
-    height: float = 0.36        # m, the 1000 mL mark
+    area: float = D422_CYLINDER_AREA
+    height: float = D422_CYLINDER_HEIGHT
 
     @classmethod
     def bravo(cls) -> "Cylinder":
         """Bravo et al. (2015): H = 0.457 m, B = 0.0635 m."""
-        return cls(math.pi / 4 * 0.0635 ** 2, 0.457)
+        return cls(math.pi / 4 * BRAVO_CYLINDER_WIDTH ** 2, BRAVO_CYLINDER_HEIGHT)
 
     @property
     def diameter(self) -> float:
+        """Inner diameter [m]."""
         return math.sqrt(4 * self.area / math.pi)
 
 
@@ -51,6 +53,7 @@ class Effects:
 
     @property
     def interacting(self) -> bool:
+        """Whether grains interact (contacts or lubrication), which needs real grains."""
         return self.contacts or self.lubrication
 
 
@@ -60,7 +63,7 @@ class Scene:
 
     psd: PSD
     classes: SizeClasses
-    fluid: Fluid
+    suspension: Suspension
     cylinder: Cylinder
     geometry: str
     width: float                    # column: side of the square section; slab: across the cylinder
@@ -77,14 +80,17 @@ class Scene:
 
     @property
     def height(self) -> float:
+        """Suspension height [m]."""
         return self.cylinder.height
 
     @property
     def dimension(self) -> int:
+        """2 for the slab, 3 for the column."""
         return 2 if self.geometry == "slab" else 3
 
     @property
     def volume(self) -> float:
+        """Volume of the simulated sub-volume [m3]."""
         return self.width * self.thickness * self.height
 
     @property
@@ -107,7 +113,7 @@ class Scene:
             return [(dt, math.ceil(self.t_end / dt))]
         every = self.frame_steps()
         steps = FRAMES_PER_STAGE * every
-        v_max = terminal_speed(self.fluid, self.classes.diameter[self.classes.count > 0].max(), self.effects.law)
+        v_max = terminal_speed(self.suspension, self.classes.diameter[self.classes.count > 0].max(), self.effects.law)
         time, dt, result = 0.0, self.height / v_max / steps, []
         while time < self.t_end * (1 - 1e-12):
             n = min(steps, every * math.ceil((self.t_end - time) / (dt * every)))
@@ -126,9 +132,10 @@ class Scene:
     def contact_time_step(self) -> float:
         """A fifth of the Rayleigh time of the smallest grain (Young's modulus as in `write`)."""
         radius = 0.5 * self.classes.diameter[self.classes.count > 0].min()
-        return 0.2 * _core.rayleigh_time(radius, self.fluid.particle_density, YOUNGS_MODULUS, POISSON_RATIO)
+        return 0.2 * _core.rayleigh_time(radius, self.suspension.particle_density, YOUNGS_MODULUS, POISSON_RATIO)
 
     def simulated_psd(self) -> PSD:
+        """The PSD the scene's particles stand for."""
         return self.classes.simulated_psd()
 
 
@@ -138,15 +145,16 @@ YOUNGS_MODULUS = 1e7    # Pa: a soft grain (contact time long enough to be affor
 POISSON_RATIO = 0.3
 
 
-def terminal_speed(fluid: Fluid, diameter: float, law: str) -> float:
+def terminal_speed(suspension: Suspension, diameter: float, law: str) -> float:
+    """Terminal speed [m/s] of a grain of `diameter` under `law` in the suspension's fluid."""
     drag_law = "dallavalle" if law == "difelice" else law    # Di Felice alone is Dallavalle's C_d
-    speed, _ = _core.terminal_velocity(drag_law, fluid.density, fluid.viscosity, 0.0, float(diameter),
-                                       fluid.particle_density, fluid.gravity)
+    speed, _ = _core.terminal_velocity(drag_law, suspension.fluid_density, suspension.viscosity, 0.0, float(diameter),
+                                       suspension.particle_density, suspension.gravity)
     return speed
 
 
 def plan(psd: PSD, *, geometry: str = "column", cylinder: Cylinder = Cylinder(), mass: float = 0.060,
-         fluid: Fluid = Fluid(), width: float | None = None, classes: int = 40, particles: int | None = 20000,
+         suspension: Suspension = Suspension(), width: float | None = None, classes: int = 40, particles: int | None = 20000,
          effects: Effects = Effects(), layers: int = 400, t_end: float = 86400.0, courant: float = 1.0,
          seed: int = 1) -> Scene:
     """The scene of a test: sub-volume, classes, particles and their placement.
@@ -172,11 +180,11 @@ def plan(psd: PSD, *, geometry: str = "column", cylinder: Cylinder = Cylinder(),
     if not 0 < width <= (cylinder.diameter if geometry == "slab" else math.sqrt(cylinder.area)):
         raise ValueError(f"sub-volume width {width:g} m does not fit the cylinder ({cylinder.diameter:g} m across)")
     fraction = width * thickness / cylinder.area
-    size_classes = discretise(psd, classes, mass, fluid.particle_density, fraction, particles)
+    size_classes = discretise(psd, classes, mass, suspension.particle_density, fraction, particles)
     if size_classes.count.sum() > MAX_PARTICLES:
         raise ValueError(f"{size_classes.count.sum():.3g} real grains in this sub-volume (more than {MAX_PARTICLES:.0e}): "
                          "simulate parcels (--particles) or a smaller sub-volume (--width, --height)")
-    scene = Scene(psd, size_classes, fluid, cylinder, geometry, width, thickness, mass, effects, layers, t_end,
+    scene = Scene(psd, size_classes, suspension, cylinder, geometry, width, thickness, mass, effects, layers, t_end,
                   courant, seed)
     place(scene)
     return scene
@@ -282,7 +290,7 @@ def _write_data(scene: Scene, path: Path) -> None:
              f"{n} atoms", "1 atom types", ""]
     lines += [f"{lo[k]:.17g} {hi[k]:.17g} {a}lo {a}hi" for k, a in enumerate("xyz")]
     lines += ["", "Atoms # sphere", ""]
-    rho = scene.fluid.particle_density
+    rho = scene.suspension.particle_density
     lines += [f"{i + 1} 1 {d:.17g} {rho:.17g} {x:.17g} {y:.17g} {z:.17g}"
               for i, (d, (x, y, z)) in enumerate(zip(scene.diameter, scene.position))]
     lines += ["", "Weights", ""]
@@ -291,13 +299,14 @@ def _write_data(scene: Scene, path: Path) -> None:
 
 
 def scene_box(scene: Scene) -> tuple[list[float], list[float]]:
+    """The simulation box (lo, hi per axis) of the scene."""
     if scene.geometry == "slab":
         return [0.0, 0.0, -0.5 * scene.thickness], [scene.width, scene.height, 0.5 * scene.thickness]
     return [0.0, 0.0, 0.0], [scene.width, scene.width, scene.height]
 
 
 def _deck(scene: Scene, data: str, layer_file: str) -> str:
-    e, f = scene.effects, scene.fluid
+    e, f = scene.effects, scene.suspension
     slab = scene.geometry == "slab"
     up = "y" if slab else "z"
     gravity = "0 -1 0" if slab else "0 0 -1"
@@ -340,7 +349,7 @@ def _deck(scene: Scene, data: str, layer_file: str) -> str:
     lines += [
         "",
         f"fix             grav all gravity {f.gravity:.12g} vector {gravity}",
-        f"fix             water all fluid density {f.density:.12g} viscosity {f.viscosity:.12g}",
+        f"fix             water all fluid density {f.fluid_density:.12g} viscosity {f.viscosity:.12g}",
         "fix             buoy all fluid/buoyancy water",
         f"compute         conc all concentration/grid layers {up} {scene.layers} bounds 0 {scene.height:.12g}"
         f"{f' thickness {scene.thickness:.12g}' if slab else ''} weight d_weight",

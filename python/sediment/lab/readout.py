@@ -8,12 +8,15 @@ the solid volume fraction per layer. Each instrument turns it into a `Readings` 
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from pathlib import Path
 
 import numpy as np
 
-G = 9.81
-WATER_20C = 998.2          # kg/m3
-VISCOSITY_20C = 1.002e-3   # Pa s
+from .. import _core
+from ..results import Table, write_text
+from ..constants import (D422_CYLINDER_AREA, GRAVITY, SOIL_PARTICLE_DENSITY, WATER_20C_DENSITY,
+                         WATER_20C_VISCOSITY)
+
 R_FACTOR = 1 - 1 / 2.65    # 152H: R = (rho_s - rho_w) / 0.6226 in g/L, calibrated for Gs = 2.65
 
 SCHEDULES = {              # reading times [min]
@@ -24,26 +27,34 @@ SCHEDULES = {              # reading times [min]
 
 
 @dataclass(frozen=True)
-class Fluid:
-    density: float = WATER_20C
-    viscosity: float = VISCOSITY_20C
-    particle_density: float = 2650.0
-    gravity: float = G
+class Suspension:
+    """The water and the solids of a sedimentation test, and Stokes' law between them."""
+
+    fluid_density: float = WATER_20C_DENSITY
+    viscosity: float = WATER_20C_VISCOSITY
+    particle_density: float = SOIL_PARTICLE_DENSITY
+    gravity: float = GRAVITY
 
     @property
     def specific_gravity(self) -> float:
+        """Gs = rho_p / 1000 kg/m3 (the hydrometer's definition)."""
         return self.particle_density / 1000.0
 
     def stokes_speed(self, diameter) -> np.ndarray:
-        """(rho_p - rho_f) g D^2 / (18 mu)."""
-        return (self.particle_density - self.density) * self.gravity * np.asarray(diameter) ** 2 / (18 * self.viscosity)
+        """Stokes' law, (rho_p - rho_f) g D^2 / (18 mu) [m/s]."""
+        return _core.stokes_velocity(self.particle_density, self.fluid_density, self.viscosity, self.gravity, diameter)
 
     def stokes_diameter(self, depth, time) -> np.ndarray:
         """Largest diameter still present at `depth` after `time`: the one settling depth / time."""
         return np.sqrt(np.asarray(depth) / np.asarray(time) / self.stokes_speed(1.0))
 
     def stokes_time(self, depth, diameter) -> np.ndarray:
+        """Time for a grain of `diameter` to settle through `depth`."""
         return np.asarray(depth) / self.stokes_speed(diameter)
+
+    def mixture_density(self, fraction) -> np.ndarray:
+        """Density of the suspension at solid volume fraction `fraction` [kg/m3]."""
+        return _core.mixture_density(self.fluid_density, self.particle_density, fraction)
 
 
 @dataclass(frozen=True)
@@ -53,7 +64,7 @@ class Column:
     depth_edges: np.ndarray     # [layers + 1], increasing from the surface (0) down
     time: np.ndarray            # [frames] s
     fraction: np.ndarray        # [frames, layers]
-    fluid: Fluid = field(default_factory=Fluid)
+    suspension: Suspension = field(default_factory=Suspension)
     slab_thickness: float = 0.0  # > 0 for a 2d slab (the pipette samples a circle)
 
     def __post_init__(self) -> None:
@@ -78,17 +89,18 @@ class Column:
         keep = depth[1:] > 0                               # layers (partly) below the surface
         edges = np.clip(np.concatenate([depth[:-1][keep][:1], depth[1:][keep]]), 0.0, None)
         fraction = layers.total[:, ::-1][:, keep]
-        fluid = Fluid(attrs["fluid_density"], attrs["fluid_viscosity"], attrs["particle_density"])
-        return cls(edges, np.asarray(layers.time, float), fraction, fluid, attrs.get("slab_thickness", 0.0))
+        suspension = Suspension(attrs["fluid_density"], attrs["fluid_viscosity"], attrs["particle_density"])
+        return cls(edges, np.asarray(layers.time, float), fraction, suspension, attrs.get("slab_thickness", 0.0))
 
     @property
     def height(self) -> float:
+        """Depth of the column below the free surface [m]."""
         return float(self.depth_edges[-1])
 
     def initial_concentration(self) -> float:
         """c0 [kg/m3]: solids per volume of suspension in the first frame."""
         widths = np.diff(self.depth_edges)
-        return float(self.fluid.particle_density * np.sum(self.fraction[0] * widths) / self.height)
+        return float(self.suspension.particle_density * np.sum(self.fraction[0] * widths) / self.height)
 
     def at(self, t: float) -> np.ndarray:
         """Solid fraction per layer at time t, linear between frames."""
@@ -102,7 +114,7 @@ class Column:
 
     def density(self, t: float) -> np.ndarray:
         """Suspension density rho_f + (rho_p - rho_f) phi per layer [kg/m3]."""
-        return self.fluid.density + (self.fluid.particle_density - self.fluid.density) * self.at(t)
+        return self.suspension.mixture_density(self.at(t))
 
     def mass_above(self, depth, t: float) -> np.ndarray:
         """Integral of the suspension density from the surface to `depth` [kg/m2], exact for
@@ -111,7 +123,7 @@ class Column:
         cumulative = np.concatenate([[0.0], np.cumsum(rho * np.diff(self.depth_edges))])
         depth = np.asarray(depth, float)
         inside = np.interp(depth, self.depth_edges, cumulative)
-        return inside + np.maximum(depth - self.height, 0.0) * self.fluid.density
+        return inside + np.maximum(depth - self.height, 0.0) * self.suspension.fluid_density
 
     def weighted_mean(self, t: float, centre: float, radius: float, disc: bool = False) -> float:
         """Mean solid fraction over a sphere (or, in a 2d slab, a disc) centred at `centre` depth,
@@ -131,6 +143,8 @@ class Column:
 
 @dataclass
 class Readings:
+    """What one instrument read at its reading times, and the PSD points it gives."""
+
     instrument: str
     time: np.ndarray        # s
     depth: np.ndarray       # m, the depth Stokes' law uses
@@ -138,12 +152,17 @@ class Readings:
     diameter: np.ndarray    # m
     percent_finer: np.ndarray
 
-    def table(self) -> str:
+    def table(self) -> Table:
+        """Time [min], depth [cm], reading, diameter [um] and percent finer per reading."""
         unit = {"hydrometer": "R [g/L]", "buoyancy": "m_app [g]", "pipette": "c [g/L]"}[self.instrument]
-        lines = [f"time_min,depth_cm,{unit},diameter_um,percent_finer"]
+        table = Table(["time_min", "depth_cm", unit, "diameter_um", "percent_finer"])
         for row in zip(self.time / 60, self.depth * 100, self.reading, self.diameter * 1e6, self.percent_finer):
-            lines.append(",".join(f"{v:.6g}" for v in row))
-        return "\n".join(lines) + "\n"
+            table.add(*map(float, row))
+        return table
+
+    def save(self, folder: Path) -> list[Path]:
+        """<instrument>.csv."""
+        return [write_text(Path(folder) / f"{self.instrument}.csv", self.table().csv())]
 
 
 @dataclass(frozen=True)
@@ -160,7 +179,7 @@ class Hydrometer:
 
     @classmethod
     def astm_152h(cls, bulb_length=0.140, bulb_volume=67.0e-6, scale_zero=0.105, scale_at_50=0.023,
-                  water_density=WATER_20C) -> "Hydrometer":
+                  water_density=WATER_20C_DENSITY) -> "Hydrometer":
         """The nominal 152H of ASTM D422. Stem area and mass follow from the calibration: it floats
         with the surface at L1(R) in a uniform suspension of density rho_w + 0.6226 R."""
         step = (scale_zero - scale_at_50) / 50.0
@@ -193,18 +212,18 @@ class Hydrometer:
             lo, hi = (mid, hi) if excess(mid) < 0 else (lo, mid)
         return 0.5 * (lo + hi)
 
-    def read(self, column: Column, times_s, cylinder_area: float = 27.8e-4, level_rise: bool = True) -> Readings:
+    def read(self, column: Column, times_s, cylinder_area: float = D422_CYLINDER_AREA, level_rise: bool = True) -> Readings:
         """Readings at the given times. The Stokes depth is the bulb centre; with `level_rise` it is
         taken as in D422, L = L1 + (L2 - VB / A_c) / 2: the bulb lifts the surface by VB / A_c."""
-        fluid = column.fluid
+        suspension = column.suspension
         c0 = column.initial_concentration()
-        a = 1.65 * fluid.specific_gravity / (2.65 * (fluid.specific_gravity - 1))    # 152H Gs correction
+        a = 1.65 * suspension.specific_gravity / (2.65 * (suspension.specific_gravity - 1))    # 152H Gs correction
         rows = []
         for t in times_s:
             top = self.bulb_top_depth(column, t)
             reading = (self.scale_zero - top) / self.scale_step
             depth = top + 0.5 * (self.bulb_length - (self.bulb_volume / cylinder_area if level_rise else 0.0))
-            rows.append((t, depth, reading, fluid.stokes_diameter(depth, t), _percent(reading * a, c0)))
+            rows.append((t, depth, reading, suspension.stokes_diameter(depth, t), _percent(reading * a, c0)))
         return _readings("hydrometer", rows)
 
 
@@ -217,18 +236,19 @@ class BuoyancySphere:
     mass: float = 0.0       # its own mass [kg]; only shifts the apparent mass
 
     def read(self, column: Column, times_s) -> Readings:
-        fluid = column.fluid
+        """Apparent mass [g] of the sphere at each time, with the diameter and percent finer it gives."""
+        suspension = column.suspension
         volume = np.pi / 6 * self.diameter ** 3
         c0 = column.initial_concentration()
         rows = []
         for t in times_s:
             phi = column.weighted_mean(t, self.depth, self.diameter / 2)
-            rho = fluid.density + (fluid.particle_density - fluid.density) * phi
+            rho = suspension.mixture_density(phi)
             apparent = self.mass - rho * volume
-            in_water = self.mass - fluid.density * volume
-            gs = fluid.specific_gravity
+            in_water = self.mass - suspension.fluid_density * volume
+            gs = suspension.specific_gravity
             concentration = (in_water - apparent) / volume * gs / (gs - 1)    # kg/m3 (Gs from water at 1000)
-            rows.append((t, self.depth, apparent * 1e3, fluid.stokes_diameter(self.depth, t),
+            rows.append((t, self.depth, apparent * 1e3, suspension.stokes_diameter(self.depth, t),
                          _percent(concentration, c0)))
         return _readings("buoyancy", rows)
 
@@ -242,20 +262,21 @@ class Pipette:
     volume: float = 25e-6
 
     def read(self, column: Column, times_s) -> Readings:
-        fluid = column.fluid
+        """Solids concentration [g/L] drawn at each time, with the diameter and percent finer it gives."""
+        suspension = column.suspension
         disc = column.slab_thickness > 0
         radius = (3 * self.volume / (4 * np.pi)) ** (1 / 3)
         c0 = column.initial_concentration()
         rows = []
         for t in times_s:
-            concentration = fluid.particle_density * column.weighted_mean(t, self.depth, radius, disc=disc)
-            rows.append((t, self.depth, concentration, fluid.stokes_diameter(self.depth, t),
+            concentration = suspension.particle_density * column.weighted_mean(t, self.depth, radius, disc=disc)
+            rows.append((t, self.depth, concentration, suspension.stokes_diameter(self.depth, t),
                          _percent(concentration, c0)))
         return _readings("pipette", rows)
 
-    def default_times(self, fluid: Fluid) -> np.ndarray:
+    def default_times(self, suspension: Suspension) -> np.ndarray:
         """Stokes times of 50, 20, 10, 5 and 2 um at the pipette depth."""
-        return fluid.stokes_time(self.depth, np.array([50, 20, 10, 5, 2]) * 1e-6)
+        return suspension.stokes_time(self.depth, np.array([50, 20, 10, 5, 2]) * 1e-6)
 
 
 def _percent(concentration: float, initial: float) -> float:

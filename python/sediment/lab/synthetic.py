@@ -6,21 +6,21 @@ from __future__ import annotations
 import numpy as np
 
 from .psd import PSD, log_classes
-from .readout import Column, Fluid
+from .readout import Column, Suspension
 
 
-def stokes_column(psd: PSD, height: float, times, initial_concentration: float, fluid: Fluid = Fluid(),
+def stokes_column(psd: PSD, height: float, times, initial_concentration: float, suspension: Suspension = Suspension(),
                   layers: int = 2000, classes: int = 600) -> Column:
     """Column of `layers` over `height` [m] at `times` [s]; `initial_concentration` in kg/m3."""
     diameter, share = log_classes(psd, psd.diameter[0], psd.diameter[-1], classes)
     share[0] += psd.percent_finer[0] / 100.0    # mass below the table's first diameter settles with the finest class
-    speed = fluid.stokes_speed(diameter)
+    speed = suspension.stokes_speed(diameter)
     edges = np.linspace(0.0, height, layers + 1)
-    phi0 = initial_concentration / fluid.particle_density
+    phi0 = initial_concentration / suspension.particle_density
     times = np.asarray(times, float)
     fraction = np.empty((len(times), layers))
     for k, t in enumerate(times):
         front = np.minimum(speed * t, height)[:, None]      # class k is present below its front
         covered = np.clip(edges[1:] - np.maximum(edges[:-1], front), 0.0, None) / np.diff(edges)
         fraction[k] = phi0 * share @ covered
-    return Column(edges, times, fraction, fluid)
+    return Column(edges, times, fraction, suspension)

@@ -11,21 +11,27 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 from scipy.optimize import brentq
 
-GRAVITY = 9.81
+from ..constants import GRAVITY
+from ..results import Table, write_text
+
 
 
 @dataclass(frozen=True)
 class Calibration:
+    """A parameter measured in repeated laboratory tests."""
+
     name: str
     unit: str
     values: np.ndarray    # one per repetition
 
     @property
     def mean(self) -> float:
+        """Mean over the repetitions."""
         return float(np.mean(self.values))
 
     @property
@@ -33,10 +39,19 @@ class Calibration:
         """Sample standard deviation (0 for a single test)."""
         return float(np.std(self.values, ddof=1)) if len(self.values) > 1 else 0.0
 
-    def describe(self) -> str:
-        each = ", ".join(f"{v:.4g}" for v in self.values)
+    def table(self) -> Table:
+        """One row per repetition; the note gives the mean and the spread."""
         unit = f" {self.unit}" if self.unit else ""
-        return f"{self.name}: {each} -> mean {self.mean:.4g}{unit} (s.d. {self.spread:.2g}{unit})"
+        table = Table(["test", f"{self.name}{f' [{self.unit}]' if self.unit else ''}"])
+        for k, value in enumerate(self.values, start=1):
+            table.add(k, f"{value:.4g}")
+        table.notes.append(f"{self.name}: mean {self.mean:.4g}{unit} (s.d. {self.spread:.2g}{unit}) over "
+                           f"{len(self.values)} test(s)")
+        return table
+
+    def save(self, folder: Path) -> list[Path]:
+        """calibration.csv."""
+        return [write_text(Path(folder) / "calibration.csv", self.table().csv())]
 
 
 def _positive(name: str, values) -> np.ndarray:

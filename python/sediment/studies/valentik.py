@@ -12,17 +12,20 @@ import math
 from dataclasses import dataclass
 from pathlib import Path
 
-from . import _core, figures
-from .paths import REPO_DIR
-from .run import run_batch
+from .. import _core, figures
+from ..results import Table, write_text
+from ..constants import GRAVITY
+from ..sim.paths import REPO_DIR
+from ..sim.run import run_batch
 
 DECK = REPO_DIR / "examples" / "valentik_whitmore" / "in.sphere"
 COLUMNS = ("suspension", "rho_f", "eta_B", "tau_y", "d", "rho_p", "v_ter_measured")
-GRAVITY = 9.81
 
 
 @dataclass
 class Sphere:
+    """A sphere of the Valentik & Whitmore table and its suspension (SI units)."""
+
     suspension: str
     rho_f: float
     eta_B: float
@@ -34,6 +37,8 @@ class Sphere:
 
 @dataclass
 class Settling:
+    """One sphere settled under one law."""
+
     sphere: Sphere
     law: str
     analytic: float     # terminal velocity of the law [m/s]
@@ -52,6 +57,7 @@ class Settling:
 
 
 def read_spheres(path: Path) -> list[Sphere]:
+    """Reads the spheres of a Valentik & Whitmore CSV, refusing malformed rows with the line."""
     path = Path(path)
     if not path.is_file():
         raise FileNotFoundError(f"{path}: no such file")
@@ -89,26 +95,46 @@ def settle(sphere: Sphere, law: str = "zhang-li", steps: int = 2000) -> Settling
     return Settling(sphere, law, speed, regime, out.results["speed"])
 
 
-def study(csv_path: Path, out_dir: Path, laws=("zhang-li", "zhang-li/smooth"), progress: bool = True) -> list[Settling]:
+@dataclass
+class SpheresStudy:
+    """Terminal velocities of spheres in Bingham suspensions: simulated, the law's, measured."""
+
+    results: list[Settling]
+
+    def table(self) -> Table:
+        """One row per sphere and law, with the code's and the law's errors."""
+        table = Table(["law", "susp", "d [mm]", "rho_p", "measured", "law", "simulated", "sim/law-1", "law/meas-1",
+                       "regime"])
+        for r in self.results:
+            s = r.sphere
+            table.add(r.law, s.suspension, f"{s.d * 1e3:.1f}", f"{s.rho_p:.0f}", f"{s.measured:.3f}",
+                      f"{r.analytic:.4f}", f"{r.simulated:.4f}", f"{r.code_error:+.1e}", f"{r.law_error:+.1%}",
+                      r.regime)
+        table.notes.append(f"worst |simulated/law - 1| = {max(abs(r.code_error) for r in self.results):.1e}")
+        return table
+
+    def save(self, folder: Path) -> list[Path]:
+        """terminal_velocities.csv and terminal_velocities.png."""
+        rows = Table(["law", *COLUMNS, "v_law", "regime", "v_simulated", "simulated_vs_law", "law_vs_measured"])
+        for r in self.results:
+            s = r.sphere
+            rows.add(r.law, s.suspension, s.rho_f, s.eta_B, s.tau_y, s.d, s.rho_p, s.measured, r.analytic, r.regime,
+                     r.simulated, f"{r.code_error:+.2e}", f"{r.law_error:+.4f}")
+        return [write_text(Path(folder) / "terminal_velocities.csv", rows.csv()),
+                plot(self.results, Path(folder) / "terminal_velocities.png")]
+
+
+def study(csv_path: Path, laws=("zhang-li", "zhang-li/smooth"), progress: bool = True) -> SpheresStudy:
+    """Settles every sphere of the CSV under every law."""
     from tqdm import tqdm
 
     spheres = read_spheres(csv_path)
     plan = [(s, law) for law in laws for s in spheres]
-    results = [settle(s, law) for s, law in tqdm(plan, desc="spheres", unit="run", disable=not progress)]
-    out_dir.mkdir(parents=True, exist_ok=True)
-    with open(out_dir / "terminal_velocities.csv", "w", newline="") as f:
-        writer = csv.writer(f)
-        writer.writerow(["law", *COLUMNS, "v_law", "regime", "v_simulated", "simulated_vs_law", "law_vs_measured"])
-        for r in results:
-            s = r.sphere
-            writer.writerow([r.law, s.suspension, s.rho_f, s.eta_B, s.tau_y, s.d, s.rho_p, s.measured,
-                             f"{r.analytic:.6g}", r.regime, f"{r.simulated:.6g}", f"{r.code_error:+.2e}",
-                             f"{r.law_error:+.4f}"])
-    plot(results, out_dir / "terminal_velocities.png")
-    return results
+    return SpheresStudy([settle(s, law) for s, law in tqdm(plan, desc="spheres", unit="run", disable=not progress)])
 
 
-def plot(results: list[Settling], path: Path) -> None:
+def plot(results: list[Settling], path: Path) -> Path:
+    """Simulated and analytic against measured terminal velocities."""
     plt = figures.pyplot()
 
     laws = sorted({r.law for r in results})
@@ -131,4 +157,4 @@ def plot(results: list[Settling], path: Path) -> None:
         ax.set(xlabel="measured terminal velocity [m/s]", ylabel="simulated terminal velocity [m/s]",
                title=f"Valentik & Whitmore (1965), law {law}", xlim=(0, 1.1 * top), ylim=(0, 1.1 * top))
         ax.legend(fontsize=7, title="suspension", title_fontsize=7)
-    figures.save(fig, path)
+    return figures.save(fig, path)

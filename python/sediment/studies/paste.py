@@ -6,7 +6,6 @@ The decks are in examples/paste: in.drop_test, in.ball_in_paste, with the shared
 """
 from __future__ import annotations
 
-import csv
 import math
 import tempfile
 from dataclasses import asdict, dataclass
@@ -15,13 +14,14 @@ from pathlib import Path
 import numpy as np
 from scipy.optimize import brentq
 
-from . import _core, figures
-from .calibrate import restitution_from_drops
-from .paths import REPO_DIR
-from .run import run_batch
+from .. import _core, figures
+from ..results import Table, write_text
+from ..constants import GRAVITY
+from ..lab.calibrate import restitution_from_drops
+from ..sim.paths import REPO_DIR
+from ..sim.run import run_batch
 
 EXAMPLES = REPO_DIR / "examples" / "paste"
-GRAVITY = 9.81
 STEEL_DENSITY = 8135.0
 PASTE = dict(density=1843.0, yield_stress=136.0, plastic_viscosity=0.7, surface=0.150)
 
@@ -45,6 +45,7 @@ def rebound_height(fall: float, tsuji: float | None = None, dt: float | None = N
 
 
 def simulated_restitution(tsuji: float | None = None, fall: float = 0.252) -> float:
+    """Restitution sqrt(H_r / H_f) of the drop deck with `damping tsuji` = tsuji."""
     return math.sqrt(rebound_height(fall, tsuji) / fall)
 
 
@@ -60,29 +61,44 @@ def tsuji_for_restitution(target: float, tolerance: float = 1e-5) -> float:
 
 @dataclass
 class DropRow:
+    """One drop of case F: fall height, measured and simulated rebound heights [m]."""
+
     fall: float
     measured: float
     simulated: float
 
     @property
     def error(self) -> float:
+        """simulated / measured - 1."""
         return self.simulated / self.measured - 1.0
 
 
-def drop_study(out_dir: Path) -> list[DropRow]:
-    """Rebounds of the five drops of case F with the contacts of steel.lmp: table and figure."""
-    rows = [DropRow(h, m, rebound_height(h)) for h, m in zip(DROP_HEIGHTS, MEASURED_REBOUNDS)]
-    out_dir.mkdir(parents=True, exist_ok=True)
-    with open(out_dir / "drop_test.csv", "w", newline="") as f:
-        writer = csv.writer(f)
-        writer.writerow(["fall_m", "rebound_measured_m", "rebound_simulated_m", "relative_error"])
-        for r in rows:
-            writer.writerow([r.fall, r.measured, f"{r.simulated:.6g}", f"{r.error:+.4f}"])
-    _plot_drops(rows, out_dir / "drop_test.png")
-    return rows
+@dataclass
+class DropStudy:
+    """The five drops of case F simulated with the contacts of steel.lmp."""
+
+    rows: list[DropRow]
+
+    def table(self) -> Table:
+        """Fall, measured and simulated rebound [mm] and the relative error, with the mean error."""
+        table = Table(["H_f [mm]", "H_r meas. [mm]", "H_r sim. [mm]", "error"])
+        for r in self.rows:
+            table.add(f"{r.fall * 1e3:.0f}", f"{r.measured * 1e3:.1f}", f"{r.simulated * 1e3:.2f}", f"{r.error:+.4f}")
+        table.notes.append(f"mean |error| {np.mean([abs(r.error) for r in self.rows]):.1%}")
+        return table
+
+    def save(self, folder: Path) -> list[Path]:
+        """drop_test.csv and drop_test.png."""
+        return [write_text(Path(folder) / "drop_test.csv", self.table().csv()),
+                _plot_drops(self.rows, Path(folder) / "drop_test.png")]
 
 
-def _plot_drops(rows: list[DropRow], path: Path) -> None:
+def drop_study() -> DropStudy:
+    """Rebounds of the five drops of case F with the contacts of steel.lmp."""
+    return DropStudy([DropRow(h, m, rebound_height(h)) for h, m in zip(DROP_HEIGHTS, MEASURED_REBOUNDS)])
+
+
+def _plot_drops(rows: list[DropRow], path: Path) -> Path:
     plt = figures.pyplot()
 
     e = restitution_from_drops(DROP_HEIGHTS, MEASURED_REBOUNDS).mean
@@ -93,12 +109,14 @@ def _plot_drops(rows: list[DropRow], path: Path) -> None:
     ax.plot(falls, e * e * falls, "k:", lw=1, label=f"e^2 H_f, e = {e:.3f}")
     ax.set(xlabel="drop height H_f [mm]", ylabel="rebound height H_r [mm]", title="8 mm steel ball on a steel plate")
     ax.legend(fontsize=8)
-    figures.save(fig, path)
+    return figures.save(fig, path)
 
 
 # ---- a ball dropped into the paste (case D) ----------------------------------------------------
 @dataclass
 class BallDrop:
+    """One ball dropped into the paste (case D) and where it came to rest."""
+
     diameter: float
     fall: float
     submergence: bool
@@ -111,6 +129,7 @@ class BallDrop:
 
 def drop_ball(diameter: float, fall: float, submergence: bool = True, dt: float = 1e-5,
               trace: Path | None = None) -> BallDrop:
+    """Drops one ball into the paste (in.ball_in_paste) and reports where and when it stopped."""
     variables = {"d": diameter, "fall": fall, "submergence": "yes" if submergence else "no", "dt": dt}
     if trace is not None:
         variables.update(trace="yes", trace_file=Path(trace).resolve())
@@ -122,23 +141,41 @@ def drop_ball(diameter: float, fall: float, submergence: bool = True, dt: float 
                     out.wall_seconds)
 
 
-def ball_study(out_dir: Path, diameters=BALL_DIAMETERS, falls=FALL_HEIGHTS, progress: bool = True) -> list[BallDrop]:
-    """Every ball from every fall height, with and without partial submergence: table and figure."""
+@dataclass
+class BallStudy:
+    """Every ball from every fall height, with and without partial submergence."""
+
+    drops: list[BallDrop]
+
+    def table(self) -> Table:
+        """Diameter, fall, submergence model, settling distance, time to rest and creep per drop."""
+        table = Table(["d [mm]", "fall [mm]", "submergence", "depth [mm]", "t_rest [s]", "creep [m]"])
+        for b in self.drops:
+            table.add(f"{b.diameter * 1e3:.1f}", f"{b.fall * 1e3:.0f}", "partial" if b.submergence else "step",
+                      f"{b.depth * 1e3:.2f}", f"{b.t_rest:.4f}", f"{b.creep:.2g}")
+        table.notes.append(f"{sum(b.wall_seconds for b in self.drops):.1f} s of runs")
+        return table
+
+    def save(self, folder: Path) -> list[Path]:
+        """ball_in_paste.csv (every field of every drop) and ball_in_paste.png."""
+        names = list(asdict(self.drops[0]))
+        rows = Table(names)
+        for drop in self.drops:
+            rows.add(*asdict(drop).values(), fmt=".9g")
+        return [write_text(Path(folder) / "ball_in_paste.csv", rows.csv()),
+                _plot_balls(self.drops, Path(folder) / "ball_in_paste.png")]
+
+
+def ball_study(diameters=BALL_DIAMETERS, falls=FALL_HEIGHTS, progress: bool = True) -> BallStudy:
+    """Every ball from every fall height, with and without partial submergence."""
     from tqdm import tqdm
 
     plan = [(d, h, sub) for sub in (True, False) for d in diameters for h in falls]
-    drops = [drop_ball(d, h, sub) for d, h, sub in tqdm(plan, desc="balls", unit="run", disable=not progress)]
-    out_dir.mkdir(parents=True, exist_ok=True)
-    with open(out_dir / "ball_in_paste.csv", "w", newline="") as f:
-        writer = csv.DictWriter(f, fieldnames=list(asdict(drops[0])))
-        writer.writeheader()
-        for drop in drops:
-            writer.writerow(asdict(drop))
-    _plot_balls(drops, out_dir / "ball_in_paste.png")
-    return drops
+    return BallStudy([drop_ball(d, h, sub) for d, h, sub in tqdm(plan, desc="balls", unit="run",
+                                                                  disable=not progress)])
 
 
-def _plot_balls(drops: list[BallDrop], path: Path) -> None:
+def _plot_balls(drops: list[BallDrop], path: Path) -> Path:
     plt = figures.pyplot()
 
     fig, ax = plt.subplots(figsize=(6, 4.3))
@@ -151,11 +188,13 @@ def _plot_balls(drops: list[BallDrop], path: Path) -> None:
     ax.set(xlabel="fall height above the paste [mm]", ylabel="settling distance [mm]",
            title="Steel balls into paste backfill (tau_y 136 Pa, eta_B 0.7 Pa s)")
     ax.legend(fontsize=7)
-    figures.save(fig, path)
+    return figures.save(fig, path)
 
 
 @dataclass
 class EnergyBalance:
+    """Where the mechanical energy of a ball entering the paste went."""
+
     mechanical_loss: float    # (potential + kinetic) at release minus at rest [J]
     buoyancy_work: float      # work done on the ball by buoyancy [J] (negative while it sinks)
     drag_work: float          # work done by the paste's drag and yield resistance [J]
@@ -164,6 +203,19 @@ class EnergyBalance:
     def residual(self) -> float:
         """(loss + work of the fluid forces) / loss: zero when the work of the fluid accounts for it."""
         return (self.mechanical_loss + self.buoyancy_work + self.drag_work) / self.mechanical_loss
+
+    def table(self) -> Table:
+        """The three energies [J] and the residual."""
+        table = Table(["quantity", "value"])
+        table.add("loss of potential + kinetic energy [J]", self.mechanical_loss)
+        table.add("work of buoyancy [J]", self.buoyancy_work)
+        table.add("work of drag and yield [J]", self.drag_work)
+        table.add("residual (of the loss)", f"{self.residual:+.2e}")
+        return table
+
+    def save(self, folder: Path) -> list[Path]:
+        """energy_balance.csv."""
+        return [write_text(Path(folder) / "energy_balance.csv", self.table().csv())]
 
 
 def energy_balance(diameter: float, fall: float, dt: float = 1e-5, law: str = "zhang-li") -> EnergyBalance:

@@ -25,8 +25,9 @@ from pathlib import Path
 
 import numpy as np
 
-from . import figures
-from .run import run_batch
+from .. import figures
+from ..results import Table, write_text
+from ..sim.run import run_batch
 
 INTEGRATORS = {"implicit": "nve/sphere/fluid", "explicit": "nve/sphere"}
 READOUTS = ("hydrometer", "buoyancy", "pipette")
@@ -42,6 +43,8 @@ class Observation:
 
 @dataclass
 class SweepRun:
+    """One run of a sweep: the swept value, its cost, what it observed and its errors."""
+
     integrator: str | None
     value: float                    # of the swept variable
     loop_seconds: float             # LAMMPS's loop time, summed over the deck's runs (start-up excluded)
@@ -58,6 +61,8 @@ class SweepRun:
 
 @dataclass
 class Sweep:
+    """A deck run at several values of one variable, scored against a reference."""
+
     deck: Path
     parameter: str
     observables: list[str]
@@ -71,6 +76,54 @@ class Sweep:
         good = [r for r in self.runs if r.error <= tolerance and (integrator is None or r.integrator == integrator)]
         return min(good, key=lambda r: r.loop_seconds, default=None)
 
+    def table(self, tolerance: float = 0.01) -> Table:
+        """One row per run (the swept value, its ratio to tau and the Rayleigh time, loop and wall
+        time, status, each observable's value and error); the notes name the cheapest run within
+        `tolerance` per integrator."""
+        head = ["integrator", self.parameter, "loop_s", "wall_s", "status"]
+        if self.tau:
+            head.insert(2, f"{self.parameter}_over_tau")
+        if self.rayleigh:
+            head.insert(2, f"{self.parameter}_over_rayleigh_time")
+        head += [f"{n}_value" for n in self.observables] + [f"{n}_error" for n in self.observables] + ["max_error"]
+        table = Table(head, notes=self.summary(tolerance))
+        for r in self.runs:
+            row = [r.integrator or "", f"{r.value:g}"]
+            if self.rayleigh:
+                row.append(f"{r.value / self.rayleigh:.4g}")
+            if self.tau:
+                row.append(f"{r.value / self.tau:.4g}")
+            row += [f"{r.loop_seconds:.4g}", f"{r.wall_seconds:.4g}", "failed: " + r.failure if r.failure else "ok"]
+            row += [(f"{r.observations[n].y[0]:.8g}" if n in r.observations and r.observations[n].x is None else "")
+                    for n in self.observables]
+            row += [(f"{r.errors[n]:.4g}" if n in r.errors else "") for n in self.observables]
+            row.append(f"{r.error:.4g}")
+            table.rows.append(row)
+        return table
+
+    def summary(self, tolerance: float) -> list[str]:
+        """The cheapest run within the tolerance, per integrator, against the 20 % Rayleigh-time rule."""
+        lines = [f"reference: {self.reference}; error = worst of {', '.join(self.observables)}"]
+        for integrator in sorted({r.integrator for r in self.runs}, key=lambda i: i or ""):
+            best = self.cheapest(tolerance, integrator)
+            label = integrator or "runs"
+            if best is None:
+                lines.append(f"{label}: no run within {tolerance * 100:.3g} %")
+                continue
+            text = (f"{label}: cheapest within {tolerance * 100:.3g} %: {self.parameter} = {best.value:g} "
+                    f"(error {best.error:.3g}, loop {best.loop_seconds:.3g} s)")
+            if self.rayleigh:
+                rule = 0.2 * self.rayleigh
+                text += f"; {best.value / rule:.3g}x the 20 % Rayleigh-time step ({rule:.3g} s)"
+                text += f", which would take about {best.loop_seconds * best.value / rule:.3g} s of loop time"
+            lines.append(text)
+        return lines
+
+    def save(self, folder: Path, tolerance: float = 0.01, title: str = "") -> list[Path]:
+        """sweep.csv and sweep.png (errors against the swept value and against loop time)."""
+        return [write_text(Path(folder) / "sweep.csv", self.table(tolerance).csv()),
+                plot(self, Path(folder) / "sweep.png", tolerance, title)]
+
 
 def parse_reference(text: str) -> tuple[str, str]:
     """'name=expression' -> (name, expression); the expression may use x and numpy's exp, log, sqrt..."""
@@ -81,6 +134,7 @@ def parse_reference(text: str) -> tuple[str, str]:
 
 
 def evaluate_reference(expression: str, x: np.ndarray | None) -> np.ndarray:
+    """Value of a reference expression (numpy functions of x only) at x."""
     try:
         value = eval(expression, {"__builtins__": {}}, dict(SAFE_NAMES, x=x))  # noqa: S307 - the user's own formula
     except Exception as exc:
@@ -131,9 +185,9 @@ def observe(text: str, names: list[str], layers_file: Path | None) -> dict[str, 
 
 
 def _readout_curves(layers_file: Path | None, instruments: list[str]) -> dict[str, Observation]:
-    from .granulometry import read_all
-    from .layers import read_layers
-    from .readout import Column
+    from ..lab.granulometry import read_all
+    from ..sim.layers import read_layers
+    from ..lab.readout import Column
 
     if layers_file is None or not layers_file.is_file():
         raise ValueError(f"readout observables need the deck's layer file ({layers_file}): does it write one?")
@@ -142,6 +196,9 @@ def _readout_curves(layers_file: Path | None, instruments: list[str]) -> dict[st
 
 
 def relative_error(run: Observation, ref: Observation, log_x: bool = False) -> float:
+    """Relative error of a run: |run / reference - 1| for a scalar; for a series, the largest
+    |run - reference| (the reference interpolated at the run's x, in log x for readouts) over the
+    reference's largest magnitude."""
     if run.x is None:
         return float(abs(run.y[0] - ref.y[0]) / abs(ref.y[0])) if ref.y[0] != 0 else float(abs(run.y[0]))
     assert ref.x is not None
@@ -231,50 +288,7 @@ def _score(sweep: Sweep, references: dict[str, str]) -> None:
             run.errors[name] = relative_error(obs, ref, log_x=name in READOUTS)
 
 
-def table(sweep: Sweep) -> str:
-    """CSV: one row per run."""
-    head = ["integrator", sweep.parameter, "loop_s", "wall_s", "status"]
-    if sweep.tau:
-        head.insert(2, f"{sweep.parameter}_over_tau")
-    if sweep.rayleigh:
-        head.insert(2, f"{sweep.parameter}_over_rayleigh_time")
-    head += [f"{n}_value" for n in sweep.observables] + [f"{n}_error" for n in sweep.observables] + ["max_error"]
-    lines = [",".join(head)]
-    for r in sweep.runs:
-        row = [r.integrator or "", f"{r.value:g}"]
-        if sweep.rayleigh:
-            row.append(f"{r.value / sweep.rayleigh:.4g}")
-        if sweep.tau:
-            row.append(f"{r.value / sweep.tau:.4g}")
-        row += [f"{r.loop_seconds:.4g}", f"{r.wall_seconds:.4g}", "failed: " + r.failure.replace(",", ";") if r.failure else "ok"]
-        row += [(f"{r.observations[n].y[0]:.8g}" if n in r.observations and r.observations[n].x is None else "")
-                for n in sweep.observables]
-        row += [(f"{r.errors[n]:.4g}" if n in r.errors else "") for n in sweep.observables]
-        row.append(f"{r.error:.4g}")
-        lines.append(",".join(row))
-    return "\n".join(lines) + "\n"
-
-
-def summary(sweep: Sweep, tolerance: float) -> list[str]:
-    """The cheapest run within the tolerance, per integrator, against the 20 % Rayleigh-time rule."""
-    lines = [f"reference: {sweep.reference}; error = worst of {', '.join(sweep.observables)}"]
-    for integrator in sorted({r.integrator for r in sweep.runs}, key=lambda i: i or ""):
-        best = sweep.cheapest(tolerance, integrator)
-        label = integrator or "runs"
-        if best is None:
-            lines.append(f"{label}: no run within {tolerance * 100:.3g} %")
-            continue
-        text = (f"{label}: cheapest within {tolerance * 100:.3g} %: {sweep.parameter} = {best.value:g} "
-                f"(error {best.error:.3g}, loop {best.loop_seconds:.3g} s)")
-        if sweep.rayleigh:
-            rule = 0.2 * sweep.rayleigh
-            text += f"; {best.value / rule:.3g}x the 20 % Rayleigh-time step ({rule:.3g} s)"
-            text += f", which would take about {best.loop_seconds * best.value / rule:.3g} s of loop time"
-        lines.append(text)
-    return lines
-
-
-def plot(sweep: Sweep, path: Path, tolerance: float, title: str = "") -> None:
+def plot(sweep: Sweep, path: Path, tolerance: float, title: str = "") -> Path:
     """Error against the swept variable (rules marked) and against loop time (Pareto front)."""
     plt = figures.pyplot()
     fig, (ax_d, ax_t) = plt.subplots(1, 2, figsize=(11, 4.4))
@@ -315,7 +329,7 @@ def plot(sweep: Sweep, path: Path, tolerance: float, title: str = "") -> None:
     ax_t.set_ylim(floor, top * 3)
     ax_d.legend(fontsize=7)
     ax_t.legend(fontsize=7)
-    figures.save(fig, path)
+    return figures.save(fig, path)
 
 
 def _pareto(runs: list[SweepRun]) -> list[SweepRun]:
@@ -325,11 +339,3 @@ def _pareto(runs: list[SweepRun]) -> list[SweepRun]:
             front.append(r)
             best = r.error
     return front
-
-
-def write(sweep: Sweep, out: Path, tolerance: float, title: str = "") -> list[Path]:
-    out.mkdir(parents=True, exist_ok=True)
-    paths = [out / "sweep.csv", out / "sweep.png"]
-    paths[0].write_text(table(sweep))
-    plot(sweep, paths[1], tolerance, title)
-    return paths

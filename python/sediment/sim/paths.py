@@ -5,7 +5,7 @@ import os
 import shutil
 from pathlib import Path
 
-PACKAGE_DIR = Path(__file__).resolve().parent
+PACKAGE_DIR = Path(__file__).resolve().parents[1]    # python/sediment
 REPO_DIR = PACKAGE_DIR.parents[1]
 
 

@@ -24,6 +24,9 @@ class LayerFileError(ValueError):
 
 @dataclass
 class LayerFile:
+    """The frames of a layer file: solid fraction per layer (total and per column) over time, with the run's
+    attributes."""
+
     path: Path
     units: str
     axis: str
@@ -47,6 +50,7 @@ class LayerFile:
 
     @property
     def total(self) -> np.ndarray:
+        """Total solid fraction per frame and layer."""
         return self.column("total")
 
     def solid_volume(self) -> np.ndarray:
@@ -59,6 +63,7 @@ def _text(value) -> str:
 
 
 def read_layers(path: str | Path) -> LayerFile:
+    """Reads a layer file written by fix layers/hdf5, refusing files that are not one (LayerFileError)."""
     import h5py
 
     path = Path(path)

@@ -1,0 +1,31 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
+"""The `sediment` command line: one module per command, each with ``add_parser(commands)`` and
+``run(args)``; results are printed with their ``table()`` and written with their ``save(folder)``."""
+from __future__ import annotations
+
+import argparse
+import sys
+
+from . import calibrate, case_a, paste, readout, run, sample, spheres, sweep, terminal
+
+COMMANDS = (terminal, case_a, sample, run, readout, calibrate, paste, spheres, sweep)
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The parser of every command."""
+    parser = argparse.ArgumentParser(prog="sediment", description="SEDIMENT: settling of DEM spheres in "
+                                     "fluids with LAMMPS, and sedimentation-test readouts.")
+    commands = parser.add_subparsers(dest="command", required=True)
+    for command in COMMANDS:
+        command.add_parser(commands).set_defaults(func=command.run)
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Runs one command; user errors end with one line on stderr and exit status 2."""
+    args = build_parser().parse_args(argv)
+    try:
+        return args.func(args)
+    except (ValueError, FileNotFoundError, RuntimeError) as exc:
+        print(f"sediment {args.command}: error: {exc}", file=sys.stderr)
+        return 2

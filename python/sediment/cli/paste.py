@@ -1,0 +1,56 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
+"""sediment paste: steel balls and paste backfill (validation cases D-F)."""
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+from .types import count, nonnegative, positive
+
+
+def add_parser(commands) -> argparse.ArgumentParser:
+    """Adds the command, its studies and their options."""
+    parser = commands.add_parser("paste", help="steel balls and paste backfill (cases D-F): drop test, single "
+                                 "balls, the funnel")
+    studies = parser.add_subparsers(dest="study", required=True)
+    target = studies.add_parser("restitution", help="the 'damping tsuji' input giving a restitution (drop deck)")
+    target.add_argument("--target", type=positive, default=0.612)
+    for name, text in (("drop-test", "rebounds of the five drops of case F with steel.lmp"),
+                       ("balls", "8, 12.6 and 16 mm balls from six fall heights, with and without partial "
+                                 "submergence: settling distances")):
+        study = studies.add_parser(name, help=text)
+        study.add_argument("--out", type=Path, default=Path("out/paste"), help="output folder")
+    energy = studies.add_parser("energy", help="energy balance of one ball entering the paste")
+    energy.add_argument("--diameter", type=positive, default=0.0126, help="[m]")
+    energy.add_argument("--fall", type=nonnegative, default=0.255, help="fall height above the paste [m]")
+    energy.add_argument("--dt", type=positive, default=1e-5, help="[s]")
+    energy.add_argument("--out", type=Path, help="also write energy_balance.csv into this folder")
+    pour = studies.add_parser("funnel", help="68 balls poured from a funnel, several random packings")
+    pour.add_argument("--runs", type=count, default=15)
+    pour.add_argument("--jobs", type=count, default=2, help="runs at a time")
+    pour.add_argument("--dt", type=positive, default=1e-6, help="[s]")
+    pour.add_argument("--out", type=Path, default=Path("out/paste"), help="output folder")
+    return parser
+
+
+def run(args: argparse.Namespace) -> int:
+    """Runs the study, prints its table and writes its files."""
+    from ..studies import funnel, paste
+
+    if args.study == "restitution":
+        c = paste.tsuji_for_restitution(args.target)
+        print(f"damping tsuji {c:.4f} gives a simulated restitution of {paste.simulated_restitution(c):.4f} "
+              f"(the input {args.target} itself gives {paste.simulated_restitution(args.target):.4f})")
+        return 0
+    if args.study == "drop-test":
+        result = paste.drop_study()
+    elif args.study == "balls":
+        result = paste.ball_study()
+    elif args.study == "energy":
+        result = paste.energy_balance(args.diameter, args.fall, args.dt)
+    else:
+        result = funnel.funnel_study(runs=args.runs, jobs=args.jobs, dt=args.dt)
+    print(result.table().text(), end="")
+    if args.out is not None:
+        print("wrote " + ", ".join(str(p) for p in result.save(args.out)))
+    return 0

@@ -1,0 +1,86 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
+"""sediment readout: hydrometer, buoyancy-sphere and pipette readings of a simulated test."""
+from __future__ import annotations
+
+import argparse
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+
+from ..constants import D422_CYLINDER_AREA, D422_CYLINDER_HEIGHT, SOIL_PARTICLE_DENSITY
+from ..lab.readout import SCHEDULES
+from .types import finite, positive
+
+
+def add_parser(commands) -> argparse.ArgumentParser:
+    """Adds the command and its options."""
+    parser = commands.add_parser("readout", help="hydrometer, buoyancy-sphere and pipette readings from a layer "
+                                 "file (fix layers/hdf5), with CSV tables, the granulometry figure and errors")
+    parser.add_argument("layers", type=Path, nargs="?", help="layer file (HDF5)")
+    parser.add_argument("--instrument", default="all", choices=["hydrometer", "buoyancy", "pipette", "all"])
+    parser.add_argument("--schedule", default="d422", choices=sorted(SCHEDULES),
+                        help="reading times (the buoyancy sphere uses Bravo et al.'s unless another is given)")
+    parser.add_argument("--psd", type=Path, help="input PSD (diameter_um,percent_finer) to compare with "
+                        "(default: input_psd.csv beside the layer file)")
+    parser.add_argument("--simulated", type=Path, help="PSD actually simulated (default: simulated_psd.csv "
+                        "beside the layer file)")
+    parser.add_argument("--stokes-preview", action="store_true",
+                        help="without a layer file: read an analytic Stokes column of --psd")
+    parser.add_argument("--height", type=positive, default=D422_CYLINDER_HEIGHT, help="preview column height [m]")
+    parser.add_argument("--concentration", type=positive, default=50.0, help="preview solids [g/L]")
+    parser.add_argument("--particle-density", type=positive, default=SOIL_PARTICLE_DENSITY, help="preview [kg/m3]")
+    parser.add_argument("--surface", type=finite, help="free-surface coordinate [m] (default: top of the layers)")
+    parser.add_argument("--sphere-depth", type=positive, help="buoyancy sphere centre depth [m] (default 0.3 H)")
+    parser.add_argument("--pipette-depth", type=positive, default=0.10, help="[m]")
+    parser.add_argument("--pipette-volume", type=positive, default=25e-6, help="[m3]")
+    parser.add_argument("--hydrometer", type=positive, nargs=6,
+                        metavar=("L2", "VB", "STEM_D", "MASS", "L1_R0", "L1_R50"),
+                        help="a measured hydrometer instead of the nominal 152H: bulb length [m], bulb volume "
+                        "[m3], stem diameter [m], mass [kg], bulb top to the R = 0 and R = 50 marks [m]")
+    parser.add_argument("--viscosity", type=positive, help="viscosity for Stokes' law [Pa s] (default: the "
+                        "layer file's fluid)")
+    parser.add_argument("--cylinder-area", type=positive, default=D422_CYLINDER_AREA,
+                        help="for the hydrometer's level rise [m2]")
+    parser.add_argument("--out", type=Path, default=Path("out/readout"), help="output folder")
+    return parser
+
+
+def run(args: argparse.Namespace) -> int:
+    """Reads the column, prints the inputs and the errors per size range, writes the report."""
+    from ..lab.granulometry import granulometry
+    from ..lab.psd import read_psd
+    from ..lab.readout import Column, Hydrometer, Suspension
+    from ..lab.synthetic import stokes_column
+
+    if args.layers is not None:    # PSD tables that `sediment sample` wrote beside the run
+        for option, name in (("psd", "input_psd.csv"), ("simulated", "simulated_psd.csv")):
+            beside = args.layers.parent / name
+            if getattr(args, option) is None and beside.is_file():
+                setattr(args, option, beside)
+                print(f"using {beside}")
+    psd = read_psd(args.psd) if args.psd else None
+    simulated = read_psd(args.simulated) if args.simulated else None
+    if args.layers is not None:
+        from ..sim.layers import read_layers
+        column = Column.from_layers(read_layers(args.layers), surface=args.surface)
+        if args.viscosity is not None:    # e.g. the lab's temperature differs from the simulation's
+            column = replace(column, suspension=replace(column.suspension, viscosity=args.viscosity))
+        title = f"{args.layers.parent.name}/{args.layers.name}: simulated sedimentation test"
+    else:
+        if psd is None:
+            raise ValueError("give a layer file, or --psd with --stokes-preview for an analytic column")
+        suspension = Suspension(particle_density=args.particle_density)
+        times = np.concatenate([[0.0], np.geomspace(10.0, 1440 * 60.0, 400)])
+        column = stokes_column(psd, args.height, times, args.concentration, suspension)
+        title = f"{args.psd.name}: Stokes settling preview (no DEM)"
+    instruments = ["hydrometer", "buoyancy", "pipette"] if args.instrument == "all" else [args.instrument]
+    hydrometer = Hydrometer.measured(*args.hydrometer) if args.hydrometer else None
+    report = granulometry(column, instruments, psd, simulated, title, schedule=args.schedule,
+                          sphere_depth=args.sphere_depth, pipette_depth=args.pipette_depth,
+                          pipette_volume=args.pipette_volume, cylinder_area=args.cylinder_area,
+                          hydrometer=hydrometer)
+    for path in report.save(args.out):
+        print(f"wrote {path}")
+    print(report.table().text(), end="")
+    return 0

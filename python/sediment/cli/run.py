@@ -1,0 +1,28 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
+"""sediment run: a deck through lmp_sediment, serial or with mpirun, with a progress bar."""
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+from .types import count
+
+
+def add_parser(commands) -> argparse.ArgumentParser:
+    """Adds the command and its options."""
+    parser = commands.add_parser("run", help="run a deck with lmp_sediment (serial or mpirun) with a progress bar")
+    parser.add_argument("deck", type=Path, help="LAMMPS input deck (e.g. from `sediment sample`)")
+    parser.add_argument("--np", type=count, default=1, help="MPI ranks")
+    parser.add_argument("--var", nargs=2, action="append", metavar=("NAME", "VALUE"), help="LAMMPS -var")
+    parser.add_argument("--quiet", action="store_true", help="no progress bar")
+    return parser
+
+
+def run(args: argparse.Namespace) -> int:
+    """Runs the deck and says what it did."""
+    from ..sim.run import run_deck
+
+    result = run_deck(args.deck, ranks=args.np, variables=dict(args.var or []), progress=not args.quiet)
+    print(f"{result.deck.name}: {result.steps} steps, {result.simulated_time:.6g} s simulated in "
+          f"{result.wall_seconds:.1f} s on {args.np} rank(s); log {result.log}")
+    return 0

@@ -1,0 +1,63 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
+"""sediment sample: a sedimentation test as a LAMMPS scene."""
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+from ..constants import SOIL_PARTICLE_DENSITY
+from .types import count, positive
+
+
+def add_parser(commands) -> argparse.ArgumentParser:
+    """Adds the command and its options."""
+    parser = commands.add_parser("sample", help="a sedimentation test as a LAMMPS scene: size classes of a PSD, "
+                                 "particles placed in a sub-volume of the cylinder, data file and ready deck")
+    parser.add_argument("psd", type=Path, help="PSD table (CSV: diameter_um,percent_finer)")
+    parser.add_argument("--out", type=Path, default=Path("out/sample"), help="output folder")
+    parser.add_argument("--geometry", default="column", choices=["column", "slab"],
+                        help="3D periodic column, or Bravo et al.'s 2D slab of the cylinder's axial section")
+    parser.add_argument("--cylinder", default="d422", choices=["d422", "bravo"],
+                        help="ASTM D422 (27.8 cm2, 0.36 m) or Bravo et al. (B 0.0635 m, H 0.457 m)")
+    parser.add_argument("--height", type=positive, help="suspension height [m] (default: the cylinder's)")
+    parser.add_argument("--width", type=positive, help="column side or slab width [m] (default: 2 largest "
+                        "diameters; the slab spans the cylinder)")
+    parser.add_argument("--mass", type=positive, default=0.060, help="dry sample mass [kg]")
+    parser.add_argument("--particle-density", type=positive, default=SOIL_PARTICLE_DENSITY, help="[kg/m3]")
+    parser.add_argument("--classes", type=count, default=40, help="log-spaced size classes (eq. 15)")
+    parser.add_argument("--particles", type=count, default=20000,
+                        help="simulated particles, as parcels of equal real mass (weights)")
+    parser.add_argument("--real-grains", action="store_true",
+                        help="one atom per real grain at the real concentration (eq. 15 counts, at least one "
+                             "per class); needed with --contacts or --lubrication")
+    parser.add_argument("--law", default="dallavalle", choices=["stokes", "schiller-naumann", "dallavalle"])
+    parser.add_argument("--hindered", action="store_true", help="Di Felice drag on the local concentration")
+    parser.add_argument("--contacts", action="store_true", help="Hertz contacts between grains and with the floor")
+    parser.add_argument("--lubrication", action="store_true", help="squeeze-film lubrication (with contacts)")
+    parser.add_argument("--layers", type=count, default=400, help="layers of the concentration grid")
+    parser.add_argument("--t-end", type=positive, default=86400.0, help="simulated time [s] (default 24 h)")
+    parser.add_argument("--courant", type=positive, default=1.0,
+                        help="layers the fastest grain in suspension may cross per step")
+    parser.add_argument("--seed", type=int, default=1, help="placement seed")
+    return parser
+
+
+def run(args: argparse.Namespace) -> int:
+    """Plans the scene, prints it and writes its data file, deck and PSD tables."""
+    from ..lab.psd import read_psd
+    from ..lab.readout import Suspension
+    from ..sim.scene import Cylinder, Effects, describe, plan, write
+
+    cylinder = Cylinder.bravo() if args.cylinder == "bravo" else Cylinder()
+    if args.height is not None:
+        cylinder = Cylinder(cylinder.area, args.height)
+    scene = plan(read_psd(args.psd), geometry=args.geometry, cylinder=cylinder, mass=args.mass,
+                 suspension=Suspension(particle_density=args.particle_density), width=args.width,
+                 classes=args.classes, particles=None if args.real_grains else args.particles,
+                 effects=Effects(args.law, args.hindered, args.contacts, args.lubrication),
+                 layers=args.layers, t_end=args.t_end, courant=args.courant, seed=args.seed)
+    print(describe(scene))
+    for path in write(scene, args.out):
+        print(f"wrote {path}")
+    print(f"next: sediment run {args.out / 'in.sedimentation'}")
+    return 0

@@ -1,0 +1,27 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
+"""sediment spheres: terminal velocities of spheres in Bingham suspensions (Valentik & Whitmore)."""
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+
+def add_parser(commands) -> argparse.ArgumentParser:
+    """Adds the command and its options."""
+    parser = commands.add_parser("spheres", help="terminal velocities of spheres in Bingham suspensions, simulated "
+                                 "vs the law and the measurement (Valentik & Whitmore 1965 columns)")
+    parser.add_argument("csv", type=Path, help="CSV with suspension,rho_f,eta_B,tau_y,d,rho_p,v_ter_measured (SI)")
+    parser.add_argument("--law", nargs="+", default=["zhang-li", "zhang-li/smooth"],
+                        choices=["zhang-li", "zhang-li/smooth"])
+    parser.add_argument("--out", type=Path, default=Path("out/spheres"), help="output folder")
+    return parser
+
+
+def run(args: argparse.Namespace) -> int:
+    """Settles every sphere, prints the table and writes the CSV and the figure."""
+    from ..studies.valentik import study
+
+    result = study(args.csv, laws=args.law)
+    print(result.table().text(), end="")
+    print("wrote " + ", ".join(str(p) for p in result.save(args.out)))
+    return 0
