@@ -13,18 +13,22 @@ from pathlib import Path
 
 import numpy as np
 
+import styles
 from harness import HERE, report, run_batch, run_deck
 
 from sediment import _core  # noqa: E402  (harness puts python/ on the path)
 
 G = 9.81
 DATA = HERE.parent / "data"    # the validation data the checks compare with (tests/data)
-CHECKS = {}
+CHECKS: dict = {}    # name -> (function of the rank count, rank counts ctest runs it with; () = once, no --np)
 
 
-def check(fn):
-    CHECKS[fn.__name__] = fn
-    return fn
+def check(fn=None, *, ranks=(1, 2)):
+    """Registers a check; ctest asks `checks.py --list` for the names and their rank counts."""
+    def register(fn):
+        CHECKS[fn.__name__] = (fn, tuple(ranks))
+        return fn
+    return register(fn) if fn is not None else register
 
 
 def stokes_reference(d: float, rho_p: float, rho_f: float = 1000.0, mu: float = 1e-3):
@@ -275,7 +279,7 @@ def verlet_limit(np_ranks: int):
     assert diff <= 1e-10 * scale
 
 
-@check
+@check(ranks=())
 def mpi_consistency(np_ranks: int):
     rng = np.random.default_rng(4321)
     n = 200
@@ -723,7 +727,7 @@ def bad_input(np_ranks: int):
     report(f"bad input: {len(BAD_INPUT) + 3} malformed decks each stopped with the expected error message")
 
 
-@check
+@check(ranks=(1,))
 def fuzz_input(np_ranks: int):
     """Every malformed command of tests/decks/fuzz.py ends with a LAMMPS error; valid ones run."""
     import subprocess
@@ -763,12 +767,28 @@ def fuzz_input(np_ranks: int):
     assert not bad
 
 
+# ---- every style: pinned regression, restart and time-step-change replay (tests/decks/styles.py) --------
+for _scene in styles.SCENES:
+    CHECKS[f"style_{_scene.name}"] = (lambda np_ranks, scene=_scene, **kw: styles.check_scene(scene, np_ranks, **kw),
+                                      (1, 2))
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__)
-    parser.add_argument("name", choices=sorted(CHECKS))
+    parser.add_argument("name", nargs="?", choices=sorted(CHECKS))
     parser.add_argument("--np", type=int, default=1, help="MPI ranks")
+    parser.add_argument("--list", action="store_true", help="print each check with the rank counts ctest runs it "
+                        "with (none: it compares rank counts itself) and exit")
+    parser.add_argument("--regenerate", action="store_true", help="style_* checks: pin the reference anew")
     args = parser.parse_args()
-    CHECKS[args.name](args.np)
+    if args.list:
+        for name, (_, ranks) in sorted(CHECKS.items()):
+            print(name, *ranks)
+        return
+    if args.name is None:
+        parser.error("name a check (or --list)")
+    function = CHECKS[args.name][0]
+    function(args.np, regenerate=True) if args.regenerate else function(args.np)
     print(f"PASS {args.name} np={args.np}")
 
 
