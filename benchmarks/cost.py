@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """Cost per particle-step of the SEDIMENT effects, as ratios measured in one run on this machine.
 
     /usr/bin/python3 benchmarks/cost.py [--particles 20000] [--steps 2000] [--repeats 3]

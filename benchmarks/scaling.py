@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """Wall time of the sedimentation test (sample 5, 24 h = 1440 min, parcels in the D422 column)
 against the number of particles and MPI ranks, with LAMMPS's memory estimate.
 

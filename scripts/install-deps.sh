@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: GPL-2.0-or-later
 # Installs the Debian packages SEDIMENT needs, if any is missing (idempotent, quiet when done).
 set -euo pipefail
 packages=(

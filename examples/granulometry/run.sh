@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: GPL-2.0-or-later
 # A simulated sedimentation test of one of the five samples of Bravo et al. (2015), end to end:
 #   examples/granulometry/run.sh SAMPLE [OUT] [sediment sample options...]
 # e.g. run.sh sample5 out/sample5 --particles 50000      (or --geometry slab --cylinder bravo)

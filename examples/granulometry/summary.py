@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """Mean |P - PSD| per instrument and size range over several runs of run.sh, as a Markdown table:
     python3 examples/granulometry/summary.py out/sample1 out/sample2 ... [--reference simulated|input]
         [--readout FOLDER]   (e.g. the output of sediment readout --schedule bravo --out RUN/FOLDER)"""

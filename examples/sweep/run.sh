@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: GPL-2.0-or-later
 # What each time step buys, for the four examples of docs/sweep.md:
 #   examples/sweep/run.sh [OUT] [case-a|sphere|paste|scene ...]       (default: out/sweep, all four)
 # Each study is one `sediment sweep` (table, figure and the cheapest step within 1 % in OUT/NAME).

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-2.0-or-later
 /* ----------------------------------------------------------------------
    SEDIMENT package: solid volume fraction of spheres in layers along one
    axis or in 3d cells (exact sphere-cell volumes), optionally by size class

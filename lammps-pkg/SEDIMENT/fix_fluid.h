@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-2.0-or-later
 /* ----------------------------------------------------------------------
    SEDIMENT package: a fluid at rest (or in uniform motion) around DEM spheres.
    Holds the fluid's properties and geometry; applies no force itself.

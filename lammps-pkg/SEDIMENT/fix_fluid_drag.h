@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-2.0-or-later
 /* ----------------------------------------------------------------------
    SEDIMENT package: drag of a fluid on spheres (Newtonian or Bingham laws).
    Applied explicitly in post_force, except on the atoms a drag-implicit

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-2.0-or-later
 /* ----------------------------------------------------------------------
    SEDIMENT package: writes the layer profiles of compute concentration/grid
    to an HDF5 file every N steps (schema: doc/fix_layers_hdf5.rst).

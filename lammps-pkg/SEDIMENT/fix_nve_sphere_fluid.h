@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-2.0-or-later
 /* ----------------------------------------------------------------------
    SEDIMENT package: constant-NVE integration of finite-size spheres with the
    fluid drag of fix fluid/drag treated implicitly (exponential integrator).

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-2.0-or-later
 /* ----------------------------------------------------------------------
    SEDIMENT package: squeeze-film lubrication between close spheres, with
    the optional exponential repulsion of Bravo et al. (2015). Meant for

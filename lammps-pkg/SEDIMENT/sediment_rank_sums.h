@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-2.0-or-later
 /* ----------------------------------------------------------------------
    SEDIMENT package: per-step sums of a fix's diagnostics, accumulated on
    each rank and reduced over all ranks when first read (compute_vector).

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-2.0-or-later
 /* ----------------------------------------------------------------------
    SEDIMENT package: style registration and the LAMMPS plugin entry point.
 ------------------------------------------------------------------------- */

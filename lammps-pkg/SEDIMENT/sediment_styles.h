@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-2.0-or-later
 /* ----------------------------------------------------------------------
    SEDIMENT package: registration of the package's styles into a LAMMPS
    instance (Debian's LAMMPS has no PLUGIN package, so styles are added to

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-2.0-or-later
 // lmp_sediment: the LAMMPS command line with the SEDIMENT styles registered.
 // Accepts every LAMMPS command-line switch (-in, -var, -log, -screen, ...) and runs under mpirun.
 

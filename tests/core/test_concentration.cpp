@@ -1,4 +1,5 @@
-// Exact sphere volume per layer (sedimentation-tests.md section 2).
+// SPDX-License-Identifier: GPL-2.0-or-later
+// Exact sphere volume per layer (docs/sedimentation-tests.md section 2).
 #include "sediment/concentration.hpp"
 #include "sediment/geometry.hpp"
 

@@ -1,4 +1,5 @@
-// Drag laws against their closed forms (physics.md sections 2 and 4).
+// SPDX-License-Identifier: GPL-2.0-or-later
+// Drag laws against their closed forms (docs/physics.md sections 2 and 4).
 #include "sediment/drag.hpp"
 #include "sediment/geometry.hpp"
 #include "sediment/terminal.hpp"

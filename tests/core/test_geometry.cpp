@@ -1,4 +1,5 @@
-// Submergence below a free surface and the Rayleigh time (physics.md sections 1 and 6).
+// SPDX-License-Identifier: GPL-2.0-or-later
+// Submergence below a free surface and the Rayleigh time (docs/physics.md sections 1 and 6).
 #include "sediment/geometry.hpp"
 
 #include <gtest/gtest.h>

@@ -1,4 +1,5 @@
-// The drag-implicit step (physics.md section 7): exactness, order, Verlet limit, yield, jumps.
+// SPDX-License-Identifier: GPL-2.0-or-later
+// The drag-implicit step (docs/physics.md section 7): exactness, order, Verlet limit, yield, jumps.
 #include "sediment/geometry.hpp"
 #include "sediment/integrator.hpp"
 #include "sediment/terminal.hpp"

@@ -1,4 +1,5 @@
-// Squeeze-film coefficient, Bravo et al. repulsion and the damping cap (physics.md section 5).
+// SPDX-License-Identifier: GPL-2.0-or-later
+// Squeeze-film coefficient, Bravo et al. repulsion and the damping cap (docs/physics.md section 5).
 #include "sediment/geometry.hpp"
 #include "sediment/lubrication.hpp"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-2.0-or-later
 // Terminal velocities: validation cases A, B and the Bingham rest criterion.
 #include "sediment/geometry.hpp"
 #include "sediment/terminal.hpp"

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """Deck tests of the SEDIMENT styles: `python3 checks.py NAME [--np N]` (run by ctest).
 
 Each check runs decks through lmp_sediment (serial or mpirun) and compares what they print with

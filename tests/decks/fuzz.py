@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """Malformed-input sweep: every SEDIMENT style's command, broken in every way we can generate.
 
 Each style has one valid command (a list of (token, kind) pairs) and the token counts at which it is

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """Runs LAMMPS decks through lmp_sediment and reads what they print.
 
 Decks print "SAMPLE v1 v2 ..." rows and "RESULT key value key value ..." lines; checks compare

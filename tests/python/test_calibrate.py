@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """Calibration helpers against the appendix numbers of case F (Zhang & Li 2024)."""
 import numpy as np
 import pytest

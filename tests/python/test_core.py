@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """The physics core as Python sees it (the same code the LAMMPS styles run)."""
 import math
 

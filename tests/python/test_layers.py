@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """sediment.layers: the reader of fix layers/hdf5 files, on good and bad files."""
 from pathlib import Path
 

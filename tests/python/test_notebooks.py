@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """Every notebook in notebooks/ executes headless (nbclient, Debian's python3 kernel)."""
 from __future__ import annotations
 

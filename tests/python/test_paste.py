@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """Steel balls and paste backfill (cases D, E, F): examples/paste decks through sediment.paste and
 sediment.funnel."""
 import math

@@ -1,4 +1,5 @@
-"""Readouts of the hydrometer, buoyancy sphere and pipette (sedimentation-tests.md sections 3-5)."""
+# SPDX-License-Identifier: GPL-2.0-or-later
+"""Readouts of the hydrometer, buoyancy sphere and pipette (docs/sedimentation-tests.md sections 3-5)."""
 from __future__ import annotations
 
 from pathlib import Path

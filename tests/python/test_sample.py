@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """`sediment sample` and `sediment run`: the scene of a sedimentation test, and the end-to-end test of
 issue 4 (sample -> run -> readout) on sample 5."""
 from __future__ import annotations

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """The SEDIMENT styles registered into a Python lammps.lammps() instance."""
 import math
 

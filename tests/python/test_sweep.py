@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """`sediment sweep`: runs, references, errors, failed runs, the table and figure, bad input."""
 from __future__ import annotations
 

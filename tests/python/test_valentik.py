@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """Valentik & Whitmore spheres through examples/valentik_whitmore/in.sphere (sediment.valentik)."""
 from pathlib import Path
 

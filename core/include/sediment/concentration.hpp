@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-2.0-or-later
 // Solid volume of spheres on a regular grid of layers or 3d cells, split among the cells by the
 // exact (closed-form) volume of the sphere inside each. Volumes are split by geometric overlap, not lumped at centres, so the field is smooth when cells
 // are smaller than grains and the solid volume is conserved to round-off.

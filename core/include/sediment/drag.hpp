@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-2.0-or-later
 // Drag laws for a sphere in a Newtonian or Bingham-plastic fluid at rest.
 //
 // Every law is written as one resisting-force curve of the slip speed s >= 0:
@@ -17,7 +18,7 @@ namespace sediment {
 
 enum class DragLaw { Stokes, SchillerNaumann, Dallavalle, ZhangLi, ZhangLiSmooth, DiFelice };
 
-// Which buoyancy the Di Felice hindrance goes with (physics.md 3.1): plain Archimedes buoyancy
+// Which buoyancy the Di Felice hindrance goes with (docs/physics.md 3.1): plain Archimedes buoyancy
 // (factor eps^-(chi+1)) or buoyancy from the mixture density (factor eps^-chi).
 enum class HindranceBuoyancy { Plain, Mixture };
 

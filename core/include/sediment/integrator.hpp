@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-2.0-or-later
 // Drag-implicit time step for one sphere, split like velocity Verlet so that LAMMPS can compute
 // the non-drag forces between the two halves.
 //

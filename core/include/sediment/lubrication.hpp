@@ -1,4 +1,5 @@
-// Lubrication between two close spheres (physics.md section 5): the leading-order Reynolds
+// SPDX-License-Identifier: GPL-2.0-or-later
+// Lubrication between two close spheres (docs/physics.md section 5): the leading-order Reynolds
 // squeeze-film force and the exponential repulsion of Bravo et al. (2015).
 #pragma once
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """Calibration of paste and contact parameters from simple laboratory tests (Zhang & Li 2024, appendices).
 
 - yield stress from a cylindrical slump test (Pashias & Boger 1996):

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """The granulometry report of a sedimentation test: each instrument's readings, its PSD next to the
 input PSD, and the error per size range (docs/sedimentation-tests.md section 6)."""
 from __future__ import annotations

@@ -1,5 +1,6 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """Particle-size distributions: the input table, its interpolation and its discretisation into size
-classes (sedimentation-tests.md section 1, Bravo et al. eq. 15)."""
+classes (docs/sedimentation-tests.md section 1, Bravo et al. eq. 15)."""
 from __future__ import annotations
 
 import csv
@@ -61,7 +62,7 @@ MIN_DIAMETER_UM = 0.01    # below this a diameter_um column was written in anoth
 
 
 def read_psd(path: str | Path) -> PSD:
-    """Reads a CSV with columns diameter_um, percent_finer (as in shared/data/psd)."""
+    """Reads a CSV with columns diameter_um, percent_finer (as in examples/granulometry/psd)."""
     path = Path(path)
     if not path.is_file():
         raise PSDError(f"{path}: no such PSD file")

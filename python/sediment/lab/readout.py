@@ -1,5 +1,6 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """Readouts of the hydrometer (ASTM 152H), buoyancy-sphere and pipette tests from layer profiles
-(sedimentation-tests.md sections 2-5). SI units throughout: m, s, kg.
+(docs/sedimentation-tests.md sections 2-5). SI units throughout: m, s, kg.
 
 A `Column` is the suspension at the reading times: layer edges as depth below the free surface and
 the solid volume fraction per layer. Each instrument turns it into a `Readings` table

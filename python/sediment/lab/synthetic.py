@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """Layer profiles built analytically, without a simulation: each size class of a PSD leaves the
 top of an initially uniform column at its Stokes velocity (no hindrance, no deposit). The readouts
 must recover the PSD from these; they are also a quick preview of a test before running DEM."""

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """Reader of the layer files written by the LAMMPS fix layers/hdf5.
 
 Schema (version 1; lammps-pkg/SEDIMENT/doc/fix_layers_hdf5.rst): root attributes `schema`

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """Where the built programs and the repository's decks are."""
 from __future__ import annotations
 

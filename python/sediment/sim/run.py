@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """Runs a deck through lmp_sediment (serial or mpirun) with a progress bar in simulated time.
 
 Decks written by `sediment sample` announce their plan ("SEDIMENT plan steps N t_end T") and print

@@ -1,4 +1,5 @@
-"""A sedimentation test as a LAMMPS scene (sedimentation-tests.md section 1): the sample's PSD
+# SPDX-License-Identifier: GPL-2.0-or-later
+"""A sedimentation test as a LAMMPS scene (docs/sedimentation-tests.md section 1): the sample's PSD
 discretised into size classes, a representative sub-volume of the cylinder (a 3D periodic column or
 Bravo et al.'s 2D slab), stratified random placement, and a LAMMPS data file with a ready deck.
 

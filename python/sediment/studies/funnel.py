@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """68 steel balls poured from a funnel into paste backfill (Zhang & Li 2024, case E).
 
 Each run places the balls at random in the funnel (random sequential addition, one seed per run),

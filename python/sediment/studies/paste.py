@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """Steel balls and paste backfill (Zhang & Li 2024, cases D and F): the drop test that sets the
 contact damping, and single balls dropped into the paste (settling distance vs fall height).
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """Case A of the validation (Zhang & Li 2024): one sphere settling from rest in water.
 
 The time-step study is a sweep (sediment.sweep) of the example deck with the drag-implicit and the

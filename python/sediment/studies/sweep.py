@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """What accuracy costs in time: one deck run at several time steps (and integrators), each run's
 observables compared with an analytic reference or the finest run, against the run time it took.
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """Spheres settling in Bingham clay suspensions (Valentik & Whitmore 1965; case C).
 
 Runs examples/valentik_whitmore/in.sphere for every row of a CSV with the columns
