@@ -21,9 +21,33 @@ SIZE_RANGES_UM = [(0.0, 5.0), (5.0, 20.0), (20.0, 75.0)]
 def read_all(column: Column, instruments: list[str], schedule: str = "d422", sphere_depth: float | None = None,
              pipette_depth: float = 0.10, pipette_volume: float = 25e-6,
              cylinder_area: float = D422_CYLINDER_AREA, hydrometer: Hydrometer | None = None) -> tuple[list[Readings], list[str]]:
-    """Readings of the chosen instruments at the schedule's times that the frames cover (the
-    hydrometer: the nominal 152H unless another is given); returns them with notes on the inputs
-    and the times left out."""
+    """Readings of the chosen instruments at the schedule's times that the frames cover.
+
+    Parameters
+    ----------
+    column : Column
+        The simulated (or analytic) suspension at the frame times.
+    instruments : list of str
+        Any of ``"hydrometer"``, ``"buoyancy"``, ``"pipette"``.
+    schedule : str
+        Reading times: ``"d422"``, ``"d7928"`` or ``"bravo"`` (the buoyancy sphere reads on Bravo et
+        al.'s times with ``"d422"``).
+    sphere_depth : float, optional
+        Buoyancy sphere centre depth [m]; default 0.3 of the column height.
+    pipette_depth, pipette_volume : float
+        Pipette tip depth [m] and sample volume [m3].
+    cylinder_area : float
+        Cylinder cross-section [m2], for the hydrometer's level rise.
+    hydrometer : Hydrometer, optional
+        The instrument; default the nominal 152H.
+
+    Returns
+    -------
+    readings : list of Readings
+        One per instrument with at least one reading time inside the frames.
+    notes : list of str
+        The readout's inputs (Gs, water, viscosity, c0, height) and the times left out.
+    """
     f = column.suspension
     notes = [f"readout inputs: Gs = {f.specific_gravity:.4g}, water {f.fluid_density:.6g} kg/m3, viscosity "
              f"{f.viscosity:.4g} Pa s, c0 = {column.initial_concentration():.4g} kg/m3, column {column.height:.4g} m"]

@@ -62,7 +62,23 @@ MIN_DIAMETER_UM = 0.01    # below this a diameter_um column was written in anoth
 
 
 def read_psd(path: str | Path) -> PSD:
-    """Reads a CSV with columns diameter_um, percent_finer (as in examples/granulometry/psd)."""
+    """Reads a particle-size distribution table.
+
+    Parameters
+    ----------
+    path : str or Path
+        CSV with the columns ``diameter_um,percent_finer`` (as in examples/granulometry/psd).
+
+    Returns
+    -------
+    PSD
+        Diameters [m] and percent finer by mass, interpolated linearly in log(diameter).
+
+    Raises
+    ------
+    PSDError
+        The file is missing, empty or malformed, with the line and the reason.
+    """
     path = Path(path)
     if not path.is_file():
         raise PSDError(f"{path}: no such PSD file")
@@ -135,7 +151,28 @@ def discretise(psd: PSD, classes: int, sample_mass: float, particle_density: flo
 
     With `particles`, about that many are simulated as parcels of equal real mass (n_k in proportion
     to dw_k, at least one), each standing for the real n_k / (simulated n_k) particles: the simulated
-    PSD is then the discretised one exactly, and every class is sampled alike."""
+    PSD is then the discretised one exactly, and every class is sampled alike.
+
+    Parameters
+    ----------
+    psd : PSD
+        The input distribution.
+    classes : int
+        Number of log-spaced size classes.
+    sample_mass : float
+        Dry mass of the whole sample [kg].
+    particle_density : float
+        Solid density [kg/m3].
+    volume_fraction : float
+        Simulated fraction of the cylinder's volume.
+    particles : int, optional
+        Parcels to simulate; None for real grains.
+
+    Returns
+    -------
+    SizeClasses
+        Diameter, real and simulated counts and weight per class.
+    """
     if classes < 2:
         raise PSDError("need at least 2 size classes")
     if not (sample_mass > 0 and particle_density > 0 and 0 < volume_fraction <= 1):

@@ -12,7 +12,27 @@ from .readout import Column, Suspension
 
 def stokes_column(psd: PSD, height: float, times, initial_concentration: float, suspension: Suspension = Suspension(),
                   layers: int = 2000, classes: int = 600) -> Column:
-    """Column of `layers` over `height` [m] at `times` [s]; `initial_concentration` in kg/m3."""
+    """An analytic column in which every size class leaves the top at its Stokes speed.
+
+    Parameters
+    ----------
+    psd : PSD
+        The distribution of the uniformly mixed sample.
+    height : float
+        Column height [m].
+    times : array_like
+        Frame times [s].
+    initial_concentration : float
+        Solids per volume at the start [kg/m3].
+    suspension : Suspension
+        Water and solids (Stokes' law).
+    layers, classes : int
+        Layers of the column, size classes of the PSD.
+
+    Returns
+    -------
+    Column
+    """
     diameter, share = log_classes(psd, psd.diameter[0], psd.diameter[-1], classes)
     share[0] += psd.percent_finer[0] / 100.0    # mass below the table's first diameter settles with the finest class
     speed = suspension.stokes_speed(diameter)

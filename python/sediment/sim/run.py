@@ -41,8 +41,29 @@ class RunResult:
 
 
 def run_deck(deck: Path, ranks: int = 1, variables: dict[str, str] | None = None, progress: bool = True) -> RunResult:
-    """Runs `deck` in its folder, writing log.lammps there; raises RuntimeError with LAMMPS's error
-    message if it fails."""
+    """Runs a deck in its folder with a progress bar in simulated time, writing log.lammps there.
+
+    Parameters
+    ----------
+    deck : Path
+        LAMMPS input deck.
+    ranks : int
+        MPI ranks (mpirun above 1).
+    variables : dict, optional
+        LAMMPS ``-var NAME VALUE`` pairs.
+    progress : bool
+        Show the progress bar.
+
+    Returns
+    -------
+    RunResult
+        Steps, simulated and wall time, the log's path.
+
+    Raises
+    ------
+    RuntimeError
+        The run failed; the message is LAMMPS's error.
+    """
     deck = Path(deck).resolve()
     if not deck.is_file():
         raise FileNotFoundError(f"{deck}: no such deck")
@@ -107,8 +128,28 @@ class DeckOutput:
 
 def run_batch(deck: Path, variables: dict[str, object] | None = None, ranks: int = 1, cwd: Path | None = None,
               timeout: float | None = None, check: bool = True) -> DeckOutput:
-    """Runs a deck quietly (no log file; in its own folder unless cwd is given) and collects what it
-    prints. With check, a failed run raises RuntimeError with LAMMPS's error message."""
+    """Runs a deck quietly (no log file) and collects what it prints.
+
+    Parameters
+    ----------
+    deck : Path
+        LAMMPS input deck.
+    variables : dict, optional
+        LAMMPS ``-var NAME VALUE`` pairs.
+    ranks : int
+        MPI ranks.
+    cwd : Path, optional
+        Working folder; default the deck's.
+    timeout : float, optional
+        Seconds before the run is killed.
+    check : bool
+        Raise RuntimeError with LAMMPS's message if the run fails.
+
+    Returns
+    -------
+    DeckOutput
+        The text, the ``RESULT`` values and ``SAMPLE`` rows, loop times and the exit status.
+    """
     deck = Path(deck).resolve()
     if not deck.is_file():
         raise FileNotFoundError(f"{deck}: no such deck")

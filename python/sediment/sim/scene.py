@@ -160,9 +160,40 @@ def plan(psd: PSD, *, geometry: str = "column", cylinder: Cylinder = Cylinder(),
          seed: int = 1) -> Scene:
     """The scene of a test: sub-volume, classes, particles and their placement.
 
-    `particles` simulated as equal-mass parcels (compute concentration/grid weight); None: real
-    grains at the real concentration of the sub-volume (required with contacts or lubrication,
-    where every atom must be a grain)."""
+    Parameters
+    ----------
+    psd : PSD
+        The sample's distribution.
+    geometry : {"column", "slab"}
+        3D periodic column, or Bravo et al.'s 2D slab of the axial section.
+    cylinder : Cylinder
+        Cross-section and suspension height.
+    mass : float
+        Dry sample mass [kg].
+    suspension : Suspension
+        Water and solids.
+    width : float, optional
+        Column side or slab width [m]; default two largest diameters (the slab: the cylinder).
+    classes : int
+        Size classes (Bravo et al. eq. 15).
+    particles : int or None
+        Equal-mass parcels to simulate (compute concentration/grid weight); None: real grains at the
+        real concentration of the sub-volume (required with contacts or lubrication).
+    effects : Effects
+        Drag law and the effects on request.
+    layers : int
+        Layers of the concentration grid.
+    t_end : float
+        Simulated time [s].
+    courant : float
+        Layers the fastest grain in suspension may cross per step.
+    seed : int
+        Placement seed.
+
+    Returns
+    -------
+    Scene
+    """
     if geometry not in GEOMETRIES:
         raise ValueError(f"geometry must be one of {', '.join(GEOMETRIES)}, not '{geometry}'")
     if effects.law not in _core.drag_law_names() or effects.law.startswith("zhang-li"):
@@ -264,7 +295,22 @@ def _periodic_delta(delta: np.ndarray, box: list[float]) -> np.ndarray:
 
 
 def write(scene: Scene, out: Path, layer_file: str = "layers.h5") -> list[Path]:
-    """The data file, the deck and the PSD tables of the scene into `out`."""
+    """Writes the scene: data file, deck and PSD tables.
+
+    Parameters
+    ----------
+    scene : Scene
+        From `plan`.
+    out : Path
+        Output folder (created).
+    layer_file : str
+        Name of the layer file the deck writes.
+
+    Returns
+    -------
+    list of Path
+        The files written.
+    """
     out.mkdir(parents=True, exist_ok=True)
     paths = [out / "sample.data", out / "in.sedimentation", out / "input_psd.csv", out / "simulated_psd.csv",
              out / "classes.csv"]

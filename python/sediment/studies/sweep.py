@@ -222,8 +222,40 @@ def run_sweep(deck: Path, values: list[float], observables: list[str], integrato
               variables: dict[str, object] | None = None, ranks: int = 1, work_dir: Path | None = None,
               tau: float | None = None, rayleigh: float | None = None, progress: bool = True) -> Sweep:
     """Runs the deck at each value of the swept variable (and each integrator) and scores each run.
-    Without an analytic reference for every observable, the reference is the run with the smallest
-    value (the implicit one if both integrators ran it)."""
+
+    Parameters
+    ----------
+    deck : Path
+        A deck with ``variable NAME index ...`` for the swept variable.
+    values : list of float
+        Values of the swept variable (> 0).
+    observables : list of str
+        ``RESULT``/``SERIES`` names the deck prints, or hydrometer, buoyancy, pipette (read from the
+        layer file the deck writes to ``${layers_file}``).
+    integrators : list of str, optional
+        ``"implicit"`` and/or ``"explicit"``, passed as ``-var integrator``.
+    parameter : str
+        The deck variable swept.
+    references : dict, optional
+        Analytic references per observable (a number, or an expression of x); without one for
+        every observable the reference is the run with the smallest value (the implicit one if
+        both integrators ran it).
+    variables : dict, optional
+        Further ``-var`` pairs for every run.
+    ranks : int
+        MPI ranks per run.
+    work_dir : Path, optional
+        Where the runs' files go.
+    tau, rayleigh : float, optional
+        Relaxation and Rayleigh times, for the ratios and the figure's marks.
+    progress : bool
+        Show a progress bar.
+
+    Returns
+    -------
+    Sweep
+        Runs (failed ones kept with their message), errors, loop times.
+    """
     deck = Path(deck).resolve()
     if not deck.is_file():
         raise FileNotFoundError(f"{deck}: no such deck")
