@@ -1,7 +1,8 @@
 # SPDX-License-Identifier: GPL-2.0-or-later
 # SEDIMENT: the two commands of the README, and their steps.
 #   make demo   installs what is missing, builds, runs the main example and says where its output is
-#   make test   installs what is missing, builds, runs every test (also under the sanitizers)
+#   make test   installs what is missing, builds, runs every test (also under the sanitizers, and the
+#               deck tests on the current LAMMPS release)
 BUILD   ?= build
 PYTHON  := /usr/bin/python3
 JOBS    ?= 2
@@ -10,7 +11,7 @@ export OMPI_ALLOW_RUN_AS_ROOT := 1
 export OMPI_ALLOW_RUN_AS_ROOT_CONFIRM := 1
 export OMP_NUM_THREADS := 1
 
-.PHONY: deps build demo test test-cpp test-python check-sanitize bench clean
+.PHONY: deps build demo test test-cpp test-python check-sanitize test-lammps-current bench clean
 
 deps:
 	@scripts/install-deps.sh
@@ -44,7 +45,25 @@ check-sanitize: build
 	cd $(SANITIZE_BUILD) && ASAN_OPTIONS=detect_leaks=0:abort_on_error=1 \
 	  UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1 ctest -j $(JOBS) --output-on-failure
 
-test: test-cpp test-python check-sanitize
+# The current LAMMPS (Debian sid's source package, about 4 min to build at -j2, kept in
+# $(CURRENT) between runs): SEDIMENT installed in its tree runs every deck test (in-tree route), and
+# this project built against it runs the style checks as a plugin loaded at start and through its
+# lmp_sediment (plugin and driver routes).
+CURRENT ?= $(BUILD)/lammps-current
+test-lammps-current: build
+	scripts/build-lammps-current.sh $(CURRENT)
+	cmake -S . -B $(CURRENT)/sediment -DCMAKE_BUILD_TYPE=Release -DSEDIMENT_BUILD_PYTHON=OFF \
+	      -DLAMMPS_SOURCE_DIR=$(abspath $(CURRENT))/lammps/src \
+	      -DLAMMPS_LIBRARY=$(abspath $(CURRENT))/build/liblammps.so \
+	      -DSEDIMENT_DECK_LMP=$(abspath $(CURRENT))/build/lmp >/dev/null
+	cmake --build $(CURRENT)/sediment -j $(JOBS)
+	cd $(CURRENT)/sediment && ctest -j $(JOBS) -L "deck|route" --output-on-failure
+	@# the doc pages of the in-tree package are in LAMMPS's command tables: no style entry missing
+	$(PYTHON) $(CURRENT)/lammps/doc/utils/check-styles.py > $(CURRENT)/check-styles.txt
+	@! grep -E "missing|incomplete" $(CURRENT)/check-styles.txt
+	@echo "check-styles: $$(grep 'Total number' $(CURRENT)/check-styles.txt)"
+
+test: test-cpp test-python check-sanitize test-lammps-current
 
 # Cost of each effect per particle-step, as ratios measured in one run (not part of make test).
 bench: build

@@ -8,6 +8,7 @@ packages=(
   pybind11-dev python3-pybind11 libgtest-dev libbenchmark-dev libhdf5-dev
   python3-numpy python3-scipy python3-matplotlib python3-h5py python3-pytest python3-tqdm
   python3-nbclient python3-nbformat python3-ipykernel
+  python3-pip python3-venv python3-setuptools python3-wheel
 )
 missing=()
 for pkg in "${packages[@]}"; do

@@ -37,7 +37,7 @@ ComputeConcentrationGrid::ComputeConcentrationGrid(LAMMPS *lmp, int narg, char *
 {
   const int dimension = domain->dimension;
   int nbounds = 0;
-  StyleArgs args(lmp, "Compute concentration/grid", narg, arg, 3);
+  StyleArgs args(lmp, FLERR, "Compute concentration/grid", narg, arg, 3);
   while (args.more()) {
     int nvalues = 1;
     if (args.is("layers") || args.is("cells")) {

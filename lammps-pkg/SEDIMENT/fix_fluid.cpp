@@ -27,7 +27,7 @@ FixFluid::FixFluid(LAMMPS *lmp, int narg, char **arg) :
   surface_normal[2] = 1.0;
 
   bool has_density = false, has_viscosity = false, has_bingham = false;
-  StyleArgs args(lmp, "Fix fluid", narg, arg, 3);
+  StyleArgs args(lmp, FLERR, "Fix fluid", narg, arg, 3);
   while (args.more()) {
     int nvalues = 1;
     if (args.is("density")) {
@@ -109,9 +109,8 @@ void FixFluid::init()
                update->unit_style);
   region = nullptr;
   if (region_id) {
-    const int iregion = domain->find_region(region_id);
-    if (iregion < 0) error->all(FLERR, "Fix fluid: region '{}' does not exist", region_id);
-    region = domain->regions[iregion];
+    region = sediment_region_by_id(domain, region_id);
+    if (!region) error->all(FLERR, "Fix fluid: region '{}' does not exist", region_id);
   }
 }
 

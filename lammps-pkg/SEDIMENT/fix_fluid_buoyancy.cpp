@@ -27,7 +27,7 @@ FixFluidBuoyancy::FixFluidBuoyancy(LAMMPS *lmp, int narg, char **arg) :
 {
   if (narg < 4) error->all(FLERR, "Fix fluid/buoyancy: expected 'fix ID group fluid/buoyancy FLUID-ID'");
   fluid_id = utils::strdup(arg[3]);
-  StyleArgs args(lmp, "Fix fluid/buoyancy", narg, arg, 4);
+  StyleArgs args(lmp, FLERR, "Fix fluid/buoyancy", narg, arg, 4);
   while (args.more()) {
     int nvalues = 1;
     if (args.is("gravity")) {

@@ -33,7 +33,7 @@ FixFluidDrag::FixFluidDrag(LAMMPS *lmp, int narg, char **arg) :
     error->all(FLERR, "Fix fluid/drag: expected 'fix ID group fluid/drag FLUID-ID law NAME'");
   fluid_id = utils::strdup(arg[3]);
   bool has_law = false;
-  StyleArgs args(lmp, "Fix fluid/drag", narg, arg, 4);
+  StyleArgs args(lmp, FLERR, "Fix fluid/drag", narg, arg, 4);
   while (args.more()) {
     if (args.is("law")) {
       args.need(1, "a name");

@@ -140,7 +140,7 @@ FixLayersHDF5::FixLayersHDF5(LAMMPS *lmp, int narg, char **arg) :
   if (strncmp(arg[5], "c_", 2) != 0)
     error->all(FLERR, "Fix layers/hdf5: expected a compute reference c_ID, not '{}'", arg[5]);
   compute_id = utils::strdup(arg[5] + 2);
-  StyleArgs args(lmp, "Fix layers/hdf5", narg, arg, 6);
+  StyleArgs args(lmp, FLERR, "Fix layers/hdf5", narg, arg, 6);
   while (args.more()) {
     args.need(1, "a value");
     if (args.is("fluid")) {

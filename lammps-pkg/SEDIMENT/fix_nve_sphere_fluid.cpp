@@ -68,7 +68,7 @@ static inline void nve_sphere_kick_drift(double *x, double *v, double *omega, co
 FixNVESphereFluid::FixNVESphereFluid(LAMMPS *lmp, int narg, char **arg) :
     Fix(lmp, narg, arg), weights(nullptr), nmax_weights(0), floor_axis(-1), floor_level(0.0)
 {
-  StyleArgs args(lmp, "Fix nve/sphere/fluid", narg, arg, 3);
+  StyleArgs args(lmp, FLERR, "Fix nve/sphere/fluid", narg, arg, 3);
   while (args.more()) {
     if (args.is("floor")) {
       args.need(2, "an axis and a coordinate");
@@ -80,8 +80,9 @@ FixNVESphereFluid::FixNVESphereFluid(LAMMPS *lmp, int narg, char **arg) :
     }
     args.next(2);
   }
-  if (!atom->sphere_flag)
-    error->all(FLERR, "Fix nve/sphere/fluid requires atom_style sphere");
+  // The per-atom arrays of atom_style sphere (newer LAMMPS has no sphere_flag; fix nve/sphere checks the same).
+  if (!atom->radius_flag || !atom->rmass_flag || !atom->omega_flag || !atom->torque_flag)
+    error->all(FLERR, "Fix nve/sphere/fluid requires atom_style sphere (per-atom radius, rmass, omega, torque)");
 
   time_integrate = 1;
   dynamic_group_allow = 1;

@@ -62,7 +62,7 @@ void PairLubricateFluid::settings(int narg, char **arg)
   range = sediment::LubricationRange{};
   repulsion_scale = 0.0;
   limit = 1;
-  StyleArgs args(lmp, "Pair lubricate/fluid", narg, arg, 1);
+  StyleArgs args(lmp, FLERR, "Pair lubricate/fluid", narg, arg, 1);
   while (args.more()) {
     args.need(1, "a value");
     if (args.is("inner")) {
@@ -107,7 +107,7 @@ void PairLubricateFluid::init_style()
   fluid = FixFluid::find(lmp, fluid_id, "Pair lubricate/fluid");
   if (!(fluid->properties().viscosity > 0.0))
     error->all(FLERR, "Pair lubricate/fluid: fix {} has no viscosity", fluid_id);
-  neighbor->request(this, instance_me);
+  sediment_request_half_list(neighbor, this, instance_me);
 
   double local_max = 0.0;
   for (int i = 0; i < atom->nlocal; ++i) local_max = std::max(local_max, atom->radius[i]);
@@ -156,8 +156,8 @@ void PairLubricateFluid::sum_damping()
     damping_sum[i] += c;
     if (force->newton_pair || j < nlocal) damping_sum[j] += c;
   });
-  if (force->newton_pair) comm->reverse_comm_pair(this);
-  comm->forward_comm_pair(this);
+  if (force->newton_pair) sediment_reverse_comm(comm, this);
+  sediment_forward_comm(comm, this);
 }
 
 void PairLubricateFluid::compute(int eflag, int vflag)

@@ -13,6 +13,7 @@
 #include "fix.h"
 #include "lammps.h"
 #include "modify.h"
+#include "sediment_lammps_api.h"
 #include "utils.h"
 
 #include <cmath>
@@ -34,9 +35,9 @@ inline int sediment_axis(const char *name)
 class StyleArgs {
  public:
   // `style` is the style's full name as the user wrote it ("Fix fluid/drag", "Pair lubricate/fluid");
-  // keywords start at arg[first].
-  StyleArgs(LAMMPS *lmp, std::string style, int narg, char **arg, int first) :
-      lmp(lmp), style(std::move(style)), narg(narg), arg(arg), iarg(first)
+  // keywords start at arg[first]; errors name the style's source at `file`, `line` (FLERR).
+  StyleArgs(LAMMPS *lmp, const char *file, int line, std::string style, int narg, char **arg, int first) :
+      lmp(lmp), file(file), line(line), style(std::move(style)), narg(narg), arg(arg), iarg(first)
   {
   }
 
@@ -67,7 +68,7 @@ class StyleArgs {
 
   double number(int k) const
   {
-    const double value = utils::numeric(FLERR, arg[iarg + k], false, lmp);
+    const double value = utils::numeric(file, line, arg[iarg + k], false, lmp);
     // utils::numeric turns 1e400 into inf: finiteness is checked here, once for every style.
     if (!std::isfinite(value)) fail("{} must be finite, not '{}'", arg[iarg], arg[iarg + k]);
     return value;
@@ -75,9 +76,11 @@ class StyleArgs {
   // A finite number > 0, or "<Style>: <what> must be finite and > 0<hint>".
   double positive(int k, const std::string &what, const char *hint = "") const
   {
-    return positive_value(lmp, style, arg[iarg + k], what, hint);
+    const double value = utils::numeric(file, line, arg[iarg + k], false, lmp);
+    if (!(value > 0.0) || !std::isfinite(value)) fail("{} must be finite and > 0{}", what, hint);
+    return value;
   }
-  int whole(int k) const { return utils::inumeric(FLERR, arg[iarg + k], false, lmp); }
+  int whole(int k) const { return utils::inumeric(file, line, arg[iarg + k], false, lmp); }
   bool yes_no(int k) const
   {
     const char *word = arg[iarg + k];
@@ -112,21 +115,14 @@ class StyleArgs {
 
   template <typename... Args> [[noreturn]] void fail(const std::string &format, Args &&...args) const
   {
-    lmp->error->all(FLERR, style + ": " + format, std::forward<Args>(args)...);
+    lmp->error->all(file, line, style + ": " + format, std::forward<Args>(args)...);
     __builtin_unreachable();    // error->all exits or throws; its formatting overload is not marked so
-  }
-
-  static double positive_value(LAMMPS *lmp, const std::string &style, const char *text, const std::string &what,
-                               const char *hint = "")
-  {
-    const double value = utils::numeric(FLERR, text, false, lmp);
-    if (!(value > 0.0) || !std::isfinite(value))
-      lmp->error->all(FLERR, "{}: {} must be finite and > 0{}", style, what, hint);
-    return value;
   }
 
  private:
   LAMMPS *lmp;
+  const char *file;
+  int line;
   std::string style;
   int narg;
   char **arg;
@@ -137,8 +133,9 @@ class StyleArgs {
 inline std::vector<Fix *> sediment_fixes_of_style(LAMMPS *lmp, const char *style)
 {
   std::vector<Fix *> found;
-  for (int i = 0; i < lmp->modify->nfix; ++i)
-    if (strcmp(lmp->modify->fix[i]->style, style) == 0) found.push_back(lmp->modify->fix[i]);
+  sediment_for_each_fix(lmp->modify, [&](Fix *fix) {
+    if (strcmp(fix->style, style) == 0) found.push_back(fix);
+  });
   return found;
 }
 
@@ -147,9 +144,8 @@ inline std::vector<Fix *> sediment_fixes_of_style(LAMMPS *lmp, const char *style
 template <class T>
 T *sediment_find_fix(LAMMPS *lmp, const char *id, const char *style, const std::string &caller, const char *role)
 {
-  const int ifix = lmp->modify->find_fix(id);
-  if (ifix < 0) lmp->error->all(FLERR, "{}: {} fix '{}' does not exist", caller, role, id);
-  Fix *fix = lmp->modify->fix[ifix];
+  Fix *fix = sediment_fix_by_id(lmp->modify, id);
+  if (!fix) lmp->error->all(FLERR, "{}: {} fix '{}' does not exist", caller, role, id);
   auto typed = dynamic_cast<T *>(fix);
   if (!typed || strcmp(fix->style, style) != 0)
     lmp->error->all(FLERR, "{}: fix '{}' is a fix {}, not a fix {}", caller, id, fix->style, style);
@@ -160,9 +156,9 @@ T *sediment_find_fix(LAMMPS *lmp, const char *id, const char *style, const std::
 inline Compute *sediment_find_compute(LAMMPS *lmp, const char *id, const std::string &caller)
 {
   const char *name = strncmp(id, "c_", 2) == 0 ? id + 2 : id;
-  const int icompute = lmp->modify->find_compute(name);
-  if (icompute < 0) lmp->error->all(FLERR, "{}: compute '{}' does not exist", caller, name);
-  return lmp->modify->compute[icompute];
+  Compute *compute = sediment_compute_by_id(lmp->modify, name);
+  if (!compute) lmp->error->all(FLERR, "{}: compute '{}' does not exist", caller, name);
+  return compute;
 }
 
 }    // namespace LAMMPS_NS

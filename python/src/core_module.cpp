@@ -1,17 +1,16 @@
 // SPDX-License-Identifier: GPL-2.0-or-later
-// sediment._core: the C++ physics core and the LAMMPS style registration, for Python.
+// sediment._core: the C++ physics core for Python. It links no LAMMPS: the styles are registered
+// into a Python LAMMPS through the styles library (sediment.sim.styles).
 
 #include "sediment/drag.hpp"
 #include "sediment/geometry.hpp"
 #include "sediment/integrator.hpp"
 #include "sediment/terminal.hpp"
-#include "sediment_styles.h"
 
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
-#include <cstdint>
 #include <stdexcept>
 
 namespace py = pybind11;
@@ -189,9 +188,4 @@ PYBIND11_MODULE(_core, m)
     return py::dict(py::arg("volume") = sub.volume, py::arg("area") = sub.area, py::arg("wetted") = sub.wetted);
   }, py::arg("radius"), py::arg("centre_height"),
      "Submerged volume, area and wetted fractions of a sphere whose centre is centre_height above the surface.");
-
-  m.def("register_styles", [](std::uintptr_t lmp) {
-    if (lmp == 0) throw py::value_error("null LAMMPS handle");
-    sediment_register(reinterpret_cast<void *>(lmp));
-  }, py::arg("lmp_handle"), "Register the SEDIMENT styles into a LAMMPS instance (its LAMMPS* as an integer).");
 }

@@ -1,0 +1,12 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
+# cmake/Modules/Packages/SEDIMENT.cmake of a LAMMPS tree: the SEDIMENT package's needs beyond its
+# sources (installed by lammps-pkg/install-in-tree.sh). fix layers/hdf5 writes HDF5 (serial
+# interface, rank 0 only); the physics core's headers sit in src/SEDIMENT/sediment/.
+enable_language(C)
+set(HDF5_PREFER_PARALLEL FALSE)
+find_package(HDF5 COMPONENTS C REQUIRED)
+if((NOT BUILD_MPI) AND HDF5_IS_PARALLEL)
+  message(FATAL_ERROR "SEDIMENT: a serial LAMMPS build cannot use a parallel HDF5 library")
+endif()
+target_link_libraries(lammps PRIVATE ${HDF5_LIBRARIES})
+target_include_directories(lammps PRIVATE ${HDF5_INCLUDE_DIRS} ${LAMMPS_SOURCE_DIR}/SEDIMENT)

@@ -1,0 +1,51 @@
+#!/bin/sh
+# SPDX-License-Identifier: GPL-2.0-or-later
+# Installs SEDIMENT as a package of a LAMMPS source tree (CMake build), so that
+#   cmake -S LAMMPS/cmake -B build -D PKG_SEDIMENT=on -D PKG_GRANULAR=on ...
+# builds its styles into liblammps and lmp:
+#   lammps-pkg/install-in-tree.sh /path/to/lammps        (the folder with src/ and cmake/)
+# Copies the styles and the physics core to src/SEDIMENT, the CMake module to
+# cmake/Modules/Packages/SEDIMENT.cmake, the doc pages to doc/src and the examples to
+# examples/PACKAGES/sediment, and adds SEDIMENT to the package lists of cmake/CMakeLists.txt and to
+# the doc's command tables. Running it again refreshes the files and changes nothing else.
+set -eu
+here=$(dirname "$(readlink -f "$0")")
+repo=$(dirname "$here")
+lammps=${1:?usage: install-in-tree.sh LAMMPS_DIR (with src/ and cmake/)}
+[ -f "$lammps/src/lammps.h" ] && [ -f "$lammps/cmake/CMakeLists.txt" ] ||
+    { echo "install-in-tree.sh: $lammps is not a LAMMPS source tree (no src/lammps.h, cmake/CMakeLists.txt)" >&2; exit 2; }
+
+pkg="$lammps/src/SEDIMENT"
+rm -rf "$pkg"
+mkdir -p "$pkg/sediment"
+# The styles; not sediment_styles.*: run-time registration and the plugin entry are for the
+# driver and the plugin, an in-tree build registers the styles from their headers.
+for f in "$here"/SEDIMENT/*.cpp "$here"/SEDIMENT/*.h; do
+    case $(basename "$f") in sediment_styles.*) ;; *) cp "$f" "$pkg/" ;; esac
+done
+for f in "$repo"/core/src/*.cpp; do cp "$f" "$pkg/sediment_core_$(basename "$f")"; done
+cp "$repo"/core/include/sediment/*.hpp "$pkg/sediment/"
+cp "$here/cmake/SEDIMENT.cmake" "$lammps/cmake/Modules/Packages/SEDIMENT.cmake"
+
+# Package lists of the CMake build: the standard packages, and those with a Packages/*.cmake.
+cmakelists="$lammps/cmake/CMakeLists.txt"
+grep -q '^  SEDIMENT$' "$cmakelists" || {
+    grep -q '^  GRANULAR$' "$cmakelists" || { echo "install-in-tree.sh: no GRANULAR in $cmakelists's package list" >&2; exit 1; }
+    sed -i 's/^  GRANULAR$/  GRANULAR\n  SEDIMENT/' "$cmakelists"
+}
+grep -q '^foreach(PKG_WITH_INCL SEDIMENT ' "$cmakelists" || {
+    grep -q '^foreach(PKG_WITH_INCL GRAPHICS ' "$cmakelists" ||
+        { echo "install-in-tree.sh: cannot find the PKG_WITH_INCL list in $cmakelists" >&2; exit 1; }
+    sed -i 's/^foreach(PKG_WITH_INCL GRAPHICS /foreach(PKG_WITH_INCL SEDIMENT GRAPHICS /' "$cmakelists"
+}
+
+# Doc pages and the command tables (doc/utils/check-styles.py looks for every style there).
+if [ -d "$lammps/doc/src" ]; then
+    cp "$here"/SEDIMENT/doc/*.rst "$lammps/doc/src/"
+    "$repo/lammps-pkg/doc-tables.py" "$lammps/doc/src"
+fi
+if [ -d "$lammps/examples" ]; then
+    mkdir -p "$lammps/examples/PACKAGES/sediment"
+    cp "$here"/examples/* "$lammps/examples/PACKAGES/sediment/"
+fi
+echo "SEDIMENT installed in $lammps: configure with -D PKG_SEDIMENT=on -D PKG_GRANULAR=on"

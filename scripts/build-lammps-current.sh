@@ -1,0 +1,53 @@
+#!/usr/bin/env bash
+# SPDX-License-Identifier: GPL-2.0-or-later
+# A minimal current LAMMPS (Debian sid's source package) with SEDIMENT installed in its tree, for
+# testing the package on a current release as well as on Debian 12's 2021 one:
+#   scripts/build-lammps-current.sh DEST
+# DEST/lammps: the source tree (src, cmake, doc) with SEDIMENT installed (lammps-pkg/install-in-tree.sh);
+# DEST/build: liblammps.so and lmp with GRANULAR, PLUGIN and SEDIMENT, MPI, no FFT library.
+# Each step is skipped when done (the tarball, the unpacked tree); the build is incremental, so a
+# rerun recompiles only what changed. Nothing of LAMMPS is committed to the project.
+set -euo pipefail
+dest=$(realpath -m "${1:?usage: build-lammps-current.sh DEST}")
+repo=$(cd "$(dirname "$0")/.." && pwd)
+mkdir -p "$dest"
+
+# The source package's orig tarball, through a deb-src entry for sid kept in DEST (the machine's apt
+# configuration is not changed). apt checks it against the signed index.
+lists="$dest/apt-lists"
+sources="$dest/sid-src.sources"
+apt_opts=(-o Dir::Etc::sourcelist="$sources" -o Dir::Etc::sourceparts=- -o Dir::State::Lists="$lists"
+          -o APT::Get::List-Cleanup=0)
+if ! ls "$dest"/lammps_*.orig.tar.* >/dev/null 2>&1; then
+    cat > "$sources" <<SRC
+Types: deb-src
+URIs: http://deb.debian.org/debian
+Suites: sid
+Components: main
+Signed-By: /usr/share/keyrings/debian-archive-keyring.gpg
+SRC
+    mkdir -p "$lists/partial"
+    apt-get update "${apt_opts[@]}" >/dev/null
+    version=$(apt-cache showsrc "${apt_opts[@]}" lammps | awk '/^Version:/ {print $2; exit}')
+    echo "fetching the LAMMPS $version source package (Debian sid)"
+    # The orig tarball is all we need; the .dsc or Debian diff may be missing on a mirror.
+    (cd "$dest" && apt-get source --download-only "${apt_opts[@]}" "lammps=$version" >/dev/null 2>&1 || true)
+    ls "$dest"/lammps_*.orig.tar.* >/dev/null 2>&1 || { echo "could not fetch the lammps source package" >&2; exit 1; }
+fi
+
+tree="$dest/lammps"
+if [ ! -f "$tree/.complete" ]; then
+    rm -rf "$tree" && mkdir -p "$tree"
+    tar -xf "$dest"/lammps_*.orig.tar.* -C "$tree" cmake src doc/src doc/utils examples/plugins
+    touch "$tree/.complete"
+fi
+"$repo/lammps-pkg/install-in-tree.sh" "$tree" >/dev/null
+
+build="$dest/build"
+if [ ! -f "$build/CMakeCache.txt" ]; then
+    cmake -S "$tree/cmake" -B "$build" -D CMAKE_BUILD_TYPE=Release -D BUILD_SHARED_LIBS=on -D BUILD_MPI=on \
+        -D BUILD_OMP=off -D BUILD_TOOLS=off -D FFT=KISS -D WITH_JPEG=off -D WITH_PNG=off -D WITH_GZIP=off \
+        -D WITH_FFMPEG=off -D WITH_CURL=off -D PKG_GRANULAR=on -D PKG_PLUGIN=on -D PKG_SEDIMENT=on >/dev/null
+fi
+cmake --build "$build" -j "${JOBS:-2}" >/dev/null
+echo "LAMMPS $(basename "$dest"/lammps_*.orig.tar.* | sed 's/lammps_\(.*\)\.orig.*/\1/') with SEDIMENT: $build/lmp"
