@@ -5,23 +5,33 @@ The physics lives in one C++ core (sediment._core), shared with the LAMMPS style
 grouped by role: `sediment.lab` (PSDs, instruments, readouts, calibrations), `sediment.sim` (running
 LAMMPS, scenes, layer files), `sediment.studies` (validation and accuracy studies) and
 `sediment.cli` (the `sediment` command); `sediment.constants` and `sediment.results` serve them all.
+
+The names below are loaded when first used, so that the parts that need no compiled code (running
+decks, reading layer files) import before the extension is built.
 """
 from __future__ import annotations
 
 __version__ = "0.1.0"
 
-try:
-    from ._core import (DragModel, critical_yield_number, drag_coefficient, drag_law_names,
-                        explicit_step_limit, mixture_density, rayleigh_time, relaxation_time,
-                        rotation_drag_rate, sphere_inertia, stokes_velocity, submergence,
-                        terminal_velocity, time_to_fraction)
-except ImportError as exc:  # pragma: no cover - only without a build
-    raise ImportError("sediment._core is not built: run `make build` (or `make test`) in the "
-                      "repository first") from exc
+_CORE = ("DragModel", "critical_yield_number", "drag_coefficient", "drag_law_names", "explicit_step_limit",
+         "mixture_density", "rayleigh_time", "relaxation_time", "rotation_drag_rate", "sphere_inertia",
+         "stokes_velocity", "submergence", "terminal_velocity", "time_to_fraction")
+_STYLES = ("lammps_with_styles", "register_styles")
 
-from .sim.styles import lammps_with_styles, register_styles
+__all__ = sorted(_CORE + _STYLES)
 
-__all__ = ["DragModel", "critical_yield_number", "drag_coefficient", "drag_law_names", "explicit_step_limit",
-           "lammps_with_styles", "mixture_density", "rayleigh_time", "register_styles", "relaxation_time",
-           "rotation_drag_rate", "sphere_inertia", "stokes_velocity", "submergence", "terminal_velocity",
-           "time_to_fraction"]
+
+def __getattr__(name: str):
+    """The core's functions and the style registration, imported on first use."""
+    if name in _CORE:
+        try:
+            from . import _core
+        except ImportError as exc:
+            raise ImportError("sediment._core is not built: run `make build` (or `make test`) in the repository, "
+                              "or `pip install .`") from exc
+        return getattr(_core, name)
+    if name in _STYLES:
+        from .sim import styles
+
+        return getattr(styles, name)
+    raise AttributeError(f"module 'sediment' has no attribute '{name}'")
