@@ -13,10 +13,15 @@
 #include "domain.h"
 #include "error.h"
 #include "modify.h"
+#include "input.h"
 #include "update.h"
+#include "utils.h"
+#include "variable.h"
 
 #include <hdf5.h>
 
+#include <cerrno>
+#include <cstdio>
 #include <cstring>
 #include <mpi.h>
 #include <stdexcept>
@@ -29,15 +34,26 @@ namespace {
 
 constexpr const char *SCHEMA = "sediment-layers";
 constexpr int SCHEMA_VERSION = 1;
+constexpr const char *SEDIMENT_VERSION = "0.1.0";
 
 // Closes an HDF5 handle when it goes out of scope.
 class Handle {
  public:
-  Handle(hid_t id, herr_t (*closer)(hid_t), const std::string &what) : id_(id), closer_(closer)
+  Handle(hid_t id, herr_t (*closer)(hid_t), const std::string &what) : id_(id), closer_(closer), what_(what)
   {
     if (id_ < 0) throw std::runtime_error(what);
   }
-  ~Handle() { closer_(id_); }
+  // Closing a dataset writes its cached chunks: a full disk shows here, so a close after writing is checked.
+  void close()
+  {
+    const herr_t status = closer_(id_);
+    id_ = -1;
+    if (status < 0) throw std::runtime_error("writing " + what_ + " (disk full?)");
+  }
+  ~Handle()
+  {
+    if (id_ >= 0) closer_(id_);
+  }
   Handle(const Handle &) = delete;
   Handle &operator=(const Handle &) = delete;
   operator hid_t() const { return id_; }
@@ -45,6 +61,7 @@ class Handle {
  private:
   hid_t id_;
   herr_t (*closer_)(hid_t);
+  std::string what_;
 };
 
 void check(herr_t status, const std::string &what)
@@ -58,6 +75,21 @@ void write_attribute(hid_t where, const char *name, double value)
   Handle attr(H5Acreate2(where, name, H5T_NATIVE_DOUBLE, space, H5P_DEFAULT, H5P_DEFAULT), H5Aclose,
               std::string("attribute ") + name);
   check(H5Awrite(attr, H5T_NATIVE_DOUBLE, &value), std::string("attribute ") + name);
+}
+
+double read_double_attribute(hid_t where, const char *name)
+{
+  double value = 0.0;
+  Handle attr(H5Aopen(where, name, H5P_DEFAULT), H5Aclose, std::string("attribute ") + name);
+  check(H5Aread(attr, H5T_NATIVE_DOUBLE, &value), std::string("attribute ") + name);
+  return value;
+}
+
+// Sets (or replaces) a scalar double attribute.
+void set_attribute(hid_t where, const char *name, double value)
+{
+  if (H5Aexists(where, name) > 0) check(H5Adelete(where, name), std::string("attribute ") + name);
+  write_attribute(where, name, value);
 }
 
 void write_attribute(hid_t where, const char *name, const std::string &value)
@@ -124,13 +156,53 @@ void put_frame(hid_t file, const char *name, hid_t type, hsize_t frames, const v
   check(H5Sselect_hyperslab(space, H5S_SELECT_SET, start, nullptr, count, nullptr), "selection");
   Handle memory(H5Screate_simple(rank, count, nullptr), H5Sclose, "dataspace");
   check(H5Dwrite(set, type, memory, space, H5P_DEFAULT, data), std::string("writing ") + name);
+  set.close();
+}
+
+bool file_exists(const std::string &name)
+{
+  FILE *probe = fopen(name.c_str(), "rb");
+  if (probe) fclose(probe);
+  return probe != nullptr;
+}
+
+long long frames_before(hid_t handle, LAMMPS_NS::bigint step)
+{
+  Handle set(H5Dopen2(handle, "step", H5P_DEFAULT), H5Dclose, "dataset step");
+  Handle space(H5Dget_space(set), H5Sclose, "dataspace");
+  hsize_t count = 0;
+  H5Sget_simple_extent_dims(space, &count, nullptr);
+  std::vector<long long> steps(count);
+  if (count > 0) check(H5Dread(set, H5T_NATIVE_LLONG, H5S_ALL, H5S_ALL, H5P_DEFAULT, steps.data()), "step");
+  long long kept = 0;
+  while (kept < static_cast<long long>(count) && steps[kept] < step) ++kept;
+  return kept;
+}
+
+void copy_file(const std::string &from, const std::string &to)
+{
+  FILE *in = fopen(from.c_str(), "rb");
+  if (!in) throw std::runtime_error(from + " cannot be read");
+  FILE *out = fopen(to.c_str(), "wb");
+  if (!out) {
+    fclose(in);
+    throw std::runtime_error(to + " cannot be written");
+  }
+  std::vector<char> buffer(1 << 20);
+  size_t n;
+  bool ok = true;
+  while (ok && (n = fread(buffer.data(), 1, buffer.size(), in)) > 0) ok = fwrite(buffer.data(), 1, n, out) == n;
+  ok = ok && !ferror(in);
+  fclose(in);
+  ok = (fclose(out) == 0) && ok;
+  if (!ok) throw std::runtime_error("copying to " + to + " failed (disk full?)");
 }
 
 }    // namespace
 
 FixLayersHDF5::FixLayersHDF5(LAMMPS *lmp, int narg, char **arg) :
     Fix(lmp, narg, arg), compute_id(nullptr), fluid_id(nullptr), particle_density(0.0), grid(nullptr),
-    fluid(nullptr), file(-1), is_open(false), frames(0)
+    fluid(nullptr), file(-1), is_open(false), frames(0), overwrite(false)
 {
   if (narg < 6)
     error->all(FLERR, "Fix layers/hdf5: expected 'fix ID group layers/hdf5 N FILE.h5 c_ID [keyword value ...]'");
@@ -148,8 +220,10 @@ FixLayersHDF5::FixLayersHDF5(LAMMPS *lmp, int narg, char **arg) :
       fluid_id = utils::strdup(args.text(1));
     } else if (args.is("particle_density")) {
       particle_density = args.positive(1, "particle_density");
+    } else if (args.is("overwrite")) {
+      overwrite = args.yes_no(1);
     } else {
-      args.unknown("fluid or particle_density");
+      args.unknown("fluid, particle_density or overwrite");
     }
     args.next(1);
   }
@@ -162,6 +236,19 @@ FixLayersHDF5::FixLayersHDF5(LAMMPS *lmp, int narg, char **arg) :
 FixLayersHDF5::~FixLayersHDF5()
 {
   if (file >= 0) H5Fclose(file);
+  // LAMMPS is done with the fix (end of input, unfix or clear; never after an error): the frames
+  // are complete. Only now does the file replace an earlier result under its name.
+  if (comm->me == 0 && !writing.empty()) {
+    try {
+      Handle done(H5Fopen(writing.c_str(), H5F_ACC_RDWR, H5P_DEFAULT), H5Fclose, "reopening");
+      set_attribute(done, "complete", 1.0);
+      done.close();
+      if (rename(writing.c_str(), path.c_str()) != 0) throw std::runtime_error(std::string("renaming: ") + strerror(errno));
+    } catch (const std::exception &e) {
+      fprintf(stderr, "ERROR: Fix layers/hdf5: %s: %s; the frames stay in %s, marked incomplete\n", path.c_str(),
+              e.what(), writing.c_str());
+    }
+  }
   delete[] compute_id;
   delete[] fluid_id;
 }
@@ -226,56 +313,38 @@ void FixLayersHDF5::open_file()
   const hsize_t shape[2] = {static_cast<hsize_t>(layers.count), names.size()};
   const bigint step_now = update->ntimestep;
 
+  const std::vector<std::pair<const char *, double>> identity = parameters(layers);
+  const char *run_id = input->variable->retrieve("sediment_run_id");
+
   on_rank0([&] {
-    const htri_t is_hdf5 = H5Fis_hdf5(path.c_str());
-    FILE *probe = fopen(path.c_str(), "rb");
-    const bool exists = probe != nullptr;
-    if (probe) fclose(probe);
-    if (exists && is_hdf5 <= 0)
-      throw std::runtime_error("exists but is not an HDF5 file; not overwriting it");
-    if (exists) {
+    if (writing.empty()) writing = choose_file(step_now, shape[0], shape[1], identity, run_id ? run_id : "");
+    if (file_exists(writing)) {
       // Continue the file: keep the frames before this step, so that a restarted run neither
       // loses nor repeats frames.
-      file = H5Fopen(path.c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
+      file = H5Fopen(writing.c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
       if (file < 0) throw std::runtime_error("cannot be opened for writing");
-      if (read_string_attribute(file, "schema") != SCHEMA)
-        throw std::runtime_error("is not a SEDIMENT layer file; not overwriting it");
-      Handle set(H5Dopen2(file, "fraction", H5P_DEFAULT), H5Dclose, "dataset fraction");
-      Handle space(H5Dget_space(set), H5Sclose, "dataspace");
-      hsize_t dims[3];
-      H5Sget_simple_extent_dims(space, dims, nullptr);
-      if (dims[1] != shape[0] || dims[2] != shape[1])
-        throw std::runtime_error(fmt::format("holds {} layers x {} columns, the compute gives {} x {}; "
-                                             "use another file", dims[1], dims[2], shape[0], shape[1]));
-      std::vector<long long> steps(dims[0]);
-      Handle step_set(H5Dopen2(file, "step", H5P_DEFAULT), H5Dclose, "dataset step");
-      if (dims[0] > 0) check(H5Dread(step_set, H5T_NATIVE_LLONG, H5S_ALL, H5S_ALL, H5P_DEFAULT, steps.data()), "step");
-      frames = 0;
-      while (frames < static_cast<long long>(steps.size()) && steps[frames] < step_now) ++frames;
+      frames = frames_before(file, step_now);
       for (const char *name : {"time", "step", "fraction"}) put_frame(file, name, H5T_NATIVE_DOUBLE, frames, nullptr);
+      set_attribute(file, "complete", 0.0);
+      check(H5Fflush(file, H5F_SCOPE_GLOBAL), "flush");
       return;
     }
-    file = H5Fcreate(path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT);
+    file = H5Fcreate(writing.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT);
     if (file < 0) throw std::runtime_error("cannot be created");
     frames = 0;
     write_attribute(file, "schema", SCHEMA);
     write_attribute(file, "schema_version", SCHEMA_VERSION);
+    write_attribute(file, "complete", 0.0);
     write_attribute(file, "units", update->unit_style);
     write_attribute(file, "axis", std::string(1, "xyz"[grid->layer_axis()]));
     write_attribute(file, "dimension", domain->dimension);
-    write_attribute(file, "cross_section", grid->cross_section());
-    if (domain->dimension == 2) write_attribute(file, "slab_thickness", grid->slab_thickness());
-    if (particle_density > 0.0) write_attribute(file, "particle_density", particle_density);
-    if (fluid) {
-      write_attribute(file, "fluid_density", fluid->properties().density);
-      write_attribute(file, "fluid_viscosity", fluid->properties().viscosity);
-      write_attribute(file, "fluid_yield_stress", fluid->properties().yield_stress);
-    }
+    for (const auto &[name, value] : identity) write_attribute(file, name, value);
+    write_attribute(file, "run_id", run_id ? run_id : "");
+    write_attribute(file, "code_version", std::string("SEDIMENT ") + SEDIMENT_VERSION + ", LAMMPS " + lmp->version);
+    write_attribute(file, "run_start", utils::current_date());
     std::string columns;
     for (const std::string &name : names) columns += (columns.empty() ? "" : ",") + name;
     write_attribute(file, "columns", columns);
-    write_attribute(file, "layer_lo", layers.lo);
-    write_attribute(file, "layer_thickness", layers.thickness);
     std::vector<double> centres(layers.count);
     for (int k = 0; k < layers.count; ++k) centres[k] = layers.lo + (k + 0.5) * layers.thickness;
     write_array(file, "layer_centre", centres);
@@ -307,11 +376,82 @@ void FixLayersHDF5::write_frame()
   });
 }
 
+std::vector<std::pair<const char *, double>> FixLayersHDF5::parameters(const sediment::Layers &layers) const
+{
+  // What the frames mean: a file continued by a run that differs in any of these would splice two
+  // different experiments.
+  std::vector<std::pair<const char *, double>> values = {{"layer_lo", layers.lo},
+                                                        {"layer_thickness", layers.thickness},
+                                                        {"cross_section", grid->cross_section()}};
+  if (domain->dimension == 2) values.emplace_back("slab_thickness", grid->slab_thickness());
+  if (particle_density > 0.0) values.emplace_back("particle_density", particle_density);
+  if (fluid) {
+    values.emplace_back("fluid_density", fluid->properties().density);
+    values.emplace_back("fluid_viscosity", fluid->properties().viscosity);
+    values.emplace_back("fluid_yield_stress", fluid->properties().yield_stress);
+  }
+  return values;
+}
+
+
+
+std::string FixLayersHDF5::choose_file(bigint step_now, size_t layers, size_t columns,
+                                       const std::vector<std::pair<const char *, double>> &identity,
+                                       const std::string &run_id)
+{
+  // New frames go to PATH.partial, which replaces PATH when LAMMPS is done (destructor). A run that
+  // continues one whose frames are under PATH.partial (killed, resumed) or PATH (finished, restarted
+  // from a restart file) carries on from a copy; PATH itself is never modified, so an earlier result
+  // survives a run that dies.
+  const std::string partial = path + ".partial";
+  for (const std::string &candidate : {partial, path}) {
+    if (!file_exists(candidate)) continue;
+    if (H5Fis_hdf5(candidate.c_str()) <= 0) throw std::runtime_error("exists but is not an HDF5 file; not overwriting it");
+    Handle old(H5Fopen(candidate.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), H5Fclose, candidate + " cannot be opened");
+    if (read_string_attribute(old, "schema") != SCHEMA)
+      throw std::runtime_error(candidate + " is not a SEDIMENT layer file; not overwriting it");
+    if (overwrite) continue;
+    const std::string what = candidate == partial ? "an unfinished run's frames" : "an earlier run's frames";
+    Handle set(H5Dopen2(old, "fraction", H5P_DEFAULT), H5Dclose, "dataset fraction");
+    Handle space(H5Dget_space(set), H5Sclose, "dataspace");
+    hsize_t dims[3];
+    H5Sget_simple_extent_dims(space, dims, nullptr);
+    if (dims[1] != layers || dims[2] != columns)
+      throw std::runtime_error(fmt::format("{} holds {} ({} layers x {} columns); the compute gives {} x {}: use "
+                                           "another file or 'overwrite yes'", candidate, what, dims[1], dims[2],
+                                           layers, columns));
+    for (const auto &[name, value] : identity) {
+      const double held = H5Aexists(old, name) > 0 ? read_double_attribute(old, name) : 0.0;
+      if (held != value)
+        throw std::runtime_error(fmt::format("{} holds {} with {} {}, this run has {}: use another file or "
+                                             "'overwrite yes'", candidate, what, name, held, value));
+    }
+    const std::string held_id = read_string_attribute(old, "run_id");
+    if (!held_id.empty() && !run_id.empty() && held_id != run_id)
+      throw std::runtime_error(fmt::format("{} holds {} of run {}, this is run {}: use another file or "
+                                           "'overwrite yes'", candidate, what, held_id, run_id));
+    const long long kept = frames_before(old, step_now);
+    if (step_now == 0 || kept == 0)
+      throw std::runtime_error(fmt::format("{} holds {} and this run starts anew at step {}: remove it, use "
+                                           "another file or 'overwrite yes'", candidate, what, step_now));
+    if (candidate == path) {    // a finished file, continued after a restart: work on a copy
+      old.close();
+      copy_file(path, partial);
+    }
+    return partial;
+  }
+  if (file_exists(partial) && remove(partial.c_str()) != 0)
+    throw std::runtime_error(partial + " cannot be replaced");
+  return partial;
+}
+
+
 void FixLayersHDF5::close_file()
 {
   on_rank0([&] {
-    if (file >= 0) H5Fclose(file);
+    const hid_t open = file;
     file = -1;
+    if (open >= 0) check(H5Fclose(open), "closing (disk full?)");
   });
   is_open = false;
 }

@@ -15,7 +15,11 @@ FixStyle(layers/hdf5,FixLayersHDF5);
 
 #include "fix.h"
 
+#include "sediment/concentration.hpp"
+
 #include <string>
+#include <utility>
+#include <vector>
 
 namespace LAMMPS_NS {
 
@@ -39,8 +43,13 @@ class FixLayersHDF5 : public Fix {
   long long file;       // hid_t of the open file (rank 0), -1 when closed
   bool is_open;         // the same on every rank (file is only meaningful on rank 0)
   long long frames;     // frames in the file
+  bool overwrite;       // a new run may replace an earlier file of other parameters
+  std::string writing;  // the file the frames go to (rank 0): PATH.partial until LAMMPS is done
 
   void open_file();
+  std::vector<std::pair<const char *, double>> parameters(const sediment::Layers &layers) const;
+  std::string choose_file(bigint step_now, size_t layers, size_t columns,
+                          const std::vector<std::pair<const char *, double>> &identity, const std::string &run_id);
   void write_frame();
   void close_file();
   // Runs `action` on rank 0 and stops every rank with its message if it failed.

@@ -88,13 +88,24 @@ def test_psd_validation(tmp_path):
         return path
     for text, message in [("", "empty PSD file"),
                           ("diameter_um,percent_finer\n", "no rows"),
-                          ("size,pct\n1,0\n2,100\n", "header must be"),
-                          ("diameter_um,percent_finer\n1,0\n1,50\n2,100\n", "diameters must increase: row 2"),
-                          ("diameter_um,percent_finer\n1,0\n2,120\n", "within 0..100: row 2"),
-                          ("diameter_um,percent_finer\n1,0\n2,60\n3,40\n", "must not decrease"),
-                          ("diameter_um,percent_finer\n1,0\n2,abc\n", "two numbers")]:
+                          ("size,pct\n10,0\n20,100\n", "header must be"),
+                          ("diameter_um,percent_finer\n10,0\n10,50\n20,100\n", "diameters must increase: row 2"),
+                          ("diameter_um,percent_finer\n10,0\n20,120\n", "within 0..100: row 2"),
+                          ("diameter_um,percent_finer\n10,0\n20,60\n30,40\n", "must not decrease"),
+                          ("diameter_um,percent_finer\n10,0\n20,abc\n", "two numbers"),
+                          ("diameter_um,percent_finer\n10,0\n20,0.4\n70,1\n", "not fractions"),
+                          ("diameter_um,percent_finer\n0.075,0\n0.6,40\n2,100\n", "millimetres"),
+                          ("diameter_um,percent_finer\n2,5,0\n20,100\n", "line 2: a row has 3 values"),
+                          ("diameter_um,percent_finer,note\n10,0,a\n20,100,b\n", "two columns")]:
         with pytest.raises(PSDError, match=message):
             read_psd(table(text))
+    assert read_psd(table("\ufeffdiameter_um,percent_finer\n10,0\n20,100\n")).diameter[1] == pytest.approx(2e-5)
+    with pytest.raises(PSDError, match="is a folder"):
+        read_psd(tmp_path)
+    binary = tmp_path / "psd.xlsx"
+    binary.write_bytes(b"PK\x03\x04\xff\xfe\x00binary")
+    with pytest.raises(PSDError, match="not a text"):
+        read_psd(binary)
 
 
 def test_discretisation_keeps_every_class_and_reports_the_simulated_psd():

@@ -6,6 +6,7 @@ from __future__ import annotations
 import argparse
 import sys
 
+from ..sim.run import RunInterrupted
 from . import calibrate, case_a, paste, readout, run, sample, spheres, sweep, terminal
 
 COMMANDS = (terminal, case_a, sample, run, readout, calibrate, paste, spheres, sweep)
@@ -22,10 +23,16 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: list[str] | None = None) -> int:
-    """Runs one command; user errors end with one line on stderr and exit status 2."""
+    """Runs one command. Errors end with one line on stderr: exit status 2 for a problem with the
+    input or the files, 130 when interrupted (Ctrl-C or SIGTERM; a run stops every rank first)."""
     args = build_parser().parse_args(argv)
     try:
         return args.func(args)
-    except (ValueError, FileNotFoundError, RuntimeError) as exc:
+    except (KeyboardInterrupt, RunInterrupted) as exc:
+        reason = str(exc) or "interrupted"
+        print(f"sediment {args.command}: {reason}; files being written were left as *.partial or not written",
+              file=sys.stderr)
+        return 130
+    except (ValueError, OSError, RuntimeError) as exc:    # OSError: missing, read-only or full files and folders
         print(f"sediment {args.command}: error: {exc}", file=sys.stderr)
         return 2

@@ -42,6 +42,8 @@ def add_parser(commands) -> argparse.ArgumentParser:
                         "layer file's fluid)")
     parser.add_argument("--cylinder-area", type=positive, default=D422_CYLINDER_AREA,
                         help="for the hydrometer's level rise [m2]")
+    parser.add_argument("--allow-partial", action="store_true",
+                        help="read a layer file whose run did not finish (its frames stop early)")
     parser.add_argument("--out", type=Path, default=Path("out/readout"), help="output folder")
     return parser
 
@@ -63,7 +65,14 @@ def run(args: argparse.Namespace) -> int:
     simulated = read_psd(args.simulated) if args.simulated else None
     if args.layers is not None:
         from ..sim.layers import read_layers
-        column = Column.from_layers(read_layers(args.layers), surface=args.surface)
+        layers = read_layers(args.layers)
+        if not layers.complete:
+            message = (f"{args.layers} is partial: the run writing it did not finish ({len(layers.time)} frames, the "
+                       f"last at {layers.time[-1] / 60:.4g} min)")
+            if not args.allow_partial:
+                raise ValueError(message + "; resume or rerun it (sediment run --resume), or pass --allow-partial")
+            print("warning: " + message)
+        column = Column.from_layers(layers, surface=args.surface)
         if args.viscosity is not None:    # e.g. the lab's temperature differs from the simulation's
             column = replace(column, suspension=replace(column.suspension, viscosity=args.viscosity))
         title = f"{args.layers.parent.name}/{args.layers.name}: simulated sedimentation test"

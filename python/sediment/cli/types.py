@@ -33,15 +33,22 @@ def nonnegative(text: str) -> float:
     return value
 
 
+MAX_COUNT = 10**9    # particles, ranks, layers, runs: beyond this no run fits this machine's memory
+
+
 def count(text: str) -> int:
-    """A whole number >= 1."""
+    """A whole number from 1 to 1e9 (written 20000 or 2e4)."""
     try:
-        value = int(text)
+        value = float(text)
     except ValueError:
         raise argparse.ArgumentTypeError(f"must be a whole number, got '{text}'") from None
+    if not (math.isfinite(value) and value.is_integer()):
+        raise argparse.ArgumentTypeError(f"must be a whole number, got '{text}'")
     if value < 1:
         raise argparse.ArgumentTypeError(f"must be >= 1, got {text}")
-    return value
+    if value > MAX_COUNT:
+        raise argparse.ArgumentTypeError(f"must be at most {MAX_COUNT:.0e}, got {text}")
+    return int(value)
 
 
 def positive_list(text: str) -> list[float]:

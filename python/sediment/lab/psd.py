@@ -58,7 +58,8 @@ class PSD:
         return np.interp(np.log(np.asarray(diameter, float)), np.log(self.diameter), self.percent_finer)
 
 
-MIN_DIAMETER_UM = 0.01    # below this a diameter_um column was written in another unit
+MIN_DIAMETER_UM = 0.01       # below this a diameter_um column was written in another unit
+MAX_DIAMETER_LOW_UM = 5.0     # a table ending below this was written in mm, not um
 
 
 def read_psd(path: str | Path) -> PSD:
@@ -80,17 +81,26 @@ def read_psd(path: str | Path) -> PSD:
         The file is missing, empty or malformed, with the line and the reason.
     """
     path = Path(path)
+    if path.is_dir():
+        raise PSDError(f"{path} is a folder, not a PSD file")
     if not path.is_file():
         raise PSDError(f"{path}: no such PSD file")
-    with open(path, newline="") as f:
-        rows = [row for row in csv.reader(f) if row and not row[0].lstrip().startswith("#")]
+    try:
+        with open(path, newline="", encoding="utf-8-sig") as f:    # utf-8-sig: a spreadsheet's byte-order mark
+            rows = [row for row in csv.reader(f) if row and not row[0].lstrip().startswith("#")]
+    except UnicodeDecodeError:
+        raise PSDError(f"{path}: not a text (CSV) file") from None
     if not rows:
         raise PSDError(f"{path}: empty PSD file (expected a header diameter_um,percent_finer and rows)")
     header, body = [h.strip() for h in rows[0]], rows[1:]
-    if header[:2] != ["diameter_um", "percent_finer"]:
-        raise PSDError(f"{path}: header must be 'diameter_um,percent_finer', not '{','.join(header)}'")
+    if header != ["diameter_um", "percent_finer"]:
+        raise PSDError(f"{path}: header must be 'diameter_um,percent_finer' (two columns), not '{','.join(header)}'")
     if not body:
         raise PSDError(f"{path}: no rows below the header")
+    wide = next((k for k, row in enumerate(body, start=2) if len([c for c in row if c.strip()]) != 2), None)
+    if wide is not None:
+        raise PSDError(f"{path}, line {wide}: a row has {len(body[wide - 2])} values; every row needs exactly two "
+                       "(diameter in um, percent finer)")
     try:
         values = np.array([[float(row[0]), float(row[1])] for row in body])
     except (ValueError, IndexError):
@@ -99,6 +109,13 @@ def read_psd(path: str | Path) -> PSD:
     if 0 < smallest < MIN_DIAMETER_UM:
         raise PSDError(f"{path}: the diameter_um column starts at {smallest:g} um, below {MIN_DIAMETER_UM} um "
                        "(10 nm): write micrometres, not metres or millimetres")
+    largest = float(np.nanmax(values[:, 0])) if np.isfinite(values[:, 0]).any() else float("nan")
+    if largest < MAX_DIAMETER_LOW_UM:
+        raise PSDError(f"{path}: the largest diameter is {largest:g} um; a sedimentation test's PSD reaches tens of "
+                       "um: if these are millimetres (sieve sizes), write micrometres (x 1000)")
+    if np.nanmax(values[:, 1]) <= 1.0:
+        raise PSDError(f"{path}: percent finer tops out at {np.nanmax(values[:, 1]):g}: write percent (0-100), "
+                       "not fractions (0-1)")
     return PSD(values[:, 0] * 1e-6, values[:, 1], name=str(path))
 
 

@@ -86,6 +86,9 @@ class Column:
                              "(fix layers/hdf5 ... fluid ID particle_density RHO)")
         z_edges = layers.layer_lo + layers.layer_thickness * np.arange(len(layers.centres) + 1)
         top = z_edges[-1] if surface is None else surface
+        if not z_edges[0] < top <= z_edges[-1]:
+            raise ValueError(f"{layers.path}: a free surface at {top:g} m leaves no layer below it (the layers span "
+                             f"{z_edges[0]:g} to {z_edges[-1]:g} m)")
         depth = (top - z_edges)[::-1]                      # from the top layer down
         keep = depth[1:] > 0                               # layers (partly) below the surface
         edges = np.clip(np.concatenate([depth[:-1][keep][:1], depth[1:][keep]]), 0.0, None)
@@ -216,6 +219,10 @@ class Hydrometer:
     def read(self, column: Column, times_s, cylinder_area: float = D422_CYLINDER_AREA, level_rise: bool = True) -> Readings:
         """Readings at the given times. The Stokes depth is the bulb centre; with `level_rise` it is
         taken as in D422, L = L1 + (L2 - VB / A_c) / 2: the bulb lifts the surface by VB / A_c."""
+        bulb_area = self.bulb_volume / self.bulb_length
+        if not cylinder_area > bulb_area:
+            raise ValueError(f"a cylinder of {cylinder_area * 1e4:.3g} cm2 is no wider than the hydrometer's bulb "
+                             f"({bulb_area * 1e4:.3g} cm2)")
         suspension = column.suspension
         c0 = column.initial_concentration()
         a = 1.65 * suspension.specific_gravity / (2.65 * (suspension.specific_gravity - 1))    # 152H Gs correction
@@ -238,6 +245,7 @@ class BuoyancySphere:
 
     def read(self, column: Column, times_s) -> Readings:
         """Apparent mass [g] of the sphere at each time, with the diameter and percent finer it gives."""
+        _fits(column, self.depth, self.diameter / 2, "buoyancy sphere")
         suspension = column.suspension
         volume = np.pi / 6 * self.diameter ** 3
         c0 = column.initial_concentration()
@@ -267,6 +275,7 @@ class Pipette:
         suspension = column.suspension
         disc = column.slab_thickness > 0
         radius = (3 * self.volume / (4 * np.pi)) ** (1 / 3)
+        _fits(column, self.depth, radius, f"{self.volume * 1e6:.3g} mL pipette sample")
         c0 = column.initial_concentration()
         rows = []
         for t in times_s:
@@ -287,3 +296,11 @@ def _percent(concentration: float, initial: float) -> float:
 def _readings(name: str, rows: list[tuple]) -> Readings:
     data = np.array(rows, float).reshape(-1, 5)
     return Readings(name, *(data[:, k] for k in range(5)))
+
+
+def _fits(column: Column, depth: float, radius: float, what: str) -> None:
+    """Refuses an instrument region (a sphere of `radius` centred `depth` below the surface) that
+    leaves the column."""
+    if not radius <= depth <= column.height - radius:
+        raise ValueError(f"the {what} (radius {radius * 100:.3g} cm) centred {depth * 100:.3g} cm deep does not fit "
+                         f"in the {column.height * 100:.3g} cm column")

@@ -42,6 +42,8 @@ class LayerFile:
     step: np.ndarray
     fraction: np.ndarray            # [frames, layers, columns] solid volume fraction
     attributes: dict[str, float] = field(default_factory=dict)    # fluid/particle properties
+    complete: bool = True           # False: the run writing it did not finish (killed, failed, still running)
+    identity: dict[str, str] = field(default_factory=dict)         # run_id, code_version, run_start
 
     def column(self, name: str) -> np.ndarray:
         """Solid fraction of one column, [frames, layers]."""
@@ -93,12 +95,26 @@ def read_layers(path: str | Path) -> LayerFile:
                                      f"({len(f['layer_centre'])}, {len(columns)})")
             extra = {k: float(f.attrs[k]) for k in ("slab_thickness", "particle_density", "fluid_density",
                                                      "fluid_viscosity", "fluid_yield_stress") if k in f.attrs}
+            bad = [k for k, v in extra.items() if not (np.isfinite(v) and v >= 0)]
+            if bad:
+                raise LayerFileError(f"{path}: attribute {bad[0]} is {extra[bad[0]]}, not a physical value (corrupt file?)")
+            if frames == 0:
+                raise LayerFileError(f"{path}: no frames (the run wrote none before it stopped)")
+            # (a layer on a floor without a bed can hold more than its volume of parcels: no upper bound)
+            if not np.all(np.isfinite(fraction)) or fraction.min() < 0:
+                raise LayerFileError(f"{path}: negative or non-numeric solid fractions (corrupt frame data: "
+                                     f"min {np.nanmin(fraction):.3g})")
+            time = np.asarray(f["time"][:frames])
+            if not np.all(np.isfinite(time)) or np.any(np.diff(time) <= 0):
+                raise LayerFileError(f"{path}: frame times are not increasing (frames of two runs spliced, or corrupt)")
+            identity = {k: _text(f.attrs[k]) for k in ("run_id", "code_version", "run_start") if k in f.attrs}
             return LayerFile(path=path, units=_text(f.attrs["units"]), axis=_text(f.attrs["axis"]),
                              dimension=int(f.attrs["dimension"]), cross_section=float(f.attrs["cross_section"]),
                              layer_lo=float(f.attrs["layer_lo"]), layer_thickness=float(f.attrs["layer_thickness"]),
                              centres=np.asarray(f["layer_centre"]), columns=columns,
-                             class_edges=np.asarray(f["class_edges"]), time=np.asarray(f["time"][:frames]),
-                             step=np.asarray(f["step"][:frames]), fraction=fraction, attributes=extra)
+                             class_edges=np.asarray(f["class_edges"]), time=time,
+                             step=np.asarray(f["step"][:frames]), fraction=fraction, attributes=extra,
+                             complete=bool(f.attrs.get("complete", 1)), identity=identity)
         except KeyError as exc:
             raise LayerFileError(f"{path}: layer file lacks {exc}") from None
         except OSError as exc:

@@ -6,12 +6,16 @@ thermo rows beginning with step and time; the bar advances in simulated time and
 the steps, which cost alike whatever the time step."""
 from __future__ import annotations
 
+import fcntl
+import hashlib
 import os
 import re
+import signal
 import subprocess
 import sys
 import time
 from collections import deque
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -29,6 +33,77 @@ def _launch(deck: str, log: str, ranks: int, variables: dict[str, object] | None
     return cmd, env
 
 
+def _start(cmd: list[str], env: dict[str, str], cwd: Path, **kwargs) -> subprocess.Popen:
+    """Starts a run in its own process group (stopped as a whole), tied to this process's life:
+    util-linux's setpriv gives it SIGTERM when this process dies, even by SIGKILL, so neither mpirun
+    (which passes the signal to its ranks) nor a serial LAMMPS outlives it. Output that is not UTF-8
+    (a binary deck echoed in an error) is replaced, not fatal."""
+    return subprocess.Popen(["setpriv", "--pdeathsig", "TERM", "--", *cmd], cwd=cwd, env=env, text=True,
+                            errors="replace", start_new_session=True, **kwargs)
+
+
+def _stop(proc: subprocess.Popen, grace: float = 10.0) -> None:
+    """SIGTERM to the run's process group (mpirun and every rank), SIGKILL after `grace` seconds."""
+    for sig in (signal.SIGTERM, signal.SIGKILL):
+        try:
+            os.killpg(proc.pid, sig)
+        except ProcessLookupError:
+            return
+        try:
+            proc.wait(timeout=grace)
+            return
+        except subprocess.TimeoutExpired:
+            continue
+
+
+class RunInterrupted(RuntimeError):
+    """The run was stopped by SIGINT or SIGTERM; every rank has been stopped."""
+
+
+@contextmanager
+def _signals_stop(proc: subprocess.Popen):
+    """While the run goes on, SIGINT and SIGTERM stop it (every rank) and raise RunInterrupted."""
+    def handler(signum, _frame):
+        raise RunInterrupted(f"stopped by {signal.Signals(signum).name}")
+
+    previous = {sig: signal.signal(sig, handler) for sig in (signal.SIGINT, signal.SIGTERM)}
+    try:
+        yield
+    except BaseException:
+        _stop(proc)
+        raise
+    finally:
+        for sig, old in previous.items():
+            signal.signal(sig, old)
+
+
+@contextmanager
+def _folder_lock(folder: Path):
+    """One `sediment run` at a time per folder: a second one would write the same files."""
+    path = folder / ".sediment-run.lock"
+    with open(path, "a+") as handle:
+        try:
+            fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            handle.seek(0)
+            raise RuntimeError(f"another sediment run is using {folder} (pid {handle.read().strip() or '?'}); "
+                               "wait for it, or run the deck from another folder") from None
+        handle.seek(0)
+        handle.truncate()
+        handle.write(str(os.getpid()))
+        handle.flush()
+        yield
+
+
+def run_id(deck: Path, variables: dict[str, object]) -> str:
+    """The identity of a run: a hash of the deck's text and its variables (stored in the layer file,
+    which refuses to be continued by another run)."""
+    digest = hashlib.sha256(Path(deck).read_bytes())
+    for name, value in sorted(variables.items()):
+        digest.update(f"\0{name}={value}".encode())
+    return digest.hexdigest()[:16]
+
+
 @dataclass
 class RunResult:
     """What a run of a deck did: steps, simulated and wall time, its log."""
@@ -40,7 +115,8 @@ class RunResult:
     simulated_time: float
 
 
-def run_deck(deck: Path, ranks: int = 1, variables: dict[str, str] | None = None, progress: bool = True) -> RunResult:
+def run_deck(deck: Path, ranks: int = 1, variables: dict[str, str] | None = None, progress: bool = True,
+             oversubscribe: bool = False, force: bool = False) -> RunResult:
     """Runs a deck in its folder with a progress bar in simulated time, writing log.lammps there.
 
     Parameters
@@ -53,52 +129,84 @@ def run_deck(deck: Path, ranks: int = 1, variables: dict[str, str] | None = None
         LAMMPS ``-var NAME VALUE`` pairs.
     progress : bool
         Show the progress bar.
+    oversubscribe : bool
+        Allow more ranks than cores.
+    force : bool
+        Let the layer file replace one of another run (``-var overwrite yes``).
 
     Returns
     -------
     RunResult
-        Steps, simulated and wall time, the log's path.
+        Steps, simulated and wall time, the log's path (log.lammps, written only when the run succeeds).
 
     Raises
     ------
     RuntimeError
-        The run failed; the message is LAMMPS's error.
+        The run failed (LAMMPS's error; its log is log.failed.lammps), or another run uses the folder.
+    RunInterrupted
+        SIGINT or SIGTERM stopped it; mpirun and every rank were stopped too.
+    ValueError
+        More ranks than cores without `oversubscribe`.
     """
     deck = Path(deck).resolve()
+    if deck.is_dir():
+        raise ValueError(f"{deck} is a folder; give the deck file (e.g. {deck / 'in.sedimentation'})")
     if not deck.is_file():
         raise FileNotFoundError(f"{deck}: no such deck")
-    log = deck.parent / "log.lammps"
-    cmd, env = _launch(deck.name, log.name, ranks, variables)
-    start = time.monotonic()
-    total_steps, t_end, step, now, errors, tail = 0, 0.0, 0, 0.0, [], deque(maxlen=5)
-    bar = None
-    with subprocess.Popen(cmd, cwd=deck.parent, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
-                          env=env) as proc:
-        assert proc.stdout is not None
-        for line in proc.stdout:
-            tail.append(line.rstrip())
-            words = line.split()
-            if line.startswith("ERROR"):
-                errors.append(line.strip())
-            elif line.startswith("SEDIMENT plan") and len(words) >= 6:
-                total_steps, t_end = int(words[3]), float(words[5])
-                if progress:
-                    from tqdm import tqdm
-                    bar = tqdm(total=t_end, unit="s", desc="simulated", file=sys.stderr, dynamic_ncols=True,
-                               mininterval=0.5, bar_format="{desc}: {percentage:3.0f}%|{bar}| {n:.4g}/{total:.4g} s "
-                                                           "[{elapsed}{postfix}]")
-            elif len(words) >= 2 and words[0].isdigit() and _is_float(words[1]):
-                step, now = int(words[0]), float(words[1])
-                if bar is not None and step:
-                    left = (time.monotonic() - start) * (total_steps - step) / step
-                    bar.set_postfix_str(f"ETA {_clock(left)}", refresh=False)
-                    bar.update(min(now, t_end) - bar.n)
-        code = proc.wait()
-    if bar is not None:
-        bar.close()
-    if code != 0 or errors:
-        message = errors[0] if errors else "\n".join(tail)
-        raise RuntimeError(f"{deck.name} failed (exit {code}): {message} (see {log})")
+    cores = len(os.sched_getaffinity(0))
+    if ranks > cores and not oversubscribe:
+        raise ValueError(f"--np {ranks} asks for more ranks than the {cores} cores here, which runs far slower than "
+                         f"--np {cores}; add --oversubscribe to run it anyway")
+    variables = dict(variables or {})
+    variables.setdefault("sediment_run_id", run_id(deck, variables))
+    if force:
+        variables["overwrite"] = "yes"
+    folder = deck.parent
+    log, failed_log = folder / "log.lammps", folder / "log.failed.lammps"
+    with _folder_lock(folder):
+        # The log is written under a temporary name: log.lammps is always a complete log of a run
+        # that succeeded, log.failed.lammps that of the last one that did not.
+        partial_log = folder / f".log.lammps.{os.getpid()}.partial"
+        cmd, env = _launch(deck.name, partial_log.name, ranks, variables)
+        start = time.monotonic()
+        total_steps, t_end, step, now, errors, tail = 0, 0.0, 0, 0.0, [], deque(maxlen=5)
+        bar = None
+        proc = _start(cmd, env, folder, stdout=subprocess.PIPE, stderr=subprocess.STDOUT)
+        try:
+            with _signals_stop(proc):
+                assert proc.stdout is not None
+                for line in proc.stdout:
+                    tail.append(line.rstrip())
+                    words = line.split()
+                    if line.startswith("ERROR"):
+                        errors.append(line.strip())
+                    elif line.startswith("SEDIMENT plan") and len(words) >= 6:
+                        total_steps, t_end = int(words[3]), float(words[5])
+                        if progress:
+                            from tqdm import tqdm
+                            bar = tqdm(total=t_end, unit="s", desc="simulated", file=sys.stderr, dynamic_ncols=True,
+                                       mininterval=0.5, bar_format="{desc}: {percentage:3.0f}%|{bar}| "
+                                                                   "{n:.4g}/{total:.4g} s [{elapsed}{postfix}]")
+                    elif len(words) >= 2 and words[0].isdigit() and _is_float(words[1]):
+                        step, now = int(words[0]), float(words[1])
+                        if bar is not None and step:
+                            left = (time.monotonic() - start) * (total_steps - step) / step
+                            bar.set_postfix_str(f"ETA {_clock(left)}", refresh=False)
+                            bar.update(min(now, t_end) - bar.n)
+                code = proc.wait()
+        except BaseException:
+            if partial_log.exists():
+                os.replace(partial_log, failed_log)
+            raise
+        finally:
+            if bar is not None:
+                bar.close()
+        if code != 0 or errors:
+            if partial_log.exists():
+                os.replace(partial_log, failed_log)
+            message = errors[0] if errors else "\n".join(tail)
+            raise RuntimeError(f"{deck.name} failed (exit {code}): {message} (see {failed_log})")
+        os.replace(partial_log, log)
     return RunResult(deck, log, time.monotonic() - start, step, now)
 
 
@@ -155,16 +263,21 @@ def run_batch(deck: Path, variables: dict[str, object] | None = None, ranks: int
         raise FileNotFoundError(f"{deck}: no such deck")
     cmd, env = _launch(str(deck), "none", ranks, variables)
     start = time.monotonic()
-    proc = subprocess.run(cmd, capture_output=True, text=True, cwd=cwd or deck.parent, timeout=timeout, env=env)
+    proc = _start(cmd, env, cwd or deck.parent, stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    try:
+        stdout, stderr = proc.communicate(timeout=timeout)
+    except BaseException:
+        _stop(proc)
+        raise
     wall = time.monotonic() - start
     rows, results = [], {}
-    for line in proc.stdout.splitlines():
+    for line in stdout.splitlines():
         if line.startswith("SAMPLE "):
             rows.append([float(v) for v in line.split()[1:]])
         elif line.startswith("RESULT "):
             words = line.split()[1:]
             results.update({k: float(v) for k, v in zip(words[::2], words[1::2])})
-    out = DeckOutput(proc.stdout + proc.stderr, proc.returncode, wall, np.array(rows), results)
+    out = DeckOutput(stdout + stderr, proc.returncode, wall, np.array(rows), results)
     if check and out.error:
         raise RuntimeError(f"{deck.name} failed: {out.error}")
     return out

@@ -21,6 +21,7 @@ from .. import _core
 from ..constants import BRAVO_CYLINDER_HEIGHT, BRAVO_CYLINDER_WIDTH, D422_CYLINDER_AREA, D422_CYLINDER_HEIGHT
 from ..lab.psd import PSD, SizeClasses, class_edges, discretise
 from ..lab.readout import Suspension
+from ..results import write_text
 
 GEOMETRIES = ("column", "slab")
 
@@ -202,6 +203,17 @@ def plan(psd: PSD, *, geometry: str = "column", cylinder: Cylinder = Cylinder(),
         raise ValueError("contacts and lubrication need real grains: use --real-grains (no parcels)")
     if not (mass > 0 and layers >= 10 and t_end > 0 and courant > 0):
         raise ValueError("mass and end time must be > 0, layers >= 10, courant > 0")
+    if not suspension.particle_density > suspension.fluid_density:
+        raise ValueError(f"grains of {suspension.particle_density:g} kg/m3 do not settle in water of "
+                         f"{suspension.fluid_density:g} kg/m3")
+    solids = mass / (cylinder.area * cylinder.height) / suspension.particle_density
+    if solids >= 0.5:
+        raise ValueError(f"{mass:g} kg of solids would fill {solids:.0%} of the {cylinder.area * cylinder.height * 1e3:.3g} L "
+                         "suspension: a sedimentation test holds a few percent (50-60 g in 1 L)")
+    d_largest = psd.span()[1]
+    if cylinder.height < 20 * d_largest:
+        raise ValueError(f"a column of {cylinder.height:g} m is not tall enough for grains of {d_largest * 1e6:.3g} um "
+                         "(at least 20 diameters)")
     d_max = psd.span()[1]
     if geometry == "slab":
         width = cylinder.diameter if width is None else width
@@ -311,22 +323,24 @@ def write(scene: Scene, out: Path, layer_file: str = "layers.h5") -> list[Path]:
     list of Path
         The files written.
     """
+    if out.exists() and not out.is_dir():
+        raise ValueError(f"{out} exists and is not a folder")
     out.mkdir(parents=True, exist_ok=True)
     paths = [out / "sample.data", out / "in.sedimentation", out / "input_psd.csv", out / "simulated_psd.csv",
              out / "classes.csv"]
     _write_data(scene, paths[0])
-    paths[1].write_text(_deck(scene, paths[0].name, layer_file))
+    write_text(paths[1], _deck(scene, paths[0].name, layer_file))
     _write_psd(scene.psd, paths[2])
     _write_psd(scene.simulated_psd(), paths[3])
     c = scene.classes
-    paths[4].write_text("diameter_um,input_mass_fraction,simulated_mass_fraction,particles,weight\n" + "".join(
+    write_text(paths[4], "diameter_um,input_mass_fraction,simulated_mass_fraction,particles,weight\n" + "".join(
         f"{d * 1e6:.6g},{m:.6g},{s:.6g},{n},{w:.6g}\n"
         for d, m, s, n, w in zip(c.diameter, c.mass_fraction, c.simulated_mass_fraction(), c.count, c.weight)))
     return paths
 
 
 def _write_psd(psd: PSD, path: Path) -> None:
-    path.write_text("diameter_um,percent_finer\n" + "".join(
+    write_text(path, "diameter_um,percent_finer\n" + "".join(
         f"{d * 1e6:.8g},{p:.8g}\n" for d, p in zip(psd.diameter, psd.percent_finer)))
 
 
@@ -342,7 +356,7 @@ def _write_data(scene: Scene, path: Path) -> None:
               for i, (d, (x, y, z)) in enumerate(zip(scene.diameter, scene.position))]
     lines += ["", "Weights", ""]
     lines += [f"{i + 1} {w:.17g}" for i, w in enumerate(scene.weight)]
-    path.write_text("\n".join(lines) + "\n")
+    write_text(path, "\n".join(lines) + "\n")
 
 
 def scene_box(scene: Scene) -> tuple[list[float], list[float]]:
@@ -376,6 +390,7 @@ def _deck(scene: Scene, data: str, layer_file: str) -> str:
         "#",
         "#   sediment run in.sedimentation        (or: lmp_sediment -in in.sedimentation)",
         f"variable        layers_file index {layer_file}",
+        "variable        overwrite index no    # yes: replace a layer file of another run (sediment run --force)",
         f"variable        t_end equal {scene.t_end:.12g}",
         "variable        dt_scale index 1    # multiplies every stage's time step (sediment sweep ... --parameter dt_scale)",
         "",
@@ -419,7 +434,7 @@ def _deck(scene: Scene, data: str, layer_file: str) -> str:
         lines.append(f"fix             step all nve/sphere/fluid floor {up} 0.0")
     lines += [
         f"fix             layers all layers/hdf5 $(round({frames_every}/v_dt_scale)+(round({frames_every}/v_dt_scale)<1)) "
-        f"${{layers_file}} c_conc fluid water particle_density {f.particle_density:.12g}",
+        f"${{layers_file}} c_conc fluid water particle_density {f.particle_density:.12g} overwrite ${{overwrite}}",
         "",
         "thermo_style    custom step time dt f_layers",
         f"thermo          {frames_every * 5}",
