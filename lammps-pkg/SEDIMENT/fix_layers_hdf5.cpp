@@ -229,6 +229,7 @@ FixLayersHDF5::FixLayersHDF5(LAMMPS *lmp, int narg, char **arg) :
   }
   scalar_flag = 1;
   global_freq = 1;
+  restart_global = 1;    // the simulated time, which restart files of LAMMPS 2021 do not keep
   extscalar = 0;
   H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);    // errors are reported through LAMMPS
 }
@@ -410,28 +411,29 @@ std::string FixLayersHDF5::choose_file(bigint step_now, size_t layers, size_t co
     Handle old(H5Fopen(candidate.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), H5Fclose, candidate + " cannot be opened");
     if (read_string_attribute(old, "schema") != SCHEMA)
       throw std::runtime_error(candidate + " is not a SEDIMENT layer file; not overwriting it");
-    if (overwrite) continue;
     const std::string what = candidate == partial ? "an unfinished run's frames" : "an earlier run's frames";
+    std::string differs;    // why the frames held there are not this run's
     Handle set(H5Dopen2(old, "fraction", H5P_DEFAULT), H5Dclose, "dataset fraction");
     Handle space(H5Dget_space(set), H5Sclose, "dataspace");
     hsize_t dims[3];
     H5Sget_simple_extent_dims(space, dims, nullptr);
     if (dims[1] != layers || dims[2] != columns)
-      throw std::runtime_error(fmt::format("{} holds {} ({} layers x {} columns); the compute gives {} x {}: use "
-                                           "another file or 'overwrite yes'", candidate, what, dims[1], dims[2],
-                                           layers, columns));
+      differs = fmt::format("{} layers x {} columns, the compute gives {} x {}", dims[1], dims[2], layers, columns);
     for (const auto &[name, value] : identity) {
       const double held = H5Aexists(old, name) > 0 ? read_double_attribute(old, name) : 0.0;
-      if (held != value)
-        throw std::runtime_error(fmt::format("{} holds {} with {} {}, this run has {}: use another file or "
-                                             "'overwrite yes'", candidate, what, name, held, value));
+      if (differs.empty() && held != value) differs = fmt::format("{} {}, this run has {}", name, held, value);
     }
     const std::string held_id = read_string_attribute(old, "run_id");
-    if (!held_id.empty() && !run_id.empty() && held_id != run_id)
-      throw std::runtime_error(fmt::format("{} holds {} of run {}, this is run {}: use another file or "
-                                           "'overwrite yes'", candidate, what, held_id, run_id));
-    const long long kept = frames_before(old, step_now);
-    if (step_now == 0 || kept == 0)
+    if (differs.empty() && !held_id.empty() && !run_id.empty() && held_id != run_id)
+      differs = fmt::format("run {}, this is run {}", held_id, run_id);
+    // A run continues the frames it finds when they are its own and it starts after the first of them
+    // (from a restart file); an unfinished run's frames are continued even with 'overwrite yes'.
+    const bool continues = differs.empty() && step_now > 0 && frames_before(old, step_now) > 0;
+    if (overwrite && !(continues && candidate == partial)) continue;
+    if (!differs.empty())
+      throw std::runtime_error(fmt::format("{} holds {} with {}: use another file or 'overwrite yes'", candidate,
+                                           what, differs));
+    if (!continues)
       throw std::runtime_error(fmt::format("{} holds {} and this run starts anew at step {}: remove it, use "
                                            "another file or 'overwrite yes'", candidate, what, step_now));
     if (candidate == path) {    // a finished file, continued after a restart: work on a copy
@@ -454,6 +456,25 @@ void FixLayersHDF5::close_file()
     if (open >= 0) check(H5Fclose(open), "closing (disk full?)");
   });
   is_open = false;
+}
+
+void FixLayersHDF5::write_restart(FILE *fp)
+{
+  // The simulated time at this step: with time steps changed between runs it is not step x dt,
+  // and LAMMPS 2021 restart files lose it (time would restart as step x the current dt).
+  if (comm->me != 0) return;
+  const double state[2] = {update->atime + (update->ntimestep - update->atimestep) * update->dt,
+                           static_cast<double>(update->ntimestep)};
+  const int size = sizeof(state);
+  fwrite(&size, sizeof(int), 1, fp);
+  fwrite(state, sizeof(double), 2, fp);
+}
+
+void FixLayersHDF5::restart(char *buf)
+{
+  const auto *state = reinterpret_cast<const double *>(buf);
+  update->atime = state[0];
+  update->atimestep = static_cast<bigint>(state[1]);
 }
 
 double FixLayersHDF5::compute_scalar()

@@ -33,6 +33,8 @@ class FixLayersHDF5 : public Fix {
   void end_of_step() override;
   void post_run() override;
   double compute_scalar() override;
+  void write_restart(FILE *) override;
+  void restart(char *) override;
 
  private:
   std::string path;

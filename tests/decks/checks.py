@@ -693,6 +693,8 @@ BAD_INPUT = [
     ("compute c all concentration/grid cells 4 4 4\nfix l all layers/hdf5 10 a.h5 c_c\nrun 0", "bins into 3d cells"),
     ("compute c all concentration/grid layers w 10", "layer axis must be x, y or z"),
     ("compute c all concentration/grid layers z 0", "numbers of layers or cells must be >= 1"),
+    ("compute c all concentration/grid layers z 2000000000", "columns is more than 2e+08 values"),
+    ("compute c all concentration/grid cells 100000 100000 100000", "columns is more than 2e+08 values"),
     ("compute c all concentration/grid layers z 10 bounds 1 0", "bounds need LO < HI along z"),
     ("compute c all concentration/grid layers z 10 classes 2 1", "positive and increasing"),
     ("compute c all concentration/grid layers z 10 thickness 1", "'thickness' is for 2d simulations only"),

@@ -16,6 +16,8 @@ def add_parser(commands) -> argparse.ArgumentParser:
     parser.add_argument("--var", nargs=2, action="append", metavar=("NAME", "VALUE"), help="LAMMPS -var")
     parser.add_argument("--quiet", action="store_true", help="no progress bar")
     parser.add_argument("--oversubscribe", action="store_true", help="allow more ranks than cores")
+    parser.add_argument("--resume", action="store_true",
+                        help="continue a killed or failed run from its last restart file (decks of `sediment sample`)")
     parser.add_argument("--force", action="store_true",
                         help="let the layer file replace one written by another run (-var overwrite yes)")
     return parser
@@ -26,7 +28,7 @@ def run(args: argparse.Namespace) -> int:
     from ..sim.run import run_deck
 
     result = run_deck(args.deck, ranks=args.np, variables=dict(args.var or []), progress=not args.quiet,
-                      oversubscribe=args.oversubscribe, force=args.force)
+                      oversubscribe=args.oversubscribe, force=args.force, resume=args.resume)
     print(f"{result.deck.name}: {result.steps} steps, {result.simulated_time:.6g} s simulated in "
           f"{result.wall_seconds:.1f} s on {args.np} rank(s); log {result.log}")
     return 0

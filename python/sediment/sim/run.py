@@ -116,7 +116,7 @@ class RunResult:
 
 
 def run_deck(deck: Path, ranks: int = 1, variables: dict[str, str] | None = None, progress: bool = True,
-             oversubscribe: bool = False, force: bool = False) -> RunResult:
+             oversubscribe: bool = False, force: bool = False, resume: bool = False) -> RunResult:
     """Runs a deck in its folder with a progress bar in simulated time, writing log.lammps there.
 
     Parameters
@@ -133,6 +133,9 @@ def run_deck(deck: Path, ranks: int = 1, variables: dict[str, str] | None = None
         Allow more ranks than cores.
     force : bool
         Let the layer file replace one of another run (``-var overwrite yes``).
+    resume : bool
+        Continue a killed or failed run from the newest restart file beside the deck (restart.a.bin or
+        restart.b.bin, as decks of `sediment sample` write them); its layer file continues.
 
     Returns
     -------
@@ -158,10 +161,27 @@ def run_deck(deck: Path, ranks: int = 1, variables: dict[str, str] | None = None
         raise ValueError(f"--np {ranks} asks for more ranks than the {cores} cores here, which runs far slower than "
                          f"--np {cores}; add --oversubscribe to run it anyway")
     variables = dict(variables or {})
-    variables.setdefault("sediment_run_id", run_id(deck, variables))
+    variables.setdefault("sediment_run_id", run_id(deck, variables))    # a resumed run is the same run
     if force:
         variables["overwrite"] = "yes"
     folder = deck.parent
+    if resume:
+        if "${resume}" not in deck.read_text(errors="replace"):
+            raise ValueError(f"{deck.name} cannot be resumed: it has no 'resume' variable (decks written by "
+                             "`sediment sample` have one)")
+        restarts = sorted((p for p in (folder / "restart.a.bin", folder / "restart.b.bin") if p.is_file()),
+                          key=lambda p: p.stat().st_mtime, reverse=True)
+        if not restarts:
+            raise ValueError(f"nothing to resume in {folder}: no restart file (restart.a.bin, restart.b.bin); "
+                             "run it without --resume")
+        # The newest restart file may be the one a kill cut short: then the other, one interval older.
+        for k, restart in enumerate(restarts):
+            try:
+                return run_deck(deck, ranks, {**variables, "resume": "yes", "restart_file": restart.name}, progress,
+                                oversubscribe, force)
+            except RuntimeError as exc:
+                if k + 1 == len(restarts) or "restart" not in str(exc).lower():
+                    raise
     log, failed_log = folder / "log.lammps", folder / "log.failed.lammps"
     with _folder_lock(folder):
         # The log is written under a temporary name: log.lammps is always a complete log of a run

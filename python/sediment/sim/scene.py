@@ -206,14 +206,14 @@ def plan(psd: PSD, *, geometry: str = "column", cylinder: Cylinder = Cylinder(),
     if not suspension.particle_density > suspension.fluid_density:
         raise ValueError(f"grains of {suspension.particle_density:g} kg/m3 do not settle in water of "
                          f"{suspension.fluid_density:g} kg/m3")
-    solids = mass / (cylinder.area * cylinder.height) / suspension.particle_density
-    if solids >= 0.5:
-        raise ValueError(f"{mass:g} kg of solids would fill {solids:.0%} of the {cylinder.area * cylinder.height * 1e3:.3g} L "
-                         "suspension: a sedimentation test holds a few percent (50-60 g in 1 L)")
     d_largest = psd.span()[1]
     if cylinder.height < 20 * d_largest:
         raise ValueError(f"a column of {cylinder.height:g} m is not tall enough for grains of {d_largest * 1e6:.3g} um "
                          "(at least 20 diameters)")
+    solids = mass / (cylinder.area * cylinder.height) / suspension.particle_density
+    if solids >= 0.5:
+        raise ValueError(f"{mass:g} kg of solids would fill {solids:.0%} of the {cylinder.area * cylinder.height * 1e3:.3g} L "
+                         "suspension: a sedimentation test holds a few percent (50-60 g in 1 L)")
     d_max = psd.span()[1]
     if geometry == "slab":
         width = cylinder.diameter if width is None else width
@@ -389,18 +389,20 @@ def _deck(scene: Scene, data: str, layer_file: str) -> str:
         f"# {len(stages)} stages, {total_steps} steps to {scene.t_end:g} s; layer frames every {frames_every} steps.",
         "#",
         "#   sediment run in.sedimentation        (or: lmp_sediment -in in.sedimentation)",
+        "#   sediment run --resume in.sedimentation   continues a killed run from its last restart file",
         f"variable        layers_file index {layer_file}",
         "variable        overwrite index no    # yes: replace a layer file of another run (sediment run --force)",
         f"variable        t_end equal {scene.t_end:.12g}",
         "variable        dt_scale index 1    # multiplies every stage's time step (sediment sweep ... --parameter dt_scale)",
+        "variable        resume index no     # yes: start from ${restart_file} (sediment run --resume)",
+        "variable        restart_file index restart.a.bin",
         "",
-        "units           si",
-        f"dimension       {scene.dimension}",
-        "atom_style      sphere",
-        f"boundary        {'p f p' if slab else 'p p f'}",
-        f"processors      {'* 1 1' if slab else '* * 1'}    # ranks side by side: each keeps its share as the grains settle",
-        "fix             weights all property/atom d_weight    # real grains each atom stands for",
-        f"read_data       {data} fix weights NULL Weights",
+        "# The weights (real grains each atom stands for) come from the data file, or back from the restart file.",
+        'if "${resume} == yes" then "read_restart ${restart_file}" "fix weights all property/atom d_weight" else &',
+        '  "units si" "dimension ' + str(scene.dimension) + '" "atom_style sphere" "boundary ' + ('p f p' if slab else 'p p f')
+        + '" "processors ' + ('* 1 1' if slab else '* * 1') + '" "fix weights all property/atom d_weight" &',
+        f'  "read_data {data} fix weights NULL Weights"',
+        f"# ranks side by side ({'* 1 1' if slab else '* * 1'}): each keeps its share of the grains as they settle",
         f"neighbor        {d_max:.6g} bin",
         f"atom_modify     sort 1000 {scene.height / scene.layers:.6g}    # neighbours in memory, layer by layer",
     ]
@@ -440,9 +442,14 @@ def _deck(scene: Scene, data: str, layer_file: str) -> str:
         f"thermo          {frames_every * 5}",
         "thermo_modify   norm no",
         f'print           "SEDIMENT plan steps $(ceil({total_steps}/v_dt_scale)) t_end {scene.t_end:.12g}"',
+        "# Two restart files in turn (one is always complete); each stage runs up to its last step, so a",
+        "# resumed run skips the stages it has done and finishes the one it was in.",
+        f"restart         $(ceil({total_steps}/20/v_dt_scale)) restart.a.bin restart.b.bin",
+        "variable        stage_end equal 0",
     ]
-    for dt, steps in stages:
-        lines += [f"timestep        $({dt:.17g}*v_dt_scale)", f"run             $(ceil({steps}/v_dt_scale)) post no"]
+    for k, (dt, steps) in enumerate(stages, start=1):
+        lines += [f"variable        stage_end equal $(v_stage_end+ceil({steps}/v_dt_scale))",
+                  f'if "$(step) < ${{stage_end}}" then "timestep $({dt:.17g}*v_dt_scale)" "run ${{stage_end}} upto post no"']
     return "\n".join(lines) + "\n"
 
 

@@ -1,0 +1,201 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
+"""Faults a user meets: a full disk, a rerun or another run over an earlier result, a killed run and
+its resumption, two runs in one folder, signals, too many ranks, implausible input. None may end
+with exit status 0 and a wrong or partial result, or lose an earlier result."""
+from __future__ import annotations
+
+import hashlib
+import os
+import signal
+import subprocess
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from sediment.sim.layers import read_layers
+
+REPO = Path(__file__).resolve().parents[2]
+SEDIMENT = [str(REPO / "bin" / "sediment")]
+PSD = REPO / "examples" / "granulometry" / "psd" / "sample5.csv"
+
+
+def sediment(*args, cwd: Path | None = None, **kwargs) -> subprocess.CompletedProcess:
+    return subprocess.run(SEDIMENT + [str(a) for a in args], capture_output=True, text=True, cwd=cwd, **kwargs)
+
+
+def sample(out: Path, *options) -> Path:
+    done = sediment("sample", PSD, "--out", out, "--t-end", 7200, *options)
+    assert done.returncode == 0, done.stderr
+    return out / "in.sedimentation"
+
+
+def digest(path: Path) -> str:
+    return hashlib.sha256(path.read_bytes()).hexdigest()
+
+
+def processes_in(folder: Path) -> list[int]:
+    """PIDs of live (not zombie) processes whose working folder is `folder`."""
+    found = []
+    for entry in Path("/proc").iterdir():
+        if not entry.name.isdigit():
+            continue
+        try:
+            if Path(os.readlink(entry / "cwd")) == folder and "Z" not in (entry / "stat").read_text().split()[2]:
+                found.append(int(entry.name))
+        except OSError:
+            continue
+    return found
+
+
+def wait_for(condition, seconds: float = 60.0) -> None:
+    end = time.monotonic() + seconds
+    while not condition():
+        assert time.monotonic() < end, "timed out"
+        time.sleep(0.1)
+
+
+def test_a_full_disk_stops_the_run_and_leaves_no_result(tmp_path):
+    small = tmp_path / "small"
+    small.mkdir()
+    if subprocess.run(["mount", "-t", "tmpfs", "-o", "size=256k", "tmpfs", str(small)], capture_output=True).returncode:
+        pytest.skip("cannot mount a small file system here (not root)")
+    try:
+        deck = (REPO / "lammps-pkg" / "examples" / "in.settling").read_text()
+        deck = deck.replace("layers.h5", str(small / "layers.h5")).replace("layers z 50", "layers z 400")
+        deck = deck.replace("layers/hdf5 100", "layers/hdf5 5")
+        (tmp_path / "in.full").write_text(deck)
+        done = subprocess.run([os.environ["SEDIMENT_LMP"], "-in", "in.full", "-log", "none"], cwd=tmp_path,
+                              capture_output=True, text=True)
+        assert done.returncode != 0
+        assert "Fix layers/hdf5" in done.stdout and "disk full" in done.stdout
+        assert not (small / "layers.h5").exists()    # only layers.h5.partial, which readout refuses
+        assert not read_layers(small / "layers.h5.partial").complete
+    finally:
+        subprocess.run(["umount", str(small)], check=True)
+
+
+def test_a_rerun_with_other_parameters_keeps_the_earlier_result(tmp_path):
+    deck = sample(tmp_path / "pd", "--particles", 2000)
+    assert sediment("run", deck, "--quiet").returncode == 0
+    first = digest(deck.parent / "layers.h5")
+    sample(tmp_path / "pd", "--particles", 2000, "--particle-density", 3500)
+    again = sediment("run", deck, "--quiet")
+    assert again.returncode == 2 and "particle_density 2650, this run has 3500" in again.stderr
+    assert digest(deck.parent / "layers.h5") == first and (deck.parent / "log.failed.lammps").is_file()
+    assert sediment("run", deck, "--quiet", "--force").returncode == 0
+    assert read_layers(deck.parent / "layers.h5").attributes["particle_density"] == 3500
+
+
+def test_a_run_starting_anew_over_a_result_is_refused(tmp_path):
+    deck = sample(tmp_path / "same", "--particles", 2000)
+    assert sediment("run", deck, "--quiet").returncode == 0
+    again = sediment("run", deck, "--quiet")
+    assert again.returncode == 2 and "starts anew at step 0" in again.stderr
+
+
+def test_frames_of_another_fluid_are_not_spliced(tmp_path):
+    deck = (REPO / "lammps-pkg" / "examples" / "in.settling").read_text().replace("run             1000", "run 200")
+    (tmp_path / "in.first").write_text(deck)
+    (tmp_path / "in.second").write_text(deck.replace("viscosity 1.002e-3", "viscosity 2e-3").replace(
+        "timestep        0.01", "reset_timestep 300\ntimestep 0.01"))
+    lmp = os.environ["SEDIMENT_LMP"]
+    assert subprocess.run([lmp, "-in", "in.first", "-log", "none"], cwd=tmp_path, capture_output=True).returncode == 0
+    before = digest(tmp_path / "layers.h5")
+    second = subprocess.run([lmp, "-in", "in.second", "-log", "none"], cwd=tmp_path, capture_output=True, text=True)
+    assert second.returncode != 0 and "fluid_viscosity 0.001002, this run has 0.002" in second.stdout
+    assert digest(tmp_path / "layers.h5") == before
+
+
+def test_a_killed_run_keeps_the_earlier_result_and_resumes_to_the_same_frames(tmp_path):
+    whole = sample(tmp_path / "whole", "--particles", 15000)
+    assert sediment("run", whole, "--quiet").returncode == 0
+    cut = sample(tmp_path / "cut", "--particles", 15000)
+    # An earlier complete result in the folder, which the killed rerun (--force) must not damage.
+    assert sediment("run", cut, "--quiet").returncode == 0
+    earlier = digest(cut.parent / "layers.h5")
+    for name in ("restart.a.bin", "restart.b.bin"):
+        (cut.parent / name).unlink()
+    run = subprocess.Popen(SEDIMENT + ["run", str(cut), "--quiet", "--force"], stdout=subprocess.DEVNULL,
+                           stderr=subprocess.DEVNULL)
+    wait_for(lambda: (cut.parent / "restart.b.bin").is_file())
+    run.send_signal(signal.SIGKILL)
+    run.wait()
+    wait_for(lambda: not processes_in(cut.parent), 10)    # LAMMPS died with its wrapper
+    assert digest(cut.parent / "layers.h5") == earlier
+    assert not read_layers(cut.parent / "layers.h5.partial").complete
+    resumed = sediment("run", "--resume", "--force", cut, "--quiet")
+    assert resumed.returncode == 0, resumed.stderr
+    a, b = read_layers(whole.parent / "layers.h5"), read_layers(cut.parent / "layers.h5")
+    assert b.complete and not (cut.parent / "layers.h5.partial").exists()
+    assert np.array_equal(a.step, b.step) and np.allclose(a.time, b.time, rtol=1e-12, atol=0)
+    assert np.max(np.abs(a.fraction - b.fraction)) < 1e-12
+
+
+def test_resume_needs_a_restart_file(tmp_path):
+    deck = sample(tmp_path / "fresh", "--particles", 2000)
+    done = sediment("run", "--resume", deck, "--quiet")
+    assert done.returncode == 2 and "nothing to resume" in done.stderr
+
+
+def test_two_runs_in_one_folder_and_signals(tmp_path):
+    deck = sample(tmp_path / "busy", "--particles", 15000)
+    first = subprocess.Popen(SEDIMENT + ["run", str(deck), "--quiet", "--np", "2"], stdout=subprocess.PIPE,
+                             stderr=subprocess.PIPE, text=True)
+    wait_for(lambda: len(processes_in(deck.parent)) >= 2)
+    second = sediment("run", deck, "--quiet")
+    assert second.returncode == 2 and "another sediment run is using" in second.stderr
+    first.send_signal(signal.SIGTERM)
+    _, err = first.communicate(timeout=60)
+    assert first.returncode == 130 and "stopped by SIGTERM" in err and "Traceback" not in err
+    wait_for(lambda: not processes_in(deck.parent), 15)    # mpirun and both ranks stopped
+    assert not (deck.parent / "layers.h5").exists() and (deck.parent / "log.failed.lammps").is_file()
+
+
+@pytest.mark.parametrize("args, message", [
+    (["run", "in.sedimentation", "--np", "1000"], "more ranks than the"),
+    (["sample", PSD, "--particle-density", "998.2"], "do not settle in water"),
+    (["sample", PSD, "--mass", "1e3"], "would fill"),
+    (["sample", PSD, "--height", "1e-6"], "not tall enough"),
+    (["sample", PSD, "--particles", "1e12"], "at most 1e+09"),
+    (["sample", REPO / "examples", "--out", "x"], "is a folder"),
+])
+def test_implausible_input_is_refused_with_the_reason(tmp_path, args, message):
+    (tmp_path / "in.sedimentation").write_text("units si\n")
+    done = sediment(*args, cwd=tmp_path)
+    assert done.returncode == 2 and message in done.stderr and "Traceback" not in done.stderr
+
+
+def test_unusable_outputs_and_decks_end_in_one_line(tmp_path):
+    (tmp_path / "file").write_text("")
+    done = sediment("sample", PSD, "--out", tmp_path / "file")
+    assert done.returncode == 2 and "exists and is not a folder" in done.stderr
+    binary = tmp_path / "in.binary"
+    binary.write_bytes(bytes(range(256)) * 4)
+    done = sediment("run", binary, "--quiet")
+    assert done.returncode == 2 and "ERROR" in done.stderr and "Traceback" not in done.stderr
+
+
+def test_readout_refuses_partial_and_implausible_readings(tmp_path):
+    deck = sample(tmp_path / "r", "--particles", 2000)
+    assert sediment("run", deck, "--quiet").returncode == 0
+    layers = deck.parent / "layers.h5"
+    cases = [(["--surface", "-1"], "leaves no layer below it"),
+             (["--cylinder-area", "1e-9"], "no wider than the hydrometer's bulb"),
+             (["--pipette-volume", "1"], "does not fit")]
+    for options, message in cases:
+        done = sediment("readout", layers, "--out", tmp_path / "out", *options)
+        assert done.returncode == 2 and message in done.stderr, (options, done.stderr)
+    partial = deck.parent / "copy.h5"
+    partial.write_bytes(layers.read_bytes())
+    import h5py
+    with h5py.File(partial, "r+") as f:
+        f.attrs["complete"] = 0.0
+    done = sediment("readout", partial, "--out", tmp_path / "out")
+    assert done.returncode == 2 and "is partial" in done.stderr
+    assert sediment("readout", partial, "--out", tmp_path / "out", "--allow-partial").returncode == 0
+    with h5py.File(partial, "r+") as f:
+        f["fraction"][3, 0, 0] = np.nan
+    done = sediment("readout", partial, "--out", tmp_path / "out", "--allow-partial")
+    assert done.returncode == 2 and "corrupt frame data" in done.stderr
