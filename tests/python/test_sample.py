@@ -54,15 +54,21 @@ def test_time_steps_double_after_the_largest_grains_have_left():
     v_max = terminal_speed(scene.suspension, scene.classes.diameter.max(), "dallavalle")
     layer = scene.height / scene.layers
     assert stages[0][0] == pytest.approx(layer / v_max)                 # one layer per step at first
-    for (dt, n), (dt_next, _) in zip(stages[1:-1], stages[2:]):
+    for (dt, n), (dt_next, _) in zip(stages[1:-2], stages[2:-1]):
         assert dt_next == pytest.approx(2 * dt)
+    assert stages[-1][0] <= 2 * stages[-2][0]                          # the last is cut to end on time
     times = np.cumsum([dt * n for dt, n in stages])
-    assert times[-1] >= 86400.0 and times[-2] < 86400.0
+    assert times[-1] == pytest.approx(86400.0, rel=1e-12) and times[-2] < 86400.0
     # after time t only grains slower than H / t remain: each stage's step keeps them within a layer
     starts = np.concatenate([[0.0], times[:-1]])
     for (dt, _), t in zip(stages, starts):
         assert dt * min(v_max, scene.height / t if t > 0 else v_max) <= layer * (1 + 1e-12)
     assert sum(n for _, n in stages) < 3000
+
+
+def test_a_short_test_ends_on_time():
+    scene = plan(read_psd(PSDS / "sample5.csv"), particles=2000, t_end=1e-6)
+    assert sum(dt * n for dt, n in scene.stages()) == pytest.approx(1e-6, rel=1e-12)
 
 
 def test_contacts_need_real_grains_and_set_the_step(tmp_path):
@@ -132,3 +138,11 @@ def test_end_to_end_sample5_hydrometer_follows_the_simulated_psd(tmp_path, capsy
     assert "mean_abs_error_points" in printed and "simulated hydrometer" in " ".join(printed.split())
     for name in ("granulometry.png", "granulometry.pdf", "errors.csv", "buoyancy.csv", "pipette.csv"):
         assert (out / "readout" / name).stat().st_size > 0
+
+
+def test_a_table_not_spanning_0_to_100_percent_is_said_to_be_renormalised(tmp_path):
+    table = tmp_path / "psd.csv"
+    table.write_text("diameter_um,percent_finer\n5,10\n20,50\n60,90\n")
+    from sediment.sim.scene import describe
+    text = describe(plan(read_psd(table), particles=2000))
+    assert "runs from 10 to 90 % finer; the 20 % of the mass outside its diameters is not simulated" in text

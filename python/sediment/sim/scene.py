@@ -109,7 +109,8 @@ class Scene:
         """(time step, steps) per stage up to t_end. Until the largest grains can have left the
         column (H / v_max) the step is courant layers / v_max; after a time t only grains slower
         than H / t can remain, so each following stage, as long as the time before it, takes a step
-        twice the last. Stages are whole numbers of frames."""
+        twice the last. Stages are whole numbers of frames; the last one's step is shortened so that
+        the run ends at t_end, not up to a stage of frames beyond it."""
         if self.effects.interacting:                  # contacts set the step everywhere
             dt = self.contact_time_step()
             return [(dt, math.ceil(self.t_end / dt))]
@@ -119,6 +120,8 @@ class Scene:
         time, dt, result = 0.0, self.height / v_max / steps, []
         while time < self.t_end * (1 - 1e-12):
             n = min(steps, every * math.ceil((self.t_end - time) / (dt * every)))
+            if time + n * dt > self.t_end:
+                dt = (self.t_end - time) / n
             result.append((dt, n))
             time += n * dt
             if time >= self.height / v_max * (1 - 1e-12):
@@ -469,6 +472,10 @@ def describe(scene: Scene) -> str:
              f"simulated PSD vs input at the class edges: max difference {worst:.2f} percentage points",
              f"time: {len(stages)} stages, {sum(n for _, n in stages)} steps to {scene.t_end:g} s "
              f"(dt {stages[0][0]:.3g} .. {stages[-1][0]:.3g} s)"]
+    first, last = scene.psd.percent_finer[0], scene.psd.percent_finer[-1]
+    if first > 0 or last < 100:
+        lines.append(f"note: the PSD table runs from {first:g} to {last:g} % finer; the {first + 100 - last:g} % of the "
+                     "mass outside its diameters is not simulated, and the simulated PSD is renormalised to 100 %")
     if scene.effects.interacting:
         lines.append(f"contacts: dt = {stages[0][0]:.3g} s (Rayleigh time / 5 of the smallest grain): "
                      f"{stages[0][1]:.3g} steps x {len(scene.diameter)} particles")
