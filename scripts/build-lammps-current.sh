@@ -12,33 +12,12 @@ dest=$(realpath -m "${1:?usage: build-lammps-current.sh DEST}")
 repo=$(cd "$(dirname "$0")/.." && pwd)
 mkdir -p "$dest"
 
-# The source package's orig tarball, through a deb-src entry for sid kept in DEST (the machine's apt
-# configuration is not changed). apt checks it against the signed index.
-lists="$dest/apt-lists"
-sources="$dest/sid-src.sources"
-apt_opts=(-o Dir::Etc::sourcelist="$sources" -o Dir::Etc::sourceparts=- -o Dir::State::Lists="$lists"
-          -o APT::Get::List-Cleanup=0)
-if ! ls "$dest"/lammps_*.orig.tar.* >/dev/null 2>&1; then
-    cat > "$sources" <<SRC
-Types: deb-src
-URIs: http://deb.debian.org/debian
-Suites: sid
-Components: main
-Signed-By: /usr/share/keyrings/debian-archive-keyring.gpg
-SRC
-    mkdir -p "$lists/partial"
-    apt-get update "${apt_opts[@]}" >/dev/null
-    version=$(apt-cache showsrc "${apt_opts[@]}" lammps | awk '/^Version:/ {print $2; exit}')
-    echo "fetching the LAMMPS $version source package (Debian sid)"
-    # The orig tarball is all we need; the .dsc or Debian diff may be missing on a mirror.
-    (cd "$dest" && apt-get source --download-only "${apt_opts[@]}" "lammps=$version" >/dev/null 2>&1 || true)
-    ls "$dest"/lammps_*.orig.tar.* >/dev/null 2>&1 || { echo "could not fetch the lammps source package" >&2; exit 1; }
-fi
+orig=$("$repo/scripts/fetch-lammps-source.sh" sid latest "$dest")
 
 tree="$dest/lammps"
 if [ ! -f "$tree/.complete" ]; then
     rm -rf "$tree" && mkdir -p "$tree"
-    tar -xf "$dest"/lammps_*.orig.tar.* -C "$tree" cmake src doc/src doc/utils examples/plugins
+    tar -xf "$orig" -C "$tree" cmake src doc/src doc/utils examples/plugins
     touch "$tree/.complete"
 fi
 "$repo/lammps-pkg/install-in-tree.sh" "$tree" >/dev/null
@@ -50,4 +29,4 @@ if [ ! -f "$build/CMakeCache.txt" ]; then
         -D WITH_FFMPEG=off -D WITH_CURL=off -D PKG_GRANULAR=on -D PKG_PLUGIN=on -D PKG_SEDIMENT=on >/dev/null
 fi
 cmake --build "$build" -j "${JOBS:-2}" >/dev/null
-echo "LAMMPS $(basename "$dest"/lammps_*.orig.tar.* | sed 's/lammps_\(.*\)\.orig.*/\1/') with SEDIMENT: $build/lmp"
+echo "LAMMPS $(basename "$orig" | sed 's/lammps_\(.*\)\.orig.*/\1/') with SEDIMENT: $build/lmp"

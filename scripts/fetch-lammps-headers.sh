@@ -9,22 +9,8 @@ dest=${1:?usage: fetch-lammps-headers.sh DEST}
 mkdir -p "$dest"
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
-
-sources=/etc/apt/sources.list.d/sediment-deb-src.sources
-if ! apt-get source --print-uris lammps >/dev/null 2>&1; then
-    cat > "$sources" <<SRC
-Types: deb-src
-URIs: http://deb.debian.org/debian
-Suites: bookworm
-Components: main
-Signed-By: /usr/share/keyrings/debian-archive-keyring.gpg
-SRC
-    apt-get update -o Dir::Etc::sourcelist="$sources" -o Dir::Etc::sourceparts="-" \
-        -o APT::Get::List-Cleanup="0" >/dev/null
-fi
 version=$(dpkg-query -W -f='${source:Version}' liblammps-dev)
-(cd "$work" && apt-get source --download-only "lammps=$version" >/dev/null)
-orig=$(ls "$work"/lammps_*.orig.tar.*)
+orig=$("$(dirname "$0")/fetch-lammps-source.sh" bookworm "$version" "$dest/../lammps-source-bookworm")
 tar -xf "$orig" -C "$work" --wildcards '*/src/*.h' '*/src/fmt/*' '*/src/GRANULAR/*' '*/src/PLUGIN/*'
 top=$(ls -d "$work"/*/src)
 cp -r "$top"/. "$dest"/
