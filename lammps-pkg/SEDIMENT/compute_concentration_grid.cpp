@@ -27,7 +27,7 @@ int ncols_for(size_t nedges, int ntypes)
   return 1 + (nedges == 0 ? 0 : static_cast<int>(nedges) + 1) + ntypes;
 }
 // The largest grid (cells x columns) a rank allocates: 2e8 values, 4.8 GB in its three copies.
-constexpr double max_grid_values = 2e8;
+constexpr bigint max_grid_values = 200000000;
 }    // namespace
 
 ComputeConcentrationGrid::ComputeConcentrationGrid(LAMMPS *lmp, int narg, char **arg) :
@@ -46,17 +46,15 @@ ComputeConcentrationGrid::ComputeConcentrationGrid(LAMMPS *lmp, int narg, char *
         args.need(2, "an axis and a count");
         axis = args.axis(1, "layer axis");
         counts[0] = counts[1] = counts[2] = 1;
-        counts[axis] = args.whole(2);
+        counts[axis] = args.count(2, max_grid_values);
         nvalues = 2;
       } else {
         if (!args.has(dimension))
           args.fail("'cells' needs {} counts in a {}d simulation", dimension, dimension);
         counts[2] = 1;
-        for (int d = 0; d < dimension; ++d) counts[d] = args.whole(1 + d);
+        for (int d = 0; d < dimension; ++d) counts[d] = args.count(1 + d, max_grid_values);
         nvalues = dimension;
       }
-      for (int d = 0; d < 3; ++d)
-        if (counts[d] < 1) args.fail("numbers of layers or cells must be >= 1");
     } else if (args.is("bounds")) {
       // LO HI along the layer axis, or xlo xhi ylo yhi [zlo zhi] for cells; checked after the grid.
       nbounds = std::min(args.numbers_after(), 2 * dimension);
@@ -117,10 +115,10 @@ ComputeConcentrationGrid::ComputeConcentrationGrid(LAMMPS *lmp, int narg, char *
   // Every rank holds the whole grid three times (local sums, their reduction, the output array):
   // refuse sizes that cannot be held instead of failing in the allocator or overflowing the index.
   const double values = static_cast<double>(counts[0]) * counts[1] * counts[2] * ncols;
-  if (values > max_grid_values)
+  if (values > static_cast<double>(max_grid_values))
     error->all(FLERR, "Compute concentration/grid: {}x{}x{} cells x {} columns is more than {:.0e} values "
                "(about {:.0f} GB per rank); use fewer layers, cells or classes", counts[0], counts[1], counts[2],
-               ncols, max_grid_values, 3.0 * values * sizeof(double) / 1e9);
+               ncols, static_cast<double>(max_grid_values), 3.0 * values * sizeof(double) / 1e9);
   const int ncells = counts[0] * counts[1] * counts[2];
   array_flag = 1;
   size_array_rows = ncells;

@@ -132,6 +132,7 @@ void create_frames(hid_t where, const char *name, hid_t type, int rank, const hs
   Handle space(H5Screate_simple(rank, dims, maxdims), H5Sclose, "dataspace");
   Handle props(H5Pcreate(H5P_DATASET_CREATE), H5Pclose, "properties");
   check(H5Pset_chunk(props, rank, chunk), "chunking");
+  check(H5Pset_fletcher32(props), "checksums");    // a damaged frame is refused on reading, not read as data
   Handle set(H5Dcreate2(where, name, type, space, H5P_DEFAULT, props, H5P_DEFAULT), H5Dclose,
              std::string("dataset ") + name);
 }

@@ -81,6 +81,13 @@ class StyleArgs {
     return value;
   }
   int whole(int k) const { return utils::inumeric(file, line, arg[iarg + k], false, lmp); }
+  // A whole number from 1 to `most`, read as a 64-bit integer so that a too large one is named, not wrapped.
+  int count(int k, bigint most) const
+  {
+    const bigint value = utils::bnumeric(file, line, arg[iarg + k], false, lmp);
+    if (value < 1 || value > most) fail("{} count {} must be from 1 to {}", arg[iarg], arg[iarg + k], most);
+    return static_cast<int>(value);
+  }
   bool yes_no(int k) const
   {
     const char *word = arg[iarg + k];

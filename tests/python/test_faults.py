@@ -199,3 +199,52 @@ def test_readout_refuses_partial_and_implausible_readings(tmp_path):
         f["fraction"][3, 0, 0] = np.nan
     done = sediment("readout", partial, "--out", tmp_path / "out", "--allow-partial")
     assert done.returncode == 2 and "corrupt frame data" in done.stderr
+
+
+def test_damaged_files_and_interrupts_end_in_one_line(tmp_path):
+    deck = sample(tmp_path / "d", "--particles", 2000)
+    assert sediment("run", deck, "--quiet").returncode == 0
+    layers = deck.parent / "layers.h5"
+    import h5py
+
+    def damaged(name: str, change) -> Path:
+        copy = tmp_path / f"{name}.h5"
+        copy.write_bytes(layers.read_bytes())
+        with h5py.File(copy, "r+") as f:
+            change(f)
+        return copy
+
+    def overwrite_frame_bytes(f):    # random bytes in a stored frame, behind HDF5's back
+        offset = f["fraction"].id.get_chunk_info(2).byte_offset
+        f.close()
+        with open(tmp_path / "bytes.h5", "r+b") as raw:
+            raw.seek(offset)
+            raw.write(np.random.default_rng(1).bytes(64))
+
+    cases = [(damaged("viscosity", lambda f: f.attrs.__setitem__("fluid_viscosity", np.nan)), "not a physical value"),
+             (damaged("empty", lambda f: [f[n].resize(0, axis=0) for n in ("time", "step", "fraction")]),
+              "no frames"),
+             (damaged("bytes", overwrite_frame_bytes), "truncated or corrupt")]
+    for path, message in cases:
+        done = sediment("readout", path, "--out", tmp_path / "out")
+        assert done.returncode == 2 and message in done.stderr and "Traceback" not in done.stderr, done.stderr
+    locked = tmp_path / "locked"
+    locked.mkdir()
+    locked.chmod(0o500)
+    try:
+        if os.access(locked, os.W_OK):    # root writes anywhere: a file where the folder should be instead
+            locked.chmod(0o700)
+            (locked / "out").write_text("")
+            target = locked / "out" / "readout"
+        else:
+            target = locked / "readout"
+        done = sediment("readout", layers, "--out", target)
+        assert done.returncode == 2 and "Traceback" not in done.stderr and done.stderr.count("\n") == 1
+    finally:
+        locked.chmod(0o700)
+    running = subprocess.Popen(SEDIMENT + ["run", str(deck), "--quiet", "--force"], stdout=subprocess.PIPE,
+                               stderr=subprocess.PIPE, text=True)
+    wait_for(lambda: len(processes_in(deck.parent)) >= 1)
+    running.send_signal(signal.SIGINT)
+    _, err = running.communicate(timeout=60)
+    assert running.returncode == 130 and "stopped by SIGINT" in err and "Traceback" not in err
