@@ -41,10 +41,7 @@ class StyleArgs {
   {
   }
 
-  const std::string &name() const { return style; }
   bool more() const { return iarg < narg; }
-  int position() const { return iarg; }
-  const char *keyword() const { return arg[iarg]; }
   bool is(const char *name) const { return strcmp(arg[iarg], name) == 0; }
   // Whether the keyword has at least n values after it.
   bool has(int n) const { return iarg + n < narg; }
@@ -80,7 +77,6 @@ class StyleArgs {
     if (!(value > 0.0) || !std::isfinite(value)) fail("{} must be finite and > 0{}", what, hint);
     return value;
   }
-  int whole(int k) const { return utils::inumeric(file, line, arg[iarg + k], false, lmp); }
   // A whole number from 1 to `most`, read as a 64-bit integer so that a too large one is named, not wrapped.
   int count(int k, bigint most) const
   {
