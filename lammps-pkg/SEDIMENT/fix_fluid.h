@@ -37,6 +37,8 @@ class FixFluid : public Fix {
   const sediment::Fluid &properties() const { return fluid; }
   bool is_bingham() const { return fluid.yield_stress > 0.0; }
   const double *velocity() const { return flow; }
+  // Whether every sphere is wholly immersed (no free surface, no region).
+  bool fills_space() const { return !has_surface && !region_id; }
 
   // Finds fix ID `fluid_id` and checks that it is a fix fluid; `caller` names the style asking
   // ("Fix fluid/drag", "Pair lubricate/fluid").

@@ -148,6 +148,12 @@ double FixFluidDrag::rotation_rate(int i, const sediment::SphereDrag &drag) cons
                                       drag.scale.wetted);
 }
 
+const sediment::DragModel *FixFluidDrag::uniform_linear_model() const
+{
+  const bool linear = model->linear_coefficient(1.0) > 0.0;
+  return linear && fluid->fills_space() && !concentration && !rotation ? model.get() : nullptr;
+}
+
 template <class Visit> void FixFluidDrag::for_each_explicit(Visit visit)
 {
   double **v = atom->v;
@@ -173,9 +179,10 @@ void FixFluidDrag::post_force(int /*vflag*/)
       return;
     }
     if (fraction_capped(i)) totals[CAPPED] += 1.0;
-    if (speed > 0.0) {
+    const double linear = model->linear_coefficient(drag.diameter, drag.scale);
+    if (linear > 0.0 || speed > 0.0) {
       // Explicit: the yield part acts only while moving, so a yield-stress fluid chatters here.
-      const double coeff = model->force(drag.diameter, speed, drag.scale) / speed;
+      const double coeff = linear > 0.0 ? linear : model->force(drag.diameter, speed, drag.scale) / speed;
       for (int k = 0; k < 3; ++k) {
         f[i][k] -= coeff * slip[k];
         totals[k] -= coeff * slip[k];

@@ -42,6 +42,10 @@ class FixFluidDrag : public Fix {
   bool fraction_capped(int i) const;
   // Linear rate of the rotational drag torque, torque = -rate * I * omega (0 if off).
   double rotation_rate(int i, const sediment::SphereDrag &drag) const;
+  // The model when the drag on every atom of the group is linear in the slip and needs nothing of
+  // the atom but its diameter (Stokes drag, the sphere wholly immersed, no hindrance or rotational
+  // drag), so that an integrator may take the closed-form step without per-atom look-ups; else nullptr.
+  const sediment::DragModel *uniform_linear_model() const;
 
  private:
   char *fluid_id;

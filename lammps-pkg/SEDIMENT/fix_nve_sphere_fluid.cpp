@@ -66,7 +66,7 @@ static inline void nve_sphere_kick_drift(double *x, double *v, double *omega, co
 }
 
 FixNVESphereFluid::FixNVESphereFluid(LAMMPS *lmp, int narg, char **arg) :
-    Fix(lmp, narg, arg), weights(nullptr), nmax_weights(0), floor_axis(-1), floor_level(0.0)
+    Fix(lmp, narg, arg), weights(nullptr), nmax_weights(0), uniform_linear(nullptr), floor_axis(-1), floor_level(0.0)
 {
   StyleArgs args(lmp, FLERR, "Fix nve/sphere/fluid", narg, arg, 3);
   while (args.more()) {
@@ -111,12 +111,19 @@ void FixNVESphereFluid::init()
 {
   drags.clear();
   for (Fix *drag : sediment_fixes_of_style(lmp, "fluid/drag")) drags.push_back(static_cast<FixFluidDrag *>(drag));
+  uniform_linear = nullptr;    // decided in setup(), once every fix is initialised
 
   double *radius = atom->radius;
   int *mask = atom->mask;
   for (int i = 0; i < atom->nlocal; ++i)
     if ((mask[i] & groupbit) && radius[i] == 0.0)
       error->one(FLERR, "Fix nve/sphere/fluid requires extended particles (radius > 0)");
+}
+
+void FixNVESphereFluid::setup(int /*vflag*/)
+{
+  // After every fix's init(): the drag fixes know their fluid and law only then.
+  uniform_linear = drags.size() == 1 ? drags.front()->uniform_linear_model() : nullptr;
 }
 
 void FixNVESphereFluid::initial_integrate(int /*vflag*/)
@@ -141,6 +148,37 @@ void FixNVESphereFluid::initial_integrate(int /*vflag*/)
         ++outside;
       }
     counts[OUTSIDE] = outside;
+    if (!finite) find_non_finite();
+    return;
+  }
+
+  // One fluid/drag whose drag is linear and the same for every atom but for its diameter: the
+  // closed-form step of drag_step_initial, operation for operation, without per-atom look-ups.
+  if (const sediment::DragModel *linear = uniform_linear) {
+    const double *flow = drags.front()->fluid_fix()->velocity();
+    const double spin_weight = dt * 0.5;    // rotation_step_initial without rotational drag
+    bool finite = true;
+    for (int i = 0; i < nlocal; ++i) {
+      if (!(mask[i] & groupbit)) continue;
+      const double mass = rmass[i];
+      double *w = weights[i];
+      const double z = linear->linear_coefficient(2.0 * radius[i]) / mass * dt;
+      const sediment::Phi p = sediment::phis(z, &w[DRAG_MEMO]);
+      double *v_i = v[i];
+      for (int k = 0; k < 3; ++k) {
+        const double a = ftm2v * f[i][k] / mass;
+        const double slip = v_i[k] - flow[k];
+        v_i[k] = flow[k] + slip * p.decay + dt * (p.phi1 - p.phi2) * a;
+        x[i][k] += dt * (flow[k] + p.phi1 * slip + dt * p.phi2 * a);
+      }
+      const double inertia = sediment::sphere_inertia(mass, radius[i]);
+      for (int k = 0; k < 3; ++k) omega[i][k] = omega[i][k] * 1.0 + spin_weight * (ftm2v * torque[i][k] / inertia);
+      w[IN_FLUID] = 1.0;
+      w[ALONG] = w[ACROSS] = dt * p.phi2;
+      w[SPIN] = spin_weight;
+      settle_on_floor(i);
+      finite &= std::isfinite(state_sum(x[i], v[i]));
+    }
     if (!finite) find_non_finite();
     return;
   }
@@ -211,6 +249,19 @@ void FixNVESphereFluid::final_integrate()
         nve_sphere_kick(v[i], omega[i], f[i], torque[i], radius[i], rmass[i], dtf);
         settle_on_floor(i);
       }
+    return;
+  }
+
+  if (uniform_linear) {    // drag_step_final and the spin update of the general loop, isotropic
+    for (int i = 0; i < nlocal; ++i) {
+      if (!(mask[i] & groupbit)) continue;
+      const double *w = weights[i];
+      const double mass = rmass[i];
+      for (int k = 0; k < 3; ++k) v[i][k] += w[ALONG] * (ftm2v * f[i][k] / mass);
+      const double spin = w[SPIN] * ftm2v / sediment::sphere_inertia(mass, radius[i]);
+      for (int k = 0; k < 3; ++k) omega[i][k] += spin * torque[i][k];
+      settle_on_floor(i);
+    }
     return;
   }
 

@@ -16,6 +16,8 @@ FixStyle(nve/sphere/fluid,FixNVESphereFluid);
 #include "fix.h"
 #include "sediment_rank_sums.h"
 
+#include "sediment/drag.hpp"
+
 #include <vector>
 
 namespace LAMMPS_NS {
@@ -26,6 +28,7 @@ class FixNVESphereFluid : public Fix {
   ~FixNVESphereFluid() override;
   int setmask() override;
   void init() override;
+  void setup(int) override;
   void initial_integrate(int) override;
   void final_integrate() override;
   double compute_vector(int) override;
@@ -45,6 +48,9 @@ class FixNVESphereFluid : public Fix {
   double **weights;
   int nmax_weights;    // rows of weights with initialised memos
   std::vector<class FixFluidDrag *> drags;
+  // Set in setup() when one fluid/drag applies the same linear drag to every atom but for its
+  // diameter: both halves of the step then take its closed form without per-atom look-ups.
+  const sediment::DragModel *uniform_linear;
 
   int floor_axis;         // -1: no floor
   double floor_level;     // spheres stop with their lowest point here
