@@ -100,8 +100,10 @@ Exponent di_felice_exponent(double re)
 }
 
 DragModel::DragModel(DragLaw law, const Fluid &fluid, HindranceBuoyancy buoyancy) :
-    law_(law), hindrance_offset_(buoyancy == HindranceBuoyancy::Plain ? 1.0 : 0.0), fluid_(fluid)
+    law_(law), hindrance_offset_(buoyancy == HindranceBuoyancy::Plain ? 1.0 : 0.0), fluid_(fluid), smooth_(false)
 {
+  std::array<ForceJump, max_jumps> unused;
+  smooth_ = fluid_.yield_stress <= 0.0 && jumps(1.0, unused) == 0;
 }
 
 DragCurve DragModel::curve(double re, double voidage) const
@@ -151,14 +153,12 @@ double DragModel::static_force(double d, DragScale scale) const
   return force_at(d, 0.0, curve(0.0, scale.voidage).g, scale);
 }
 
-double DragModel::tangent(double d, double speed, DragScale scale) const
+double DragModel::slope_at(double d, double speed, DragCurve g, DragScale scale) const
 {
-  const double re = reynolds(d, speed);
-  const DragCurve g = curve(re, scale.voidage);
-  const double visc = viscous_scale(d, speed);
   double dforce = fluid_.viscosity / d * g.g;
   if (speed > 0.0) {
     // dRe'/ds = rho s (2 tau_y + eta s / d) / (tau_y + eta s / d)^2
+    const double visc = viscous_scale(d, speed);
     const double dre =
         fluid_.density * speed * (2.0 * fluid_.yield_stress + fluid_.viscosity * speed / d) /
         (visc * visc);
@@ -167,10 +167,17 @@ double DragModel::tangent(double d, double speed, DragScale scale) const
   return scale.area * 0.5 * sphere_area(d) * dforce;
 }
 
-double DragModel::linear_coefficient(double d, DragScale scale) const
+double DragModel::tangent(double d, double speed, DragScale scale) const
 {
-  if (law_ != DragLaw::Stokes || fluid_.yield_stress > 0.0) return 0.0;
-  return scale.area * 3.0 * pi * fluid_.viscosity * d;
+  const double re = reynolds(d, speed);
+  return slope_at(d, speed, curve(re, scale.voidage), scale);
+}
+
+DragModel::ForceSlope DragModel::force_and_tangent(double d, double speed, DragScale scale) const
+{
+  const double re = reynolds(d, speed);
+  const DragCurve g = curve(re, scale.voidage);
+  return {force_at(d, speed, g.g, scale), slope_at(d, speed, g, scale)};
 }
 
 int DragModel::jumps(double d, std::array<ForceJump, max_jumps> &out, DragScale scale) const

@@ -44,18 +44,6 @@ Phi phis(double z)
   return {decay, (1.0 - decay) / z, (z - 1.0 + decay) / (z * z)};
 }
 
-Phi phis(double z, double memo[PHI_MEMO_SIZE])
-{
-  if (z != memo[0]) {
-    const Phi p = phis(z);
-    memo[0] = z;
-    memo[1] = p.decay;
-    memo[2] = p.phi1;
-    memo[3] = p.phi2;
-  }
-  return {memo[1], memo[2], memo[3]};
-}
-
 double phi1(double z) { return phis(z).phi1; }
 
 double phi2(double z) { return phis(z).phi2; }
@@ -68,11 +56,12 @@ struct Segment {
   double distance;
 };
 
-Segment advance(double s0, double c, double k, double t)
+Segment advance(const Phi &p, double s0, double c, double t)
 {
-  const Phi p = phis(k * t);
   return {s0 * p.decay + c * t * p.phi1, s0 * t * p.phi1 + c * t * t * p.phi2};
 }
+
+Segment advance(double s0, double c, double k, double t) { return advance(phis(k * t), s0, c, t); }
 
 // Time for ds/dt = c - k s to go from s0 to `target`, which lies between s0 and the asymptote.
 double time_to_reach(double s0, double c, double k, double target)
@@ -154,38 +143,13 @@ double dot(const double a[3], const double b[3]) { return a[0] * b[0] + a[1] * b
 
 }    // namespace
 
-StepCorrection drag_step_initial(const SphereDrag &drag, double mass, const double a[3],
-                                 const double u[3], double dt, double v[3], double dx[3], double *memo)
+StepCorrection nonlinear_step_initial(const SphereDrag &drag, double mass, const double a[3],
+                                      const double u[3], double dt, double v[3], double dx[3])
 {
   StepCorrection corr;
-  const bool no_drag = drag.model == nullptr || (drag.scale.area <= 0.0 && drag.scale.wetted <= 0.0);
-  if (no_drag) {
-    for (int k = 0; k < 3; ++k) {
-      v[k] += 0.5 * dt * a[k];
-      dx[k] = dt * v[k];
-    }
-    corr.along = corr.across = 0.5 * dt;
-    return corr;
-  }
-
-  double w[3] = {v[0] - u[0], v[1] - u[1], v[2] - u[2]};
-
-  // Drag linear in the slip: the same step with equal rates along and across the slip and no
-  // set-valued points, in closed form.
-  const double linear = drag.model->linear_coefficient(drag.diameter, drag.scale);
-  if (linear > 0.0) {
-    const double z = linear / mass * dt;
-    const Phi p = memo ? phis(z, memo) : phis(z);
-    for (int k = 0; k < 3; ++k) {
-      v[k] = u[k] + w[k] * p.decay + dt * (p.phi1 - p.phi2) * a[k];
-      dx[k] = dt * (u[k] + p.phi1 * w[k] + dt * p.phi2 * a[k]);
-    }
-    corr.along = corr.across = dt * p.phi2;
-    return corr;
-  }
-
+  const double w[3] = {v[0] - u[0], v[1] - u[1], v[2] - u[2]};
   const double s = std::sqrt(dot(w, w));
-  const double a_norm = std::sqrt(dot(a, a));
+  const double a_norm = s > 0.0 ? 0.0 : std::sqrt(dot(a, a));    // needed only at rest
   double *dir = corr.dir;
   if (s > 0.0) {
     for (int k = 0; k < 3; ++k) dir[k] = w[k] / s;
@@ -195,27 +159,40 @@ StepCorrection drag_step_initial(const SphereDrag &drag, double mass, const doub
   const double a_par = dot(a, dir);
   const double a_perp[3] = {a[0] - a_par * dir[0], a[1] - a_par * dir[1], a[2] - a_par * dir[2]};
 
-  const double static_force = drag.model->static_force(drag.diameter, drag.scale);
-  const bool stays_at_rest = s == 0.0 && static_force > 0.0 && mass * a_norm <= static_force;
-  const AlongSlip along = stays_at_rest ? AlongSlip{0.0, 0.0, 0.0, SlipState::Stuck}
-                                        : advance_along(drag, mass, s, a_par, dt, static_force);
-  corr.state = along.state;
-  if (along.state == SlipState::Stuck) {
-    for (int k = 0; k < 3; ++k) {
-      v[k] = u[k];
-      dx[k] = u[k] * dt + along.distance * dir[k];
+  double rate_across;
+  AlongSlip along;
+  if (drag.model->smooth()) {
+    // No set-valued point to stop at: one evaluation of the law gives the Newton step along the
+    // slip (the piecewise advance below, in one piece) and the secant rate across it.
+    const DragModel::ForceSlope fs = drag.model->force_and_tangent(drag.diameter, s, drag.scale);
+    const double rate = fs.slope / mass;
+    const Phi p = phis(rate * dt);
+    const Segment full = advance(p, s, a_par - (fs.force - fs.slope * s) / mass, dt);
+    along = {full.speed, full.distance, rate, SlipState::Free};
+    rate_across = s > 0.0 ? fs.force / (s * mass) : rate;
+    corr.along = dt * p.phi2;
+  } else {
+    const double static_force = drag.model->static_force(drag.diameter, drag.scale);
+    const bool stays_at_rest = s == 0.0 && static_force > 0.0 && mass * a_norm <= static_force;
+    along = stays_at_rest ? AlongSlip{0.0, 0.0, 0.0, SlipState::Stuck}
+                          : advance_along(drag, mass, s, a_par, dt, static_force);
+    corr.state = along.state;
+    if (along.state == SlipState::Stuck) {
+      for (int k = 0; k < 3; ++k) {
+        v[k] = u[k];
+        dx[k] = u[k] * dt + along.distance * dir[k];
+      }
+      corr.along = corr.across = 0.0;
+      return corr;
     }
-    corr.along = corr.across = 0.0;
-    return corr;
+    // Across the slip the force turns with the slip: secant rate F(s) / s.
+    rate_across = s > 0.0 ? drag.model->force(drag.diameter, s, drag.scale) / (s * mass)
+                          : drag.model->tangent(drag.diameter, 0.0, drag.scale) / mass;
+    corr.along = along.state == SlipState::Free ? dt * phi2(along.rate * dt) : 0.0;
   }
-
-  // Across the slip the force turns with the slip: secant rate F(s) / s.
-  const double rate_across = s > 0.0 ? drag.model->force(drag.diameter, s, drag.scale) / (s * mass)
-                                     : drag.model->tangent(drag.diameter, 0.0, drag.scale) / mass;
   const Phi across = phis(rate_across * dt);
   const double p1 = across.phi1;
   const double p2 = across.phi2;
-  corr.along = along.state == SlipState::Free ? dt * phi2(along.rate * dt) : 0.0;
   corr.across = dt * p2;
   for (int k = 0; k < 3; ++k) {
     v[k] = u[k] + along.speed * dir[k] + a_perp[k] * dt * p1;
@@ -224,25 +201,6 @@ StepCorrection drag_step_initial(const SphereDrag &drag, double mass, const doub
     v[k] -= corr.along * a_par * dir[k] + corr.across * a_perp[k];
   }
   return corr;
-}
-
-void drag_step_final(const StepCorrection &corr, const double a[3], double v[3])
-{
-  if (corr.along == corr.across) {    // isotropic: linear drag, no drag, or held
-    for (int k = 0; k < 3; ++k) v[k] += corr.along * a[k];
-    return;
-  }
-  const double a_par = dot(a, corr.dir);
-  for (int k = 0; k < 3; ++k)
-    v[k] += corr.along * a_par * corr.dir[k] + corr.across * (a[k] - a_par * corr.dir[k]);
-}
-
-double rotation_step_initial(double rate, const double alpha[3], double dt, double omega[3], double *memo)
-{
-  const Phi p = memo ? phis(rate * dt, memo) : phis(rate * dt);
-  const double weight_now = dt * (p.phi1 - p.phi2);
-  for (int k = 0; k < 3; ++k) omega[k] = omega[k] * p.decay + weight_now * alpha[k];
-  return dt * p.phi2;
 }
 
 }    // namespace sediment

@@ -119,7 +119,7 @@ void FixFluid::prepare()
   if (region) region->prematch();
 }
 
-sediment::Submergence FixFluid::immersion(const double *x, double radius) const
+sediment::Submergence FixFluid::bounded_immersion(const double *x, double radius) const
 {
   if (region && !region->match(x[0], x[1], x[2])) return {0.0, 0.0, 0.0};
   if (!has_surface) return {1.0, 1.0, 1.0};

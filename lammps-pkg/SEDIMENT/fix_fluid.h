@@ -31,8 +31,11 @@ class FixFluid : public Fix {
 
   // Call once per step before immersion(): refreshes a moving region.
   void prepare();
-  // How much of sphere (centre x, radius r) is in the fluid.
-  sediment::Submergence immersion(const double *x, double radius) const;
+  // How much of sphere (centre x, radius r) is in the fluid (inline: called per atom and step).
+  sediment::Submergence immersion(const double *x, double radius) const
+  {
+    return fills_space() ? sediment::Submergence{1.0, 1.0, 1.0} : bounded_immersion(x, radius);
+  }
 
   const sediment::Fluid &properties() const { return fluid; }
   bool is_bingham() const { return fluid.yield_stress > 0.0; }
@@ -52,6 +55,7 @@ class FixFluid : public Fix {
   double surface_offset;       // surface is {x : x . normal = offset}
   char *region_id;
   class Region *region;
+  sediment::Submergence bounded_immersion(const double *x, double radius) const;
 };
 
 }    // namespace LAMMPS_NS

@@ -104,21 +104,28 @@ void FixFluidBuoyancy::post_force(int /*vflag*/)
 
   fluid->prepare();
   if (mixture && mixture->invoked_peratom != update->ntimestep) mixture->compute_peratom();
-  totals.clear();
+  const double g[3] = {gravity[0], gravity[1], gravity[2]};
+  const double *fraction = mixture ? mixture->vector_atom : nullptr;
+  // Local sums: a store into the fix inside the loop would alias the force array.
+  double sum[3] = {0.0, 0.0, 0.0};
+  int immersed = 0;
   for (int i = 0; i < nlocal; ++i) {
     if (!(mask[i] & groupbit)) continue;
     const sediment::Submergence sub = fluid->immersion(x[i], radius[i]);
     if (!sub.any()) continue;
     // The suspension around the sphere, or the clear fluid.
-    const double density = mixture ? sediment::mixture_density(rho, solid_density, mixture->vector_atom[i]) : rho;
+    const double density = fraction ? sediment::mixture_density(rho, solid_density, fraction[i]) : rho;
     const double displaced = sediment::displaced_mass(density, radius[i], sub);
     for (int k = 0; k < 3; ++k) {
-      const double fb = -displaced * gravity[k];
+      const double fb = -displaced * g[k];
       f[i][k] += fb;
-      totals[k] += fb;
+      sum[k] += fb;
     }
-    totals[3] += 1.0;
+    ++immersed;
   }
+  totals.clear();
+  for (int k = 0; k < 3; ++k) totals[k] = sum[k];
+  totals[3] = immersed;
 }
 
 double FixFluidBuoyancy::compute_vector(int n)

@@ -27,7 +27,7 @@ using namespace FixConst;
 FixFluidDrag::FixFluidDrag(LAMMPS *lmp, int narg, char **arg) :
     Fix(lmp, narg, arg), fluid_id(nullptr), fluid(nullptr), law(sediment::DragLaw::Stokes),
     hindrance_buoyancy(sediment::HindranceBuoyancy::Plain), concentration_id(nullptr),
-    concentration(nullptr), max_fraction(0.64), rotation(0), implicit_groupbit(0)
+    concentration(nullptr), max_fraction(0.64), rotation(0), implicit_groupbit(0), all_implicit(false)
 {
   if (narg < 6)
     error->all(FLERR, "Fix fluid/drag: expected 'fix ID group fluid/drag FLUID-ID law NAME'");
@@ -97,6 +97,8 @@ void FixFluidDrag::init()
       concentration_id ? ComputeConcentrationGrid::find_fraction(lmp, concentration_id, "Fix fluid/drag") : nullptr;
   implicit_groupbit = 0;
   for (Fix *integrator : sediment_fixes_of_style(lmp, "nve/sphere/fluid")) implicit_groupbit |= integrator->groupbit;
+  // Group 'all' (bit 1) or this fix's own group: no atom of the group is dragged here.
+  all_implicit = (implicit_groupbit & 1) || (implicit_groupbit & groupbit);
 }
 
 void FixFluidDrag::setup(int vflag)
@@ -122,17 +124,23 @@ void FixFluidDrag::refresh_concentration()
   if (concentration && concentration->invoked_peratom != update->ntimestep) concentration->compute_peratom();
 }
 
-sediment::SphereDrag FixFluidDrag::sphere_drag(int i) const
+sediment::SphereDrag FixFluidDrag::immersed_drag(int i) const
 {
   sediment::SphereDrag drag;
-  if (!(atom->mask[i] & groupbit)) return drag;
-  const double radius = atom->radius[i];
-  const sediment::Submergence sub = fluid->immersion(atom->x[i], radius);
-  if (!sub.any()) return drag;
   drag.model = model.get();
-  drag.diameter = 2.0 * radius;
-  drag.scale = sub.drag_scale();
+  drag.diameter = 2.0 * atom->radius[i];
   if (concentration) drag.scale.voidage = 1.0 - std::clamp(concentration->vector_atom[i], 0.0, max_fraction);
+  return drag;
+}
+
+sediment::SphereDrag FixFluidDrag::sphere_drag(int i) const
+{
+  if (!(atom->mask[i] & groupbit)) return {};
+  const sediment::Submergence sub = fluid->immersion(atom->x[i], atom->radius[i]);
+  if (!sub.any()) return {};
+  sediment::SphereDrag drag = immersed_drag(i);
+  drag.scale.area = sub.area;
+  drag.scale.wetted = sub.wetted;
   return drag;
 }
 
@@ -148,10 +156,9 @@ double FixFluidDrag::rotation_rate(int i, const sediment::SphereDrag &drag) cons
                                       drag.scale.wetted);
 }
 
-const sediment::DragModel *FixFluidDrag::uniform_linear_model() const
+bool FixFluidDrag::uniform() const
 {
-  const bool linear = model->linear_coefficient(1.0) > 0.0;
-  return linear && fluid->fills_space() && !concentration && !rotation ? model.get() : nullptr;
+  return fluid->fills_space() && !rotation;
 }
 
 template <class Visit> void FixFluidDrag::for_each_explicit(Visit visit)
@@ -173,6 +180,9 @@ void FixFluidDrag::post_force(int /*vflag*/)
   double **f = atom->f;
   refresh_concentration();
   totals.clear();
+  if (all_implicit) return;    // fix nve/sphere/fluid takes the drag of every atom into its step
+  // Local sums: a store into the fix inside the loop would alias the force array.
+  double sum[3] = {0.0, 0.0, 0.0};
   for_each_explicit([&](int i, const sediment::SphereDrag &drag, const double *slip, double speed) {
     if (!drag.model) {
       totals[OUTSIDE] += 1.0;
@@ -185,7 +195,7 @@ void FixFluidDrag::post_force(int /*vflag*/)
       const double coeff = linear > 0.0 ? linear : model->force(drag.diameter, speed, drag.scale) / speed;
       for (int k = 0; k < 3; ++k) {
         f[i][k] -= coeff * slip[k];
-        totals[k] -= coeff * slip[k];
+        sum[k] -= coeff * slip[k];
       }
     }
     const double rate = rotation_rate(i, drag);
@@ -194,6 +204,7 @@ void FixFluidDrag::post_force(int /*vflag*/)
       for (int k = 0; k < 3; ++k) atom->torque[i][k] -= rate * inertia * atom->omega[i][k];
     }
   });
+  for (int k = 0; k < 3; ++k) totals[k] = sum[k];
 }
 
 int FixFluidDrag::count_unstable_explicit()

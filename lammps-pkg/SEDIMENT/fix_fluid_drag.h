@@ -42,10 +42,12 @@ class FixFluidDrag : public Fix {
   bool fraction_capped(int i) const;
   // Linear rate of the rotational drag torque, torque = -rate * I * omega (0 if off).
   double rotation_rate(int i, const sediment::SphereDrag &drag) const;
-  // The model when the drag on every atom of the group is linear in the slip and needs nothing of
-  // the atom but its diameter (Stokes drag, the sphere wholly immersed, no hindrance or rotational
-  // drag), so that an integrator may take the closed-form step without per-atom look-ups; else nullptr.
-  const sediment::DragModel *uniform_linear_model() const;
+  // True when every atom of the group is wholly immersed (a fluid without surface or region) and
+  // has no rotational drag: then immersed_drag(i) is sphere_drag(i) for the atoms of the group, and
+  // an integrator may skip the per-atom region, surface and rotation look-ups.
+  bool uniform() const;
+  // The drag on local atom i of the group when uniform(): its diameter and local fraction only.
+  sediment::SphereDrag immersed_drag(int i) const;
 
  private:
   char *fluid_id;
@@ -58,6 +60,7 @@ class FixFluidDrag : public Fix {
   double max_fraction;             // local fractions are capped here
   int rotation;
   int implicit_groupbit;    // atoms advanced by fix nve/sphere/fluid: no explicit drag
+  bool all_implicit;        // every atom of the group is one of them
   // Explicitly integrated atoms: drag force (x, y, z), spheres outside the fluid, capped fractions.
   enum { FX, FY, FZ, OUTSIDE, CAPPED, NTOTALS };
   RankSums<NTOTALS> totals;

@@ -66,7 +66,7 @@ static inline void nve_sphere_kick_drift(double *x, double *v, double *omega, co
 }
 
 FixNVESphereFluid::FixNVESphereFluid(LAMMPS *lmp, int narg, char **arg) :
-    Fix(lmp, narg, arg), weights(nullptr), nmax_weights(0), uniform_linear(nullptr), floor_axis(-1), floor_level(0.0)
+    Fix(lmp, narg, arg), weights(nullptr), nmax_weights(0), uniform(nullptr), floor_axis(-1), floor_level(0.0)
 {
   StyleArgs args(lmp, FLERR, "Fix nve/sphere/fluid", narg, arg, 3);
   while (args.more()) {
@@ -111,7 +111,7 @@ void FixNVESphereFluid::init()
 {
   drags.clear();
   for (Fix *drag : sediment_fixes_of_style(lmp, "fluid/drag")) drags.push_back(static_cast<FixFluidDrag *>(drag));
-  uniform_linear = nullptr;    // decided in setup(), once every fix is initialised
+  uniform = nullptr;    // decided in setup(), once every fix is initialised
 
   double *radius = atom->radius;
   int *mask = atom->mask;
@@ -122,66 +122,17 @@ void FixNVESphereFluid::init()
 
 void FixNVESphereFluid::setup(int /*vflag*/)
 {
-  // After every fix's init(): the drag fixes know their fluid and law only then.
-  uniform_linear = drags.size() == 1 ? drags.front()->uniform_linear_model() : nullptr;
+  // After every fix's init(): the drag fixes know their fluid only then.
+  uniform = drags.size() == 1 && drags.front()->uniform() ? drags.front() : nullptr;
 }
 
-void FixNVESphereFluid::initial_integrate(int /*vflag*/)
+template <class Lookup> void FixNVESphereFluid::first_half(Lookup lookup)
 {
   const auto [x, v, f, omega, torque, radius, rmass, mask, nlocal] = sphere_arrays(atom);
   const double dt = update->dt;
   const double ftm2v = force->ftm2v;
-  static const double no_flow[3] = {0.0, 0.0, 0.0};
-
-  for (FixFluidDrag *drag : drags) drag->prepare_step();
-  counts.clear();
-
   const double dtf = 0.5 * dt * ftm2v;
-  if (drags.empty()) {    // every fluid effect off: fix nve/sphere's step, no per-atom bookkeeping
-    int outside = 0;    // a local count: a store into the fix would alias the atom arrays
-    bool finite = true;    // a flag, not a running sum: no chain of dependent additions
-    for (int i = 0; i < nlocal; ++i)
-      if (mask[i] & groupbit) {
-        nve_sphere_kick_drift(x[i], v[i], omega[i], f[i], torque[i], radius[i], rmass[i], dtf, dt);
-        settle_on_floor(i);
-        finite &= std::isfinite(state_sum(x[i], v[i]));
-        ++outside;
-      }
-    counts[OUTSIDE] = outside;
-    if (!finite) find_non_finite();
-    return;
-  }
-
-  // One fluid/drag whose drag is linear and the same for every atom but for its diameter: the
-  // closed-form step of drag_step_initial, operation for operation, without per-atom look-ups.
-  if (const sediment::DragModel *linear = uniform_linear) {
-    const double *flow = drags.front()->fluid_fix()->velocity();
-    const double spin_weight = dt * 0.5;    // rotation_step_initial without rotational drag
-    bool finite = true;
-    for (int i = 0; i < nlocal; ++i) {
-      if (!(mask[i] & groupbit)) continue;
-      const double mass = rmass[i];
-      double *w = weights[i];
-      const double z = linear->linear_coefficient(2.0 * radius[i]) / mass * dt;
-      const sediment::Phi p = sediment::phis(z, &w[DRAG_MEMO]);
-      double *v_i = v[i];
-      for (int k = 0; k < 3; ++k) {
-        const double a = ftm2v * f[i][k] / mass;
-        const double slip = v_i[k] - flow[k];
-        v_i[k] = flow[k] + slip * p.decay + dt * (p.phi1 - p.phi2) * a;
-        x[i][k] += dt * (flow[k] + p.phi1 * slip + dt * p.phi2 * a);
-      }
-      const double inertia = sediment::sphere_inertia(mass, radius[i]);
-      for (int k = 0; k < 3; ++k) omega[i][k] = omega[i][k] * 1.0 + spin_weight * (ftm2v * torque[i][k] / inertia);
-      w[IN_FLUID] = 1.0;
-      w[ALONG] = w[ACROSS] = dt * p.phi2;
-      w[SPIN] = spin_weight;
-      settle_on_floor(i);
-      finite &= std::isfinite(state_sum(x[i], v[i]));
-    }
-    if (!finite) find_non_finite();
-    return;
-  }
+  static const double no_flow[3] = {0.0, 0.0, 0.0};
 
   bool finite = true;
   for (int i = 0; i < nlocal; ++i) {
@@ -189,17 +140,7 @@ void FixNVESphereFluid::initial_integrate(int /*vflag*/)
     sediment::SphereDrag sphere;
     const double *flow = no_flow;
     double spin_rate = 0.0;
-    for (FixFluidDrag *drag : drags) {
-      const sediment::SphereDrag candidate = drag->sphere_drag(i);
-      if (!candidate.model) continue;
-      if (sphere.model)
-        error->one(FLERR, "Fix nve/sphere/fluid: atom {} is in the fluid of two fluid/drag fixes",
-                   atom->tag[i]);
-      sphere = candidate;
-      flow = drag->fluid_fix()->velocity();
-      spin_rate = drag->rotation_rate(i, sphere);
-      if (drag->fraction_capped(i)) counts[CAPPED] += 1.0;
-    }
+    lookup(i, sphere, flow, spin_rate);
 
     const double mass = rmass[i];
     double *w = weights[i];
@@ -212,7 +153,9 @@ void FixNVESphereFluid::initial_integrate(int /*vflag*/)
       continue;
     }
 
-    const double a[3] = {ftm2v * f[i][0] / mass, ftm2v * f[i][1] / mass, ftm2v * f[i][2] / mass};
+    // One division per atom and half step, as fix nve/sphere (divisions dominate a cheap step).
+    const double per_mass = ftm2v / mass;
+    const double a[3] = {f[i][0] * per_mass, f[i][1] * per_mass, f[i][2] * per_mass};
     double dx[3];
     const sediment::StepCorrection corr =
         sediment::drag_step_initial(sphere, mass, a, flow, dt, v[i], dx, &w[DRAG_MEMO]);
@@ -222,19 +165,71 @@ void FixNVESphereFluid::initial_integrate(int /*vflag*/)
     if (corr.state == sediment::SlipState::Stuck) counts[STUCK] += 1.0;
     if (corr.state == sediment::SlipState::HeldAtJump) counts[AT_JUMP] += 1.0;
 
-    const double inertia = sediment::sphere_inertia(mass, radius[i]);
-    const double alpha[3] = {ftm2v * torque[i][0] / inertia, ftm2v * torque[i][1] / inertia,
-                             ftm2v * torque[i][2] / inertia};
+    const double per_inertia = ftm2v / sediment::sphere_inertia(mass, radius[i]);
+    const double alpha[3] = {torque[i][0] * per_inertia, torque[i][1] * per_inertia, torque[i][2] * per_inertia};
     w[SPIN] = sediment::rotation_step_initial(spin_rate, alpha, dt, omega[i], &w[SPIN_MEMO]);
     w[ALONG] = corr.along;
     w[ACROSS] = corr.across;
-    w[DIRX] = corr.dir[0];
-    w[DIRY] = corr.dir[1];
-    w[DIRZ] = corr.dir[2];
+    if (corr.along != corr.across) {    // the direction matters to the second half only then
+      w[DIRX] = corr.dir[0];
+      w[DIRY] = corr.dir[1];
+      w[DIRZ] = corr.dir[2];
+    }
     settle_on_floor(i);
     finite &= std::isfinite(state_sum(x[i], v[i]));
   }
   if (!finite) find_non_finite();
+}
+
+void FixNVESphereFluid::initial_integrate(int /*vflag*/)
+{
+  for (FixFluidDrag *drag : drags) drag->prepare_step();
+  counts.clear();
+
+  if (drags.empty()) {    // every fluid effect off: fix nve/sphere's step, no per-atom bookkeeping
+    const auto [x, v, f, omega, torque, radius, rmass, mask, nlocal] = sphere_arrays(atom);
+    const double dt = update->dt;
+    const double dtf = 0.5 * dt * force->ftm2v;
+    int outside = 0;    // a local count: a store into the fix would alias the atom arrays
+    bool finite = true;    // a flag, not a running sum: no chain of dependent additions
+    for (int i = 0; i < nlocal; ++i)
+      if (mask[i] & groupbit) {
+        nve_sphere_kick_drift(x[i], v[i], omega[i], f[i], torque[i], radius[i], rmass[i], dtf, dt);
+        finite &= std::isfinite(state_sum(x[i], v[i]));
+        ++outside;
+      }
+    if (floor_axis >= 0)
+      for (int i = 0; i < nlocal; ++i)
+        if (mask[i] & groupbit) stop_on_floor(i);
+    counts[OUTSIDE] = outside;
+    if (!finite) find_non_finite();
+    return;
+  }
+
+  if (FixFluidDrag *drag = uniform) {
+    const int *mask = atom->mask;
+    const int drag_bit = drag->groupbit;
+    const double *flow = drag->fluid_fix()->velocity();
+    first_half([&](int i, sediment::SphereDrag &sphere, const double *&u, double &) {
+      if (!(mask[i] & drag_bit)) return;
+      sphere = drag->immersed_drag(i);
+      u = flow;
+      if (drag->fraction_capped(i)) counts[CAPPED] += 1.0;
+    });
+    return;
+  }
+  first_half([&](int i, sediment::SphereDrag &sphere, const double *&u, double &spin_rate) {
+    for (FixFluidDrag *drag : drags) {
+      const sediment::SphereDrag candidate = drag->sphere_drag(i);
+      if (!candidate.model) continue;
+      if (sphere.model)
+        error->one(FLERR, "Fix nve/sphere/fluid: atom {} is in the fluid of two fluid/drag fixes", atom->tag[i]);
+      sphere = candidate;
+      u = drag->fluid_fix()->velocity();
+      spin_rate = drag->rotation_rate(i, sphere);
+      if (drag->fraction_capped(i)) counts[CAPPED] += 1.0;
+    }
+  });
 }
 
 void FixNVESphereFluid::final_integrate()
@@ -245,23 +240,10 @@ void FixNVESphereFluid::final_integrate()
   const double dtf = 0.5 * update->dt * ftm2v;
   if (drags.empty()) {
     for (int i = 0; i < nlocal; ++i)
-      if (mask[i] & groupbit) {
-        nve_sphere_kick(v[i], omega[i], f[i], torque[i], radius[i], rmass[i], dtf);
-        settle_on_floor(i);
-      }
-    return;
-  }
-
-  if (uniform_linear) {    // drag_step_final and the spin update of the general loop, isotropic
-    for (int i = 0; i < nlocal; ++i) {
-      if (!(mask[i] & groupbit)) continue;
-      const double *w = weights[i];
-      const double mass = rmass[i];
-      for (int k = 0; k < 3; ++k) v[i][k] += w[ALONG] * (ftm2v * f[i][k] / mass);
-      const double spin = w[SPIN] * ftm2v / sediment::sphere_inertia(mass, radius[i]);
-      for (int k = 0; k < 3; ++k) omega[i][k] += spin * torque[i][k];
-      settle_on_floor(i);
-    }
+      if (mask[i] & groupbit) nve_sphere_kick(v[i], omega[i], f[i], torque[i], radius[i], rmass[i], dtf);
+    if (floor_axis >= 0)
+      for (int i = 0; i < nlocal; ++i)
+        if (mask[i] & groupbit) stop_on_floor(i);
     return;
   }
 
@@ -274,13 +256,16 @@ void FixNVESphereFluid::final_integrate()
       continue;
     }
     const double mass = rmass[i];
+    const double per_mass = ftm2v / mass;
+    const double a[3] = {f[i][0] * per_mass, f[i][1] * per_mass, f[i][2] * per_mass};
     sediment::StepCorrection corr;
     corr.along = w[ALONG];
     corr.across = w[ACROSS];
-    corr.dir[0] = w[DIRX];
-    corr.dir[1] = w[DIRY];
-    corr.dir[2] = w[DIRZ];
-    const double a[3] = {ftm2v * f[i][0] / mass, ftm2v * f[i][1] / mass, ftm2v * f[i][2] / mass};
+    if (corr.along != corr.across) {    // written by the first half only then
+      corr.dir[0] = w[DIRX];
+      corr.dir[1] = w[DIRY];
+      corr.dir[2] = w[DIRZ];
+    }
     sediment::drag_step_final(corr, a, v[i]);
 
     const double spin = w[SPIN] * ftm2v / sediment::sphere_inertia(mass, radius[i]);
@@ -305,11 +290,10 @@ void FixNVESphereFluid::find_non_finite() const
   }
 }
 
-void FixNVESphereFluid::settle_on_floor(int i)
+void FixNVESphereFluid::stop_on_floor(int i)
 {
   // A perfectly inelastic floor without a bed: a sphere reaching it stops with its lowest point
   // on it, and stays while the forces press it down (only the settling is resolved, not the deposit).
-  if (floor_axis < 0) return;
   double *x = atom->x[i];
   double *v = atom->v[i];
   const double rest = floor_level + atom->radius[i];

@@ -48,13 +48,17 @@ class FixNVESphereFluid : public Fix {
   double **weights;
   int nmax_weights;    // rows of weights with initialised memos
   std::vector<class FixFluidDrag *> drags;
-  // Set in setup() when one fluid/drag applies the same linear drag to every atom but for its
-  // diameter: both halves of the step then take its closed form without per-atom look-ups.
-  const sediment::DragModel *uniform_linear;
+  // Set in setup() when there is one fluid/drag and it is uniform() (every atom of its group wholly
+  // immersed, no rotational drag): the step then skips the per-atom region and surface look-ups.
+  class FixFluidDrag *uniform;
+  // The first half of the step for every atom of the group, with the drag found by lookup(i, sphere,
+  // flow, spin_rate) (one loop for the general and the uniform look-up, compiled for each).
+  template <class Lookup> void first_half(Lookup lookup);
 
   int floor_axis;         // -1: no floor
   double floor_level;     // spheres stop with their lowest point here
-  void settle_on_floor(int i);
+  void settle_on_floor(int i) { if (floor_axis >= 0) stop_on_floor(i); }
+  void stop_on_floor(int i);
 
   // Diagnostics of the last step (compute_vector): spheres stuck by the yield stress, held at a
   // Cd jump, outside every fluid, and with their local solid fraction capped (hindered drag).

@@ -217,3 +217,29 @@ TEST(RotationDrag, RotletOverInertia)
   EXPECT_NEAR(rotation_drag_rate(mu, d, mass), 10 * pi * mu * d / mass, 1e-13 * 10 * pi * mu * d / mass);
   EXPECT_DOUBLE_EQ(rotation_drag_rate(mu, d, mass, 0.25), 0.25 * rotation_drag_rate(mu, d, mass));
 }
+
+TEST(DragLaw, ForceAndTangentInOneEvaluationAreBitwiseTheSeparateOnes)
+{
+  const DragScale hindered{0.7, 0.6, 0.8};
+  for (auto law : {DragLaw::Stokes, DragLaw::SchillerNaumann, DragLaw::Dallavalle, DragLaw::ZhangLi,
+                   DragLaw::ZhangLiSmooth, DragLaw::DiFelice})
+    for (const Fluid &fluid : {water, clay})
+      for (double speed : {0.0, 1e-6, 3e-3, 0.4, 7.0}) {
+        const DragModel model(law, fluid);
+        const DragModel::ForceSlope both = model.force_and_tangent(2e-4, speed, hindered);
+        EXPECT_EQ(both.slope, model.tangent(2e-4, speed, hindered)) << drag_law_name(law) << " " << speed;
+        EXPECT_EQ(both.force, model.force(2e-4, speed, hindered)) << drag_law_name(law) << " " << speed;
+      }
+}
+
+TEST(DragLaw, SmoothLawsAreThoseWithoutYieldOrJumps)
+{
+  EXPECT_TRUE(DragModel(DragLaw::Stokes, water).smooth());
+  EXPECT_TRUE(DragModel(DragLaw::Dallavalle, water).smooth());
+  EXPECT_TRUE(DragModel(DragLaw::DiFelice, water).smooth());
+  EXPECT_TRUE(DragModel(DragLaw::ZhangLiSmooth, water).smooth());
+  EXPECT_FALSE(DragModel(DragLaw::SchillerNaumann, water).smooth());    // Cd steps at Re 1000
+  EXPECT_FALSE(DragModel(DragLaw::ZhangLi, water).smooth());            // steps at Re' 1 and 150
+  EXPECT_FALSE(DragModel(DragLaw::ZhangLiSmooth, clay).smooth());       // yield stress
+  EXPECT_FALSE(DragModel(DragLaw::Stokes, clay).smooth());
+}

@@ -9,6 +9,8 @@
 // s_A and s_w scale the projected area and the yield term for a partly submerged sphere.
 #pragma once
 
+#include "sediment/geometry.hpp"
+
 #include <array>
 #include <optional>
 #include <string>
@@ -77,10 +79,24 @@ class DragModel {
   double force(double d, double speed, DragScale scale = {}) const;
   // dF/ds for speed >= 0 (right derivative at 0).
   double tangent(double d, double speed, DragScale scale = {}) const;
+  // force() and tangent() at the same speed from one evaluation of the law (the costly part with
+  // the Di Felice hindrance); the same values, bit for bit.
+  struct ForceSlope {
+    double force;
+    double slope;
+  };
+  ForceSlope force_and_tangent(double d, double speed, DragScale scale = {}) const;
+  // True when F(s) is single-valued and continuous: no yield stress and no Cd jump, so a step
+  // needs no event handling (Stokes, Dallavalle, Di Felice, zhang-li/smooth in a Newtonian fluid).
+  bool smooth() const { return smooth_; }
   // F(0+): the largest force a sphere at rest resists (zero for a Newtonian fluid).
   double static_force(double d, DragScale scale = {}) const;
   // c when F(s) = c s exactly (Stokes in a Newtonian fluid), else 0.
-  double linear_coefficient(double d, DragScale scale = {}) const;
+  double linear_coefficient(double d, DragScale scale = {}) const
+  {
+    if (law_ != DragLaw::Stokes || fluid_.yield_stress > 0.0) return 0.0;
+    return scale.area * 3.0 * pi * fluid_.viscosity * d;
+  }
   // Jumps of F in increasing speed; returns how many were written.
   int jumps(double d, std::array<ForceJump, max_jumps> &out, DragScale scale = {}) const;
 
@@ -88,12 +104,15 @@ class DragModel {
   double viscous_scale(double d, double speed) const;    // tau_y + eta s / d
   double speed_at_reynolds(double d, double re) const;  // inverse of reynolds()
   double force_at(double d, double speed, double g, DragScale scale) const;
+  // dF/ds from the law's curve evaluated at this speed.
+  double slope_at(double d, double speed, DragCurve g, DragScale scale) const;
   // Cd Re' of the law at this sphere, with the Di Felice hindrance when it applies.
   DragCurve curve(double re, double voidage) const;
 
   DragLaw law_;
   double hindrance_offset_;    // 1: eps^-(chi+1), 0: eps^-chi
   Fluid fluid_;
+  bool smooth_;
 };
 
 // Linear relaxation time m / F'(0) of a sphere of density rho_p (Stokes: rho_p d^2 / (18 mu)).

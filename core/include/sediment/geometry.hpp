@@ -2,8 +2,6 @@
 // Sphere geometry: volumes, areas, inertia and partial submergence below a plane free surface.
 #pragma once
 
-#include "sediment/drag.hpp"
-
 namespace sediment {
 
 constexpr double pi = 3.14159265358979323846;
@@ -29,7 +27,6 @@ struct Submergence {
   double area;       // fraction of the cross-section below the waterline, seen along the normal
   double wetted;     // wetted fraction of the surface, h / d
   bool any() const { return volume > 0.0; }
-  DragScale drag_scale() const { return {area, wetted}; }
 };
 
 Submergence submergence(double radius, double centre_height);

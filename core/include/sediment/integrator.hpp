@@ -34,7 +34,17 @@ Phi phis(double z);
 // phis(z) remembered for the last z a sphere saw, in memo = {z, decay, phi1, phi2} (z NaN: empty).
 // With a fixed step and a linear drag z does not change, so the exponential is taken once.
 constexpr int PHI_MEMO_SIZE = 4;
-Phi phis(double z, double memo[PHI_MEMO_SIZE]);
+inline Phi phis(double z, double memo[PHI_MEMO_SIZE])
+{
+  if (z != memo[0]) {
+    const Phi p = phis(z);
+    memo[0] = z;
+    memo[1] = p.decay;
+    memo[2] = p.phi1;
+    memo[3] = p.phi2;
+  }
+  return {memo[1], memo[2], memo[3]};
+}
 
 // The drag seen by one sphere during a step.
 struct SphereDrag {
@@ -54,19 +64,68 @@ struct StepCorrection {
   SlipState state = SlipState::Free;
 };
 
+// drag_step_initial for a drag that is not linear in the slip (out of line: Newton linearisation,
+// set-valued points).
+StepCorrection nonlinear_step_initial(const SphereDrag &drag, double mass, const double a[3],
+                                      const double u[3], double dt, double v[3], double dx[3]);
+
 // First half: advances x by dx and replaces v with the mid-step velocity, given the non-drag
 // acceleration a_n = f_n / m and the uniform fluid velocity u. A memo (see phis) saves the
-// exponential of a linear drag from step to step.
-StepCorrection drag_step_initial(const SphereDrag &drag, double mass, const double a[3],
-                                 const double u[3], double dt, double v[3], double dx[3],
-                                 double *memo = nullptr);
+// exponential of a linear drag from step to step. Inline: the per-atom loops of the integrator
+// take the linear and no-drag cases without a call.
+inline StepCorrection drag_step_initial(const SphereDrag &drag, double mass, const double a[3],
+                                        const double u[3], double dt, double v[3], double dx[3],
+                                        double *memo = nullptr)
+{
+  StepCorrection corr;
+  if (drag.model == nullptr || (drag.scale.area <= 0.0 && drag.scale.wetted <= 0.0)) {
+    for (int k = 0; k < 3; ++k) {
+      v[k] += 0.5 * dt * a[k];
+      dx[k] = dt * v[k];
+    }
+    corr.along = corr.across = 0.5 * dt;
+    return corr;
+  }
+  // Drag linear in the slip: the same step with equal rates along and across the slip and no
+  // set-valued points, in closed form.
+  const double linear = drag.model->linear_coefficient(drag.diameter, drag.scale);
+  if (!(linear > 0.0)) return nonlinear_step_initial(drag, mass, a, u, dt, v, dx);
+  const double z = linear / mass * dt;
+  const Phi p = memo ? phis(z, memo) : phis(z);
+  for (int k = 0; k < 3; ++k) {
+    const double w = v[k] - u[k];
+    v[k] = u[k] + w * p.decay + dt * (p.phi1 - p.phi2) * a[k];
+    dx[k] = dt * (u[k] + p.phi1 * w + dt * p.phi2 * a[k]);
+  }
+  corr.along = corr.across = dt * p.phi2;
+  return corr;
+}
 
 // Second half: adds the weighted acceleration a_{n+1} = f_{n+1} / m.
-void drag_step_final(const StepCorrection &corr, const double a[3], double v[3]);
+inline void drag_step_final(const StepCorrection &corr, const double a[3], double v[3])
+{
+  if (corr.along == corr.across) {    // isotropic: linear drag, no drag, or held
+    for (int k = 0; k < 3; ++k) v[k] += corr.along * a[k];
+    return;
+  }
+  const double a_par = a[0] * corr.dir[0] + a[1] * corr.dir[1] + a[2] * corr.dir[2];
+  for (int k = 0; k < 3; ++k)
+    v[k] += corr.along * a_par * corr.dir[k] + corr.across * (a[k] - a_par * corr.dir[k]);
+}
 
 // Rotation with a linear drag torque -k I omega: same ETD2 weights, isotropic.
 // Returns the weight of alpha_{n+1} for the second half (dt / 2 when k = 0).
-double rotation_step_initial(double rate, const double alpha[3], double dt, double omega[3],
-                             double *memo = nullptr);
+inline double rotation_step_initial(double rate, const double alpha[3], double dt, double omega[3],
+                                    double *memo = nullptr)
+{
+  if (rate == 0.0) {    // phis(0) = {1, 1, 1/2}: the same values without the memo
+    for (int k = 0; k < 3; ++k) omega[k] += dt * 0.5 * alpha[k];
+    return dt * 0.5;
+  }
+  const Phi p = memo ? phis(rate * dt, memo) : phis(rate * dt);
+  const double weight_now = dt * (p.phi1 - p.phi2);
+  for (int k = 0; k < 3; ++k) omega[k] = omega[k] * p.decay + weight_now * alpha[k];
+  return dt * p.phi2;
+}
 
 }    // namespace sediment
