@@ -218,9 +218,23 @@ void smooth_profile(const Layers &layers, const double *values, double width, do
   }
 }
 
+namespace {
+
+// The one resolved axis of a grid of layers, or -1: such a grid takes the one-axis functions, which
+// give the same values without the per-axis bookkeeping of a grid of cells.
+int layer_axis(const Grid &grid)
+{
+  const int resolved = grid.resolved[0] + grid.resolved[1] + grid.resolved[2];
+  return resolved != 1 ? -1 : grid.resolved[0] ? 0 : grid.resolved[1] ? 1 : 2;
+}
+
+}    // namespace
+
 double add_sphere_to_grid(const Grid &grid, const double centre[3], double radius, double *values, int stride,
                           double weight)
 {
+  if (const int axis = layer_axis(grid); axis >= 0)
+    return add_sphere_to_layers(grid.axes[axis], centre[axis], radius, values, stride, weight);
   const double total = 4.0 / 3.0 * pi * radius * radius * radius;
   int first[3], last[3], ncrossing = 0, along = -1;
   bool crosses[3] = {false, false, false};
@@ -257,6 +271,7 @@ double add_sphere_to_grid(const Grid &grid, const double centre[3], double radiu
 
 double grid_value_at(const Grid &grid, const double *values, const double point[3], int stride)
 {
+  if (const int axis = layer_axis(grid); axis >= 0) return profile_at(grid.axes[axis], values, point[axis], stride);
   Bracket at[3];
   for (int d = 0; d < 3; ++d) at[d] = grid.resolved[d] ? bracket(grid.axes[d], point[d]) : Bracket{0, 0, 0.0};
   const int nx = grid.axes[0].count, ny = grid.axes[1].count;

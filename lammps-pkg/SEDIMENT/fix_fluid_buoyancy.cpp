@@ -109,9 +109,11 @@ void FixFluidBuoyancy::post_force(int /*vflag*/)
   // Local sums: a store into the fix inside the loop would alias the force array.
   double sum[3] = {0.0, 0.0, 0.0};
   int immersed = 0;
+  const bool everywhere = fluid->fills_space();    // tested once, not per atom
   for (int i = 0; i < nlocal; ++i) {
     if (!(mask[i] & groupbit)) continue;
-    const sediment::Submergence sub = fluid->immersion(x[i], radius[i]);
+    const sediment::Submergence sub =
+        everywhere ? sediment::Submergence{1.0, 1.0, 1.0} : fluid->immersion(x[i], radius[i]);
     if (!sub.any()) continue;
     // The suspension around the sphere, or the clear fluid.
     const double density = fraction ? sediment::mixture_density(rho, solid_density, fraction[i]) : rho;

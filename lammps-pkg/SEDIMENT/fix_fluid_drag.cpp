@@ -24,6 +24,11 @@
 using namespace LAMMPS_NS;
 using namespace FixConst;
 
+static inline double norm(const double *w)
+{
+  return sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]);
+}
+
 FixFluidDrag::FixFluidDrag(LAMMPS *lmp, int narg, char **arg) :
     Fix(lmp, narg, arg), fluid_id(nullptr), fluid(nullptr), law(sediment::DragLaw::Stokes),
     hindrance_buoyancy(sediment::HindranceBuoyancy::Plain), concentration_id(nullptr),
@@ -166,12 +171,13 @@ template <class Visit> void FixFluidDrag::for_each_explicit(Visit visit)
   double **v = atom->v;
   const int *mask = atom->mask;
   const double *u = fluid->velocity();
+  const bool everywhere = fluid->fills_space();    // tested once, not per atom
   prepare_step();
   for (int i = 0; i < atom->nlocal; ++i) {
     if (!(mask[i] & groupbit) || (mask[i] & implicit_groupbit)) continue;
-    const sediment::SphereDrag drag = sphere_drag(i);
+    const sediment::SphereDrag drag = everywhere ? immersed_drag(i) : sphere_drag(i);
     const double slip[3] = {v[i][0] - u[0], v[i][1] - u[1], v[i][2] - u[2]};
-    visit(i, drag, slip, sqrt(slip[0] * slip[0] + slip[1] * slip[1] + slip[2] * slip[2]));
+    visit(i, drag, slip);
   }
 }
 
@@ -183,13 +189,14 @@ void FixFluidDrag::post_force(int /*vflag*/)
   if (all_implicit) return;    // fix nve/sphere/fluid takes the drag of every atom into its step
   // Local sums: a store into the fix inside the loop would alias the force array.
   double sum[3] = {0.0, 0.0, 0.0};
-  for_each_explicit([&](int i, const sediment::SphereDrag &drag, const double *slip, double speed) {
+  for_each_explicit([&](int i, const sediment::SphereDrag &drag, const double *slip) {
     if (!drag.model) {
       totals[OUTSIDE] += 1.0;
       return;
     }
     if (fraction_capped(i)) totals[CAPPED] += 1.0;
     const double linear = model->linear_coefficient(drag.diameter, drag.scale);
+    const double speed = linear > 0.0 ? 0.0 : norm(slip);
     if (linear > 0.0 || speed > 0.0) {
       // Explicit: the yield part acts only while moving, so a yield-stress fluid chatters here.
       const double coeff = linear > 0.0 ? linear : model->force(drag.diameter, speed, drag.scale) / speed;
@@ -210,9 +217,9 @@ void FixFluidDrag::post_force(int /*vflag*/)
 int FixFluidDrag::count_unstable_explicit()
 {
   int count = 0;
-  for_each_explicit([&](int i, const sediment::SphereDrag &drag, const double *, double speed) {
+  for_each_explicit([&](int i, const sediment::SphereDrag &drag, const double *slip) {
     if (drag.model &&
-        update->dt > sediment::explicit_step_limit(*model, drag.diameter, speed, atom->rmass[i], drag.scale))
+        update->dt > sediment::explicit_step_limit(*model, drag.diameter, norm(slip), atom->rmass[i], drag.scale))
       ++count;
   });
   int count_all = 0;

@@ -65,8 +65,8 @@ class FixFluidDrag : public Fix {
   enum { FX, FY, FZ, OUTSIDE, CAPPED, NTOTALS };
   RankSums<NTOTALS> totals;
 
-  // visit(i, drag, slip[3], |slip|) for every local atom of the group that this fix drags
-  // explicitly (drag.model is nullptr outside the fluid).
+  // visit(i, drag, slip[3]) for every local atom of the group that this fix drags explicitly
+  // (drag.model is nullptr outside the fluid).
   template <class Visit> void for_each_explicit(Visit visit);
   int count_unstable_explicit();
   void refresh_concentration();

@@ -20,6 +20,7 @@
 #include "modify.h"
 #include "update.h"
 
+#include <array>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -28,18 +29,21 @@ using namespace LAMMPS_NS;
 using namespace FixConst;
 
 // The kick of fix nve/sphere, written as it does, so that a scene without fluid is bitwise the
-// same as with fix nve/sphere. dtf = dt ftm2v / 2.
-static inline void nve_sphere_kick(double *v, double *omega, const double *f, const double *torque, double radius,
-                                   double rmass, double dtf)
+// same as with fix nve/sphere. dtf = dt ftm2v / 2. Returns the new velocity: read back from v, it
+// would wait for the stores just made.
+static inline std::array<double, 3> nve_sphere_kick(double *v, double *omega, const double *f, const double *torque,
+                                                    double radius, double rmass, double dtf)
 {
   const double dtfm = dtf / rmass;
-  v[0] += dtfm * f[0];
-  v[1] += dtfm * f[1];
-  v[2] += dtfm * f[2];
+  const std::array<double, 3> kicked = {v[0] + dtfm * f[0], v[1] + dtfm * f[1], v[2] + dtfm * f[2]};
+  v[0] = kicked[0];
+  v[1] = kicked[1];
+  v[2] = kicked[2];
   const double dtirotate = dtf / sediment::solid_sphere_inertia / (radius * radius * rmass);
   omega[0] += dtirotate * torque[0];
   omega[1] += dtirotate * torque[1];
   omega[2] += dtirotate * torque[2];
+  return kicked;
 }
 
 // The per-atom arrays both halves of the step read, taken anew in each half (exchanges move them).
@@ -55,14 +59,17 @@ static inline SphereArrays sphere_arrays(const Atom *atom)
   return {atom->x, atom->v, atom->f, atom->omega, atom->torque, atom->radius, atom->rmass, atom->mask, atom->nlocal};
 }
 
-// The first half of fix nve/sphere's step: kick, then drift over the whole step.
-static inline void nve_sphere_kick_drift(double *x, double *v, double *omega, const double *f, const double *torque,
-                                         double radius, double rmass, double dtf, double dt)
+// The first half of fix nve/sphere's step: kick, then drift over the whole step. Returns the sum
+// of the new position and velocity (the finite-state check), taken from registers.
+static inline double nve_sphere_kick_drift(double *x, double *v, double *omega, const double *f,
+                                           const double *torque, double radius, double rmass, double dtf, double dt)
 {
-  nve_sphere_kick(v, omega, f, torque, radius, rmass, dtf);
-  x[0] += dt * v[0];
-  x[1] += dt * v[1];
-  x[2] += dt * v[2];
+  const auto [v0, v1, v2] = nve_sphere_kick(v, omega, f, torque, radius, rmass, dtf);
+  const double x0 = x[0] + dt * v0, x1 = x[1] + dt * v1, x2 = x[2] + dt * v2;
+  x[0] = x0;
+  x[1] = x1;
+  x[2] = x2;
+  return x0 + x1 + x2 + v0 + v1 + v2;
 }
 
 FixNVESphereFluid::FixNVESphereFluid(LAMMPS *lmp, int narg, char **arg) :
@@ -147,9 +154,7 @@ template <class Lookup> void FixNVESphereFluid::first_half(Lookup lookup)
     w[IN_FLUID] = sphere.model ? 1.0 : 0.0;
     if (!sphere.model) {
       counts[OUTSIDE] += 1.0;
-      nve_sphere_kick_drift(x[i], v[i], omega[i], f[i], torque[i], radius[i], rmass[i], dtf, dt);
-      settle_on_floor(i);
-      finite &= std::isfinite(state_sum(x[i], v[i]));
+      finite &= std::isfinite(nve_sphere_kick_drift(x[i], v[i], omega[i], f[i], torque[i], radius[i], rmass[i], dtf, dt));
       continue;
     }
 
@@ -175,10 +180,10 @@ template <class Lookup> void FixNVESphereFluid::first_half(Lookup lookup)
       w[DIRY] = corr.dir[1];
       w[DIRZ] = corr.dir[2];
     }
-    settle_on_floor(i);
     finite &= std::isfinite(state_sum(x[i], v[i]));
   }
   if (!finite) find_non_finite();
+  settle_on_floor();
 }
 
 void FixNVESphereFluid::initial_integrate(int /*vflag*/)
@@ -194,15 +199,12 @@ void FixNVESphereFluid::initial_integrate(int /*vflag*/)
     bool finite = true;    // a flag, not a running sum: no chain of dependent additions
     for (int i = 0; i < nlocal; ++i)
       if (mask[i] & groupbit) {
-        nve_sphere_kick_drift(x[i], v[i], omega[i], f[i], torque[i], radius[i], rmass[i], dtf, dt);
-        finite &= std::isfinite(state_sum(x[i], v[i]));
+        finite &= std::isfinite(nve_sphere_kick_drift(x[i], v[i], omega[i], f[i], torque[i], radius[i], rmass[i], dtf, dt));
         ++outside;
       }
-    if (floor_axis >= 0)
-      for (int i = 0; i < nlocal; ++i)
-        if (mask[i] & groupbit) stop_on_floor(i);
     counts[OUTSIDE] = outside;
     if (!finite) find_non_finite();
+    settle_on_floor();
     return;
   }
 
@@ -241,9 +243,7 @@ void FixNVESphereFluid::final_integrate()
   if (drags.empty()) {
     for (int i = 0; i < nlocal; ++i)
       if (mask[i] & groupbit) nve_sphere_kick(v[i], omega[i], f[i], torque[i], radius[i], rmass[i], dtf);
-    if (floor_axis >= 0)
-      for (int i = 0; i < nlocal; ++i)
-        if (mask[i] & groupbit) stop_on_floor(i);
+    settle_on_floor();
     return;
   }
 
@@ -252,7 +252,6 @@ void FixNVESphereFluid::final_integrate()
     const double *w = weights[i];
     if (w[IN_FLUID] == 0.0) {
       nve_sphere_kick(v[i], omega[i], f[i], torque[i], radius[i], rmass[i], dtf);
-      settle_on_floor(i);
       continue;
     }
     const double mass = rmass[i];
@@ -272,8 +271,8 @@ void FixNVESphereFluid::final_integrate()
     omega[i][0] += spin * torque[i][0];
     omega[i][1] += spin * torque[i][1];
     omega[i][2] += spin * torque[i][2];
-    settle_on_floor(i);
   }
+  settle_on_floor();
 }
 
 void FixNVESphereFluid::find_non_finite() const
@@ -290,18 +289,23 @@ void FixNVESphereFluid::find_non_finite() const
   }
 }
 
-void FixNVESphereFluid::stop_on_floor(int i)
+void FixNVESphereFluid::settle_on_floor()
 {
   // A perfectly inelastic floor without a bed: a sphere reaching it stops with its lowest point
   // on it, and stays while the forces press it down (only the settling is resolved, not the deposit).
-  double *x = atom->x[i];
-  double *v = atom->v[i];
-  const double rest = floor_level + atom->radius[i];
-  if (x[floor_axis] > rest || (x[floor_axis] == rest && v[floor_axis] > 0.0)) return;
-  x[floor_axis] = rest;
-  v[0] = v[1] = v[2] = 0.0;
-  double *omega = atom->omega[i];
-  omega[0] = omega[1] = omega[2] = 0.0;
+  // A pass of its own after each half step: without a floor it costs one test, not one per atom.
+  if (floor_axis < 0) return;
+  double **x = atom->x, **v = atom->v, **omega = atom->omega;
+  const double *radius = atom->radius;
+  const int *mask = atom->mask;
+  for (int i = 0; i < atom->nlocal; ++i) {
+    if (!(mask[i] & groupbit)) continue;
+    const double rest = floor_level + radius[i];
+    if (x[i][floor_axis] > rest || (x[i][floor_axis] == rest && v[i][floor_axis] > 0.0)) continue;
+    x[i][floor_axis] = rest;
+    v[i][0] = v[i][1] = v[i][2] = 0.0;
+    omega[i][0] = omega[i][1] = omega[i][2] = 0.0;
+  }
 }
 
 double FixNVESphereFluid::compute_vector(int n)

@@ -41,10 +41,12 @@ class FixNVESphereFluid : public Fix {
 
  private:
   // Per atom, from the first half of the step to the second: weights of the new force along
-  // and across the slip, the slip direction, the weight of the new torque, and whether the
-  // atom was in a fluid (outside, the step is fix nve/sphere's, operation for operation); then
-  // the exponentials of the last step's translational and rotational drag (sediment::phis memos).
-  enum { ALONG, ACROSS, DIRX, DIRY, DIRZ, SPIN, IN_FLUID, DRAG_MEMO, SPIN_MEMO = DRAG_MEMO + 4, NCOLS = SPIN_MEMO + 4 };
+  // and across the slip, the weight of the new torque, whether the atom was in a fluid (outside,
+  // the step is fix nve/sphere's, operation for operation), the exponentials of the last step's
+  // translational drag (sediment::phis memo); then the slip direction (needed only when the
+  // weights differ) and the memo of the rotational drag. 16 columns: in rows aligned to 64 bytes,
+  // a sphere with linear drag and no rotational drag touches only the first cache line of its row.
+  enum { ALONG, ACROSS, SPIN, IN_FLUID, DRAG_MEMO, DIRX = DRAG_MEMO + 4, DIRY, DIRZ, SPIN_MEMO, NCOLS = SPIN_MEMO + 5 };
   double **weights;
   int nmax_weights;    // rows of weights with initialised memos
   std::vector<class FixFluidDrag *> drags;
@@ -57,8 +59,7 @@ class FixNVESphereFluid : public Fix {
 
   int floor_axis;         // -1: no floor
   double floor_level;     // spheres stop with their lowest point here
-  void settle_on_floor(int i) { if (floor_axis >= 0) stop_on_floor(i); }
-  void stop_on_floor(int i);
+  void settle_on_floor();    // every sphere of the group that reached the floor
 
   // Diagnostics of the last step (compute_vector): spheres stuck by the yield stress, held at a
   // Cd jump, outside every fluid, and with their local solid fraction capped (hindered drag).

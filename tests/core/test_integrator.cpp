@@ -244,10 +244,10 @@ TEST(Integrator, RotationDecaysExactly)
   EXPECT_DOUBLE_EQ(rotation_step_initial(0.0, alpha, dt, omega), 0.5 * dt);
 }
 
-TEST(Integrator, PhiFunctionsAreSmoothAcrossTheSeriesSwitch)
+TEST(Integrator, PhiFunctionsAreSmoothAcrossTheSeriesSwitches)
 {
   // References in long double: the direct formulas where they do not cancel, else the series.
-  for (double z : {0.0, 1e-12, 1e-4, 9.99e-4, 0.1, 0.4999, 0.5001, 2.0, 10.0, 1e6}) {
+  for (double z : {0.0, 1e-12, 1e-4, 9.76e-4, 9.78e-4, 9.99e-4, 0.0624, 0.0626, 0.1, 0.4999, 0.5001, 2.0, 10.0, 1e6}) {
     const long double x = z;
     long double p1 = 0.0L, p2 = 0.0L, term1 = 1.0L, term2 = 0.5L;
     if (z > 1.0) {

@@ -92,12 +92,15 @@ inline StepCorrection drag_step_initial(const SphereDrag &drag, double mass, con
   if (!(linear > 0.0)) return nonlinear_step_initial(drag, mass, a, u, dt, v, dx);
   const double z = linear / mass * dt;
   const Phi p = memo ? phis(z, memo) : phis(z);
+  // Copies first: the stores into v could alias u or a, which would then be read anew each time.
+  const double flow[3] = {u[0], u[1], u[2]}, accel[3] = {a[0], a[1], a[2]};
+  const double slip[3] = {v[0] - flow[0], v[1] - flow[1], v[2] - flow[2]};
+  const double weight_now = dt * (p.phi1 - p.phi2), weight_drift = dt * p.phi2;
   for (int k = 0; k < 3; ++k) {
-    const double w = v[k] - u[k];
-    v[k] = u[k] + w * p.decay + dt * (p.phi1 - p.phi2) * a[k];
-    dx[k] = dt * (u[k] + p.phi1 * w + dt * p.phi2 * a[k]);
+    v[k] = flow[k] + slip[k] * p.decay + weight_now * accel[k];
+    dx[k] = dt * (flow[k] + p.phi1 * slip[k] + weight_drift * accel[k]);
   }
-  corr.along = corr.across = dt * p.phi2;
+  corr.along = corr.across = weight_drift;
   return corr;
 }
 
