@@ -11,6 +11,9 @@ set -euo pipefail
 dest=$(realpath -m "${1:?usage: build-lammps-current.sh DEST}")
 repo=$(cd "$(dirname "$0")/.." && pwd)
 mkdir -p "$dest"
+# One build at a time in the cache (clones on one machine share it).
+exec 9>"$dest/.lock"
+flock 9
 
 orig=$("$repo/scripts/fetch-lammps-source.sh" sid latest "$dest")
 
@@ -23,10 +26,10 @@ fi
 "$repo/lammps-pkg/install-in-tree.sh" "$tree" >/dev/null
 
 build="$dest/build"
-if [ ! -f "$build/CMakeCache.txt" ]; then
-    cmake -S "$tree/cmake" -B "$build" -D CMAKE_BUILD_TYPE=Release -D BUILD_SHARED_LIBS=on -D BUILD_MPI=on \
-        -D BUILD_OMP=off -D BUILD_TOOLS=off -D FFT=KISS -D WITH_JPEG=off -D WITH_PNG=off -D WITH_GZIP=off \
-        -D WITH_FFMPEG=off -D WITH_CURL=off -D PKG_GRANULAR=on -D PKG_PLUGIN=on -D PKG_SEDIMENT=on >/dev/null
-fi
+# Configured every time (seconds): LAMMPS's CMake lists a package's sources when it configures, so a
+# style added to or removed from SEDIMENT since the last run is picked up.
+cmake -S "$tree/cmake" -B "$build" -D CMAKE_BUILD_TYPE=Release -D BUILD_SHARED_LIBS=on -D BUILD_MPI=on \
+    -D BUILD_OMP=off -D BUILD_TOOLS=off -D FFT=KISS -D WITH_JPEG=off -D WITH_PNG=off -D WITH_GZIP=off \
+    -D WITH_FFMPEG=off -D WITH_CURL=off -D PKG_GRANULAR=on -D PKG_PLUGIN=on -D PKG_SEDIMENT=on >/dev/null
 cmake --build "$build" -j "${JOBS:-2}" >/dev/null
 echo "LAMMPS $(basename "$orig" | sed 's/lammps_\(.*\)\.orig.*/\1/') with SEDIMENT: $build/lmp"
