@@ -106,8 +106,7 @@ AlongSlip advance_along(const SphereDrag &drag, double mass, double s, double a_
     }
 
     // Newton linearisation F(w) ~ F(s) + F'(s) (w - s) around the current slip.
-    const double force = model.force(d, s_eval, drag.scale);
-    const double slope = model.tangent(d, s_eval, drag.scale);
+    const auto [force, slope] = model.force_and_tangent(d, s_eval, drag.scale);
     rate = slope / mass;
     const double c = a_par - (force - slope * s) / mass;
     const Segment full = advance(s, c, rate, left);
