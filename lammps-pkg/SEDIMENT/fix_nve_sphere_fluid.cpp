@@ -158,7 +158,7 @@ template <class Lookup> void FixNVESphereFluid::first_half(Lookup lookup)
       continue;
     }
 
-    // One division per atom and half step, as fix nve/sphere (divisions dominate a cheap step).
+    // Divisions dominate a cheap step: one for the forces and one for the torques, as fix nve/sphere.
     const double per_mass = ftm2v / mass;
     const double a[3] = {f[i][0] * per_mass, f[i][1] * per_mass, f[i][2] * per_mass};
     double dx[3];
