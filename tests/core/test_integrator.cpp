@@ -266,6 +266,17 @@ TEST(Integrator, PhiFunctionsAreSmoothAcrossTheSeriesSwitches)
   }
 }
 
+TEST(Integrator, PhiFunctionsPastTheUnderflowOfTheExponentialAreTheDirectForms)
+{
+  for (double z : {745.0, 745.2, 745.3, 1e4, 2.4e5, 1e300}) {
+    const double decay = std::exp(-z);
+    const Phi p = phis(z);
+    EXPECT_EQ(p.decay, decay) << z;
+    EXPECT_EQ(p.phi1, (1.0 - decay) / z) << z;
+    EXPECT_EQ(p.phi2, (z - 1.0 + decay) / (z * z)) << z;
+  }
+}
+
 TEST(Integrator, PhiMemoGivesTheSameStepAndFollowsTheRate)
 {
   double memo[PHI_MEMO_SIZE] = {std::nan(""), 0.0, 0.0, 0.0};
