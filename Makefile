@@ -48,7 +48,7 @@ check-sanitize: build
 	  UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1 && ctest -j $(JOBS) --output-on-failure -E '\.np2$$' && \
 	  ctest -j $(JOBS) --output-on-failure -R '(lubrication|layers_hdf5|restart_state|uniform_fast_path)\.np2$$'
 
-# The current LAMMPS (Debian sid's source package, 8-9 min to build at -j2 the first time): SEDIMENT
+# The current LAMMPS (Debian sid's source package, about 7 min to build at -j2 the first time): SEDIMENT
 # installed in its tree runs every deck test (in-tree route), and this project built against it runs
 # the style checks as a plugin loaded at start and through its lmp_sediment (plugin and driver
 # routes). The LAMMPS tree and build are a cache outside the checkout, shared by every clone on the
