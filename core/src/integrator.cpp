@@ -76,6 +76,20 @@ double time_to_reach(double s0, double c, double k, double target)
   return (target - s0) / c;
 }
 
+// Newton linearisation F(w) ~ F(s_eval) + F'(s_eval) (w - s) of the drag about the slip s, as the
+// slip's equation ds/dt = c - rate s; force is F(s_eval), for the secant rate across the slip.
+struct Linearised {
+  double force;
+  double rate;
+  double c;
+};
+
+Linearised linearise(const SphereDrag &drag, double mass, double s_eval, double s, double a_par)
+{
+  const auto [force, slope] = drag.model->force_and_tangent(drag.diameter, s_eval, drag.scale);
+  return {force, slope / mass, a_par - (force - slope * s) / mass};
+}
+
 struct AlongSlip {
   double speed;
   double distance;
@@ -108,10 +122,9 @@ AlongSlip advance_along(const SphereDrag &drag, double mass, double s, double a_
       s_eval = drive > jumps[j].force_above ? s * (1.0 + 1e-11) : s * (1.0 - 1e-11);
     }
 
-    // Newton linearisation F(w) ~ F(s) + F'(s) (w - s) around the current slip.
-    const auto [force, slope] = model.force_and_tangent(d, s_eval, drag.scale);
-    rate = slope / mass;
-    const double c = a_par - (force - slope * s) / mass;
+    const Linearised lin = linearise(drag, mass, s_eval, s, a_par);
+    rate = lin.rate;
+    const double c = lin.c;
     const Segment full = advance(s, c, rate, left);
 
     // First set-valued point crossed on the way from s to full.speed.
@@ -169,12 +182,11 @@ StepCorrection nonlinear_step_initial(const SphereDrag &drag, double mass, const
   if (drag.model->smooth()) {
     // No set-valued point to stop at: one evaluation of the law gives the Newton step along the
     // slip (the piecewise advance below, in one piece) and the secant rate across it.
-    const DragModel::ForceSlope fs = drag.model->force_and_tangent(drag.diameter, s, drag.scale);
-    const double rate = fs.slope / mass;
-    const Phi p = phis(rate * dt);
-    const Segment full = advance(p, s, a_par - (fs.force - fs.slope * s) / mass, dt);
-    along = {full.speed, full.distance, rate, SlipState::Free};
-    rate_across = s > 0.0 ? fs.force / (s * mass) : rate;
+    const Linearised lin = linearise(drag, mass, s, s, a_par);
+    const Phi p = phis(lin.rate * dt);
+    const Segment full = advance(p, s, lin.c, dt);
+    along = {full.speed, full.distance, lin.rate, SlipState::Free};
+    rate_across = s > 0.0 ? lin.force / (s * mass) : lin.rate;
     corr.along = dt * p.phi2;
   } else {
     const double static_force = drag.model->static_force(drag.diameter, drag.scale);
