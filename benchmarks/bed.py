@@ -14,6 +14,7 @@ from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE.parent / "python"))
+from sediment.cli.types import count  # noqa: E402
 from sediment.sim.run import run_batch  # noqa: E402
 
 SPLITS = {"z": "LAMMPS's default split (along z, the tall axis)",
@@ -23,8 +24,8 @@ SPLITS = {"z": "LAMMPS's default split (along z, the tall axis)",
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("--steps", type=int, default=1000)
-    parser.add_argument("--repeats", type=int, default=2)
+    parser.add_argument("--steps", type=count, default=1000)
+    parser.add_argument("--repeats", type=count, default=2)
     args = parser.parse_args()
     runs = [("z", 1)] + [(split, 2) for split in SPLITS]
     best = {run: float("inf") for run in runs}

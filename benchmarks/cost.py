@@ -15,6 +15,7 @@ from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE.parent / "python"))
+from sediment.cli.types import count  # noqa: E402
 from sediment.sim.run import run_batch  # noqa: E402
 
 SCENES = {"plain": "nve/sphere + gravity (reference)",
@@ -34,9 +35,9 @@ def loop_time(scene: str, particles: int, steps: int) -> float:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("--particles", type=int, default=20000)
-    parser.add_argument("--steps", type=int, default=2000)
-    parser.add_argument("--repeats", type=int, default=3)
+    parser.add_argument("--particles", type=count, default=20000)
+    parser.add_argument("--steps", type=count, default=2000)
+    parser.add_argument("--repeats", type=count, default=3)
     args = parser.parse_args()
     times = {s: float("inf") for s in SCENES}
     for _ in range(args.repeats):
