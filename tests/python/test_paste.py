@@ -57,8 +57,8 @@ def test_energy_lost_is_the_work_of_the_paste(diameter, fall):
 
 
 def test_unknown_submergence_is_refused():
-    out = run_batch(paste.EXAMPLES / "in.ball_in_paste", {"submergence": "maybe"}, check=False)
-    assert out.error == "ERROR: submergence must be yes or no, not maybe"
+    out = run_batch(paste.EXAMPLES / "in.ball_in_paste", {"effect_submergence": "maybe"}, check=False)
+    assert out.error == "ERROR: effect_submergence must be yes or no, not maybe"
 
 
 def test_funnel_pours_every_ball_into_the_mould():

@@ -9,7 +9,7 @@ import pytest
 
 from sediment.lab.psd import PSD, PSDError, discretise, read_psd
 from sediment.lab.readout import SCHEDULES, BuoyancySphere, Column, Hydrometer, Pipette, R_FACTOR, Suspension
-from sediment.lab.synthetic import stokes_column
+from sediment.lab.synthetic import settling_column
 
 PSDS = Path(__file__).resolve().parents[2] / "examples" / "granulometry" / "psd"
 
@@ -59,7 +59,7 @@ def sample5():
     psd = read_psd(PSDS / "sample5.csv")
     times = np.array(sorted(set(SCHEDULES["d422"] + SCHEDULES["d7928"] + SCHEDULES["bravo"]))) * 60.0
     suspension = Suspension(particle_density=2650.0)
-    column = stokes_column(psd, 0.36, np.concatenate([[0.0], times]), 50.0, suspension)
+    column = settling_column(psd, 0.36, np.concatenate([[0.0], times]), 50.0, suspension)
     return psd, column, times
 
 

@@ -53,7 +53,7 @@ def run(args: argparse.Namespace) -> int:
     from ..lab.granulometry import granulometry
     from ..lab.psd import read_psd
     from ..lab.readout import Column, Hydrometer, Suspension
-    from ..lab.synthetic import stokes_column
+    from ..lab.synthetic import settling_column
 
     if args.layers is not None:    # PSD tables that `sediment sample` wrote beside the run
         for option, name in (("psd", "input_psd.csv"), ("simulated", "simulated_psd.csv")):
@@ -81,7 +81,7 @@ def run(args: argparse.Namespace) -> int:
             raise ValueError("give a layer file, or --psd with --stokes-preview for an analytic column")
         suspension = Suspension(particle_density=args.particle_density)
         times = np.concatenate([[0.0], np.geomspace(10.0, 1440 * 60.0, 400)])
-        column = stokes_column(psd, args.height, times, args.concentration, suspension)
+        column = settling_column(psd, args.height, times, args.concentration, suspension)
         title = f"{args.psd.name}: Stokes settling preview (no DEM)"
     instruments = ["hydrometer", "buoyancy", "pipette"] if args.instrument == "all" else [args.instrument]
     hydrometer = Hydrometer.measured(*args.hydrometer) if args.hydrometer else None

@@ -15,6 +15,23 @@ def add_parser(commands) -> argparse.ArgumentParser:
                                  "particles placed in a sub-volume of the cylinder, data file and ready deck")
     parser.add_argument("psd", type=Path, help="PSD table (CSV: diameter_um,percent_finer)")
     parser.add_argument("--out", type=Path, default=Path("out/sample"), help="output folder")
+    add_test_options(parser)
+    parser.add_argument("--particles", type=count, default=20000,
+                        help="simulated particles, as parcels of equal real mass (weights)")
+    parser.add_argument("--real-grains", action="store_true",
+                        help="one atom per real grain at the real concentration (eq. 15 counts, at least one "
+                             "per class); needed with --contacts or --lubrication")
+    parser.add_argument("--law", default="dallavalle", choices=["stokes", "schiller-naumann", "dallavalle"])
+    parser.add_argument("--hindered", action="store_true", help="Di Felice drag on the local concentration")
+    parser.add_argument("--contacts", action="store_true", help="Hertz contacts between grains and with the floor")
+    parser.add_argument("--lubrication", action="store_true", help="squeeze-film lubrication (with contacts)")
+    parser.add_argument("--courant", type=positive, default=1.0,
+                        help="layers the fastest grain in suspension may cross per step")
+    return parser
+
+
+def add_test_options(parser: argparse.ArgumentParser) -> None:
+    """The options that describe the test itself (shared with `sediment plan`)."""
     parser.add_argument("--geometry", default="column", choices=["column", "slab"],
                         help="3D periodic column, or Bravo et al.'s 2D slab of the cylinder's axial section")
     parser.add_argument("--cylinder", default="d422", choices=["d422", "bravo"],
@@ -25,33 +42,26 @@ def add_parser(commands) -> argparse.ArgumentParser:
     parser.add_argument("--mass", type=positive, default=0.060, help="dry sample mass [kg]")
     parser.add_argument("--particle-density", type=positive, default=SOIL_PARTICLE_DENSITY, help="[kg/m3]")
     parser.add_argument("--classes", type=count, default=40, help="log-spaced size classes (eq. 15)")
-    parser.add_argument("--particles", type=count, default=20000,
-                        help="simulated particles, as parcels of equal real mass (weights)")
-    parser.add_argument("--real-grains", action="store_true",
-                        help="one atom per real grain at the real concentration (eq. 15 counts, at least one "
-                             "per class); needed with --contacts or --lubrication")
-    parser.add_argument("--law", default="dallavalle", choices=["stokes", "schiller-naumann", "dallavalle"])
-    parser.add_argument("--hindered", action="store_true", help="Di Felice drag on the local concentration")
-    parser.add_argument("--contacts", action="store_true", help="Hertz contacts between grains and with the floor")
-    parser.add_argument("--lubrication", action="store_true", help="squeeze-film lubrication (with contacts)")
     parser.add_argument("--layers", type=count, default=400, help="layers of the concentration grid")
     parser.add_argument("--t-end", type=positive, default=86400.0, help="simulated time [s] (default 24 h)")
-    parser.add_argument("--courant", type=positive, default=1.0,
-                        help="layers the fastest grain in suspension may cross per step")
     parser.add_argument("--seed", type=int, default=1, help="placement seed")
-    return parser
+
+
+def cylinder_of(args: argparse.Namespace):
+    """The cylinder the test options name."""
+    from ..sim.scene import Cylinder
+
+    cylinder = Cylinder.bravo() if args.cylinder == "bravo" else Cylinder()
+    return cylinder if args.height is None else Cylinder(cylinder.area, args.height)
 
 
 def run(args: argparse.Namespace) -> int:
     """Plans the scene, prints it and writes its data file, deck and PSD tables."""
     from ..lab.psd import read_psd
     from ..lab.readout import Suspension
-    from ..sim.scene import Cylinder, Effects, describe, plan, write
+    from ..sim.scene import Effects, describe, plan, write
 
-    cylinder = Cylinder.bravo() if args.cylinder == "bravo" else Cylinder()
-    if args.height is not None:
-        cylinder = Cylinder(cylinder.area, args.height)
-    scene = plan(read_psd(args.psd), geometry=args.geometry, cylinder=cylinder, mass=args.mass,
+    scene = plan(read_psd(args.psd), geometry=args.geometry, cylinder=cylinder_of(args), mass=args.mass,
                  suspension=Suspension(particle_density=args.particle_density), width=args.width,
                  classes=args.classes, particles=None if args.real_grains else args.particles,
                  effects=Effects(args.law, args.hindered, args.contacts, args.lubrication),

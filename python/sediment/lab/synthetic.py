@@ -1,8 +1,12 @@
 # SPDX-License-Identifier: GPL-2.0-or-later
 """Layer profiles built analytically, without a simulation: each size class of a PSD leaves the
-top of an initially uniform column at its Stokes velocity (no hindrance, no deposit). The readouts
-must recover the PSD from these; they are also a quick preview of a test before running DEM."""
+top of an initially uniform column at its own constant speed (Stokes' law unless told otherwise; no
+deposit). The readouts must recover the PSD from the Stokes column; they are also a quick preview of
+a test before running DEM, and with other speeds (a drag law, hindrance) the effects planner's
+estimate of how much an effect moves the readings."""
 from __future__ import annotations
+
+from typing import Callable
 
 import numpy as np
 
@@ -10,9 +14,10 @@ from .psd import PSD, log_classes
 from .readout import Column, Suspension
 
 
-def stokes_column(psd: PSD, height: float, times, initial_concentration: float, suspension: Suspension = Suspension(),
-                  layers: int = 2000, classes: int = 600) -> Column:
-    """An analytic column in which every size class leaves the top at its Stokes speed.
+def settling_column(psd: PSD, height: float, times, initial_concentration: float, suspension: Suspension = Suspension(),
+                    layers: int = 2000, classes: int = 600,
+                    speed: Callable[[np.ndarray], np.ndarray] | None = None) -> Column:
+    """An analytic column in which every size class leaves the top at a constant speed.
 
     Parameters
     ----------
@@ -28,6 +33,8 @@ def stokes_column(psd: PSD, height: float, times, initial_concentration: float, 
         Water and solids (Stokes' law).
     layers, classes : int
         Layers of the column, size classes of the PSD.
+    speed : callable, optional
+        Settling speed [m/s] of an array of diameters [m]; default Stokes' law.
 
     Returns
     -------
@@ -35,7 +42,7 @@ def stokes_column(psd: PSD, height: float, times, initial_concentration: float, 
     """
     diameter, share = log_classes(psd, psd.diameter[0], psd.diameter[-1], classes)
     share[0] += psd.percent_finer[0] / 100.0    # mass below the table's first diameter settles with the finest class
-    speed = suspension.stokes_speed(diameter)
+    speed = (speed or suspension.stokes_speed)(diameter)
     edges = np.linspace(0.0, height, layers + 1)
     phi0 = initial_concentration / suspension.particle_density
     times = np.asarray(times, float)

@@ -131,7 +131,7 @@ class BallDrop:
 def drop_ball(diameter: float, fall: float, submergence: bool = True, dt: float = 1e-5,
               trace: Path | None = None) -> BallDrop:
     """Drops one ball into the paste (in.ball_in_paste) and reports where and when it stopped."""
-    variables = {"d": diameter, "fall": fall, "submergence": "yes" if submergence else "no", "dt": dt}
+    variables = {"d": diameter, "fall": fall, "effect_submergence": "yes" if submergence else "no", "dt": dt}
     if trace is not None:
         variables.update(trace="yes", trace_file=Path(trace).resolve())
     out = run_batch(EXAMPLES / "in.ball_in_paste", variables)

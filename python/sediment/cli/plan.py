@@ -1,0 +1,115 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
+"""sediment plan: which effects a scene calls for, from screening numbers and measured changes."""
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+from .sample import add_test_options, cylinder_of
+from .types import count, positive, positive_list
+
+
+def _counts(text: str) -> list[int]:
+    return [count(word) for word in text.split(",")]
+
+
+def _ladder(text: str) -> tuple[str, list[str]]:
+    name, sep, values = text.partition("=")
+    if not sep or not name.strip() or not values.strip():
+        raise argparse.ArgumentTypeError(f"a ladder is NAME=RICHEST,...,CHEAPEST, got '{text}'")
+    return name.strip(), [v.strip() for v in values.split(",")]
+
+
+def _setting(text: str) -> tuple[str, str]:
+    name, sep, value = text.partition("=")
+    if not sep or not name.strip() or not value.strip():
+        raise argparse.ArgumentTypeError(f"a setting is NAME=VALUE, got '{text}'")
+    return name.strip(), value.strip()
+
+
+def add_parser(commands) -> argparse.ArgumentParser:
+    """Adds the command and its options."""
+    parser = commands.add_parser(
+        "plan", help="the effects a scene calls for: screening numbers, measured changes and costs, the cheapest "
+        "setting within a tolerance, its deck and a report",
+        description="For a sedimentation test (PSD and the options of `sediment sample`) or a deck with "
+        "'variable effect_NAME index yes' lines (--deck): screens every effect, runs the scene with each effect "
+        "and resolution in question changed against the richest run, chooses the cheapest setting within "
+        "--tolerance, verifies it with a run, and writes OUT/decision (the deck), effects.csv, trials.csv, "
+        "report.json and plan.png. See docs/effects.md.")
+    parser.add_argument("psd", type=Path, nargs="?", help="PSD table of the sample (CSV: diameter_um,percent_finer)")
+    parser.add_argument("--deck", type=Path, help="plan a deck instead: it reads effect_NAME variables (yes/no), "
+                        "prints RESULT/SERIES observables and may print 'SCREEN number value' lines")
+    parser.add_argument("--tolerance", type=positive, help="largest error allowed: points of percent finer for a test "
+                        "(default 0.5), relative for a deck (default 0.01)")
+    parser.add_argument("--jobs", type=count, default=2, help="runs at once, one core each (default 2)")
+    parser.add_argument("--out", type=Path, default=Path("out/plan"), help="output folder")
+    parser.add_argument("--measure-all", action="store_true",
+                        help="measure every effect, also those the screening settled")
+    parser.add_argument("--screen-only", action="store_true", help="print the screening and stop (no runs)")
+    parser.add_argument("--set", type=_setting, action="append", metavar="NAME=VALUE",
+                        help="fix an effect or resolution instead of planning it (e.g. drag=difelice, "
+                        "particles=20000, contacts=no)")
+    test = parser.add_argument_group("sedimentation test")
+    add_test_options(test)
+    test.add_argument("--instruments", nargs="+", default=["hydrometer", "buoyancy", "pipette"],
+                      choices=["hydrometer", "buoyancy", "pipette"], help="the readings that make the answer")
+    test.add_argument("--particles", type=_counts, default=[40000, 20000, 10000, 5000],
+                      help="parcel ladder, comma-separated (default 40000,20000,10000,5000; the largest is the reference)")
+    test.add_argument("--courant", type=positive_list, default=[1.0, 2.0, 4.0],
+                      help="Courant ladder, comma-separated (default 1,2,4; the smallest is the reference)")
+    deck = parser.add_argument_group("deck")
+    deck.add_argument("--observe", nargs="+", metavar="NAME", help="RESULT or SERIES names the deck prints")
+    deck.add_argument("--ladder", type=_ladder, action="append", metavar="NAME=V1,V2",
+                      help="a resolution variable of the deck, richest value first (e.g. dt=1e-5,2e-5,4e-5)")
+    deck.add_argument("--var", nargs=2, action="append", metavar=("NAME", "VALUE"), help="LAMMPS -var for every run")
+    deck.add_argument("--np", type=count, default=1, help="MPI ranks per deck run")
+    return parser
+
+
+def run(args: argparse.Namespace) -> int:
+    """Screens (and unless --screen-only measures and decides), prints the tables, writes the report."""
+    from ..planner.plan import pin, plan_effects
+    from ..planner.scenes import DeckScene, TestScene
+
+    if (args.psd is None) == (args.deck is None):
+        raise ValueError("give either a PSD table (a sedimentation test) or --deck DECK")
+    if args.deck is not None:
+        tolerance = args.tolerance or 0.01
+        scene = DeckScene(args.deck, args.observe or [], dict(args.ladder or []), tolerance, dict(args.var or []),
+                          args.np)
+        name = args.deck.name
+        if args.screen_only:
+            raise ValueError("a deck is screened from the numbers its reference run prints: --screen-only needs a PSD")
+    else:
+        from ..lab.psd import read_psd
+        from ..lab.readout import Suspension
+        from ..planner.screening import SedimentationTest
+
+        tolerance = args.tolerance or 0.5
+        psd = read_psd(args.psd)
+        test = SedimentationTest(psd, Suspension(particle_density=args.particle_density), cylinder_of(args), args.mass,
+                                 tuple(dict.fromkeys(args.instruments)))
+        options = dict(geometry=args.geometry, width=args.width, classes=args.classes, layers=args.layers,
+                       t_end=args.t_end)
+        scene = TestScene(test, options, args.particles, args.courant, tolerance)
+        name = args.psd.stem
+        if args.screen_only:
+            _print_screens(scene.screens)
+            return 0
+    pin(scene, dict(args.set or []))
+    plan = plan_effects(scene, args.out, tolerance, args.jobs, args.seed if args.deck is None else 1,
+                        args.measure_all, name=name)
+    print(plan.effect_table().text(), end="")
+    print(f"wrote {args.out}/effects.csv, trials.csv, report.json, plan.png; the chosen scene: {args.out / 'decision'}")
+    return 0
+
+
+def _print_screens(screens) -> None:
+    from ..results import Table
+
+    table = Table(["effect", "screening_number", "value", "estimated_change", "verdict"],
+                  notes=[f"{s.effect}: {s.reason}" for s in screens])
+    for s in screens:
+        table.add(s.effect, s.number, f"{s.value:.4g}", "" if s.change is None else f"{s.change:.3g}", s.verdict)
+    print(table.text(), end="")

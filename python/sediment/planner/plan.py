@@ -1,0 +1,337 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
+"""The effects planner (docs/effects.md): screen every effect, measure what screening cannot settle,
+decide the cheapest setting within the tolerance, verify it with a run, and report.
+
+1. The reference trial runs every knob at its richest value.
+2. Each knob value still in question (an effect the screening left to measure, every rung of a
+   resolution ladder) runs as a trial that differs from the reference in that knob alone: its error
+   against the reference and its cost ratio (loop time over the reference's).
+3. Every combination of the measured values is priced: predicted error the sum of its knobs' errors
+   (each effect moves the observables on its own; errors of separate causes add at worst), predicted
+   cost the product of their cost ratios. The cheapest within the tolerance is run to verify it; if it
+   misses, the next cheapest is tried, and the reference is the last resort.
+"""
+from __future__ import annotations
+
+import itertools
+import json
+import math
+from concurrent.futures import ThreadPoolExecutor, as_completed
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+
+from .. import figures
+from ..results import Table, write_text
+from .scenes import Knob, Outcome, prepare
+from .screening import INCLUDE, MEASURE, OMIT, Screen
+
+VERIFY_ATTEMPTS = 3
+
+
+@dataclass
+class Trial:
+    """One run of the planner: a setting of every knob, what it gave and how far from the reference."""
+
+    name: str
+    settings: dict
+    outcome: Outcome = field(default_factory=Outcome)
+    errors: dict[str, float] = field(default_factory=dict)
+    predicted_error: float | None = None
+    predicted_cost: float | None = None
+
+    @property
+    def error(self) -> float:
+        """The worst error over the observables (inf if the run failed)."""
+        return math.inf if self.outcome.failure else max(self.errors.values(), default=0.0)
+
+
+@dataclass
+class Plan:
+    """The planner's evidence and decision for one scene."""
+
+    scene_name: str
+    unit: str                         # "pp" or "relative"
+    tolerance: float
+    knobs: list[Knob]
+    screens: list[Screen]
+    reference: Trial
+    trials: list[Trial]               # one-knob variations of the reference
+    verified: list[Trial]             # the candidates run to verify them, in order
+    decision: Trial
+    fixed: dict[str, tuple]           # knob -> (value, error bound, reason) settled by screening
+    candidates: list[tuple[dict, float, float]]    # every priced combination (settings, error, cost)
+    command: str = ""
+
+    @property
+    def speedup(self) -> float:
+        """Reference loop time over the decision's."""
+        return self.reference.outcome.loop_seconds / self.decision.outcome.loop_seconds
+
+    def effect_table(self) -> Table:
+        """Per knob value: what it leaves out, the screening number, estimated and measured change,
+        cost ratio, verdict; then the effects that are not knobs, with their screening."""
+        unit = "pp" if self.unit == "pp" else "rel"
+        table = Table(["knob", "value", "leaves_out", "screening_number", "screening_value", f"estimated_change_{unit}",
+                       f"measured_change_{unit}", "cost_ratio", "verdict"], notes=self.notes())
+        screens = {s.effect: s for s in self.screens}
+        ref_loop = self.reference.outcome.loop_seconds
+        for knob in self.knobs:
+            chosen = self.decision.settings[knob.name]
+            why = self.fixed[knob.name][2] if knob.name in self.fixed else "measured"
+            for k, value in enumerate(knob.values[1:]):
+                s = screens.get(knob.drops[k]) if k < len(knob.drops) else None
+                trial = next((t for t in self.trials if t.settings[knob.name] == value), None)
+                table.add(knob.name, value, s.label if s else "", s.number if s else "", f"{s.value:.4g}" if s else "",
+                          f"{s.change:.3g}" if s and s.change is not None else "",
+                          f"{trial.error:.3g}" if trial else "",
+                          f"{trial.outcome.loop_seconds / ref_loop:.3g}" if trial and not trial.outcome.failure else "",
+                          ("chosen" if chosen == value else f"keep {chosen}") + f" ({why})")
+        knobbed = {d for k in self.knobs for d in k.drops}
+        for s in self.screens:
+            if s.effect not in knobbed:
+                table.add(s.effect, "", s.label, s.number, f"{s.value:.4g}", f"{s.change:.3g}" if s.change is not None else "",
+                          "", "", f"{s.verdict}: {s.reason}")
+        return table
+
+    def notes(self) -> list[str]:
+        """The decision in words."""
+        d, r = self.decision, self.reference
+        unit = "pp" if self.unit == "pp" else "(relative)"
+        lines = [f"reference (richest): {_describe(r.settings)}, loop {r.outcome.loop_seconds:.3g} s",
+                 f"decision: {_describe(d.settings)}: error {d.error:.3g} {unit} (tolerance {self.tolerance:g}), "
+                 f"loop {d.outcome.loop_seconds:.3g} s, {self.speedup:.3g}x faster than the reference"]
+        if self.command:
+            lines.append(f"as options: {self.command}")
+        for t in self.verified:
+            if t is not d:
+                verdict = "rejected" if t.error > self.tolerance else "also within the tolerance"
+                lines.append(f"verified, {verdict}: {_describe(t.settings)} (predicted {t.predicted_error:.3g}, "
+                             f"measured {t.error:.3g}, loop {t.outcome.loop_seconds:.3g} s)")
+        knobbed = {d for k in self.knobs for d in k.drops}
+        for s in self.screens:
+            if s.verdict == MEASURE and s.effect not in knobbed:
+                lines.append(f"not measurable in this scene: {s.label} (bound {s.change if s.change is not None else '?'}"
+                             f"{'' if s.change is None else ' ' + unit}): left out")
+        return lines
+
+    def table(self) -> Table:
+        """The effects table (see effect_table)."""
+        return self.effect_table()
+
+    def trial_table(self) -> Table:
+        """Every run: its settings, loop time, errors per observable."""
+        names = sorted(self.reference.errors) or sorted(self.reference.outcome.observations)
+        table = Table(["trial", *[k.name for k in self.knobs], "loop_s", "status",
+                       *[f"error_{n}" for n in names], "max_error", "predicted_error", "predicted_cost_ratio"])
+        for t in [self.reference, *self.trials, *self.verified]:
+            table.add(t.name, *[t.settings[k.name] for k in self.knobs], f"{t.outcome.loop_seconds:.4g}",
+                      "failed: " + t.outcome.failure if t.outcome.failure else "ok",
+                      *[f"{t.errors.get(n, math.nan):.4g}" for n in names], f"{t.error:.4g}",
+                      "" if t.predicted_error is None else f"{t.predicted_error:.4g}",
+                      "" if t.predicted_cost is None else f"{t.predicted_cost:.4g}")
+        return table
+
+    def as_dict(self) -> dict:
+        """Everything in the report, for scripts (report.json)."""
+        def trial(t: Trial) -> dict:
+            return {"name": t.name, "settings": t.settings, "loop_seconds": t.outcome.loop_seconds,
+                    "failure": t.outcome.failure, "errors": t.errors, "error": t.error if math.isfinite(t.error) else None,
+                    "predicted_error": t.predicted_error, "predicted_cost_ratio": t.predicted_cost}
+        return {"scene": self.scene_name, "unit": self.unit, "tolerance": self.tolerance,
+                "knobs": [{"name": k.name, "kind": k.kind, "values": list(k.values)} for k in self.knobs],
+                "screening": [s.__dict__ for s in self.screens], "fixed": {k: {"value": v, "bound": b, "reason": w} for k, (v, b, w) in self.fixed.items()},
+                "reference": trial(self.reference), "trials": [trial(t) for t in self.trials],
+                "verified": [trial(t) for t in self.verified], "decision": trial(self.decision),
+                "speedup": self.speedup, "command": self.command,
+                "candidates": [{"settings": s, "predicted_error": e, "predicted_cost_ratio": c}
+                               for s, e, c in self.candidates]}
+
+    def save(self, folder: Path) -> list[Path]:
+        """effects.csv, trials.csv, report.json, plan.png."""
+        folder = Path(folder)
+        return [write_text(folder / "effects.csv", self.effect_table().csv()),
+                write_text(folder / "trials.csv", self.trial_table().csv()),
+                write_text(folder / "report.json", json.dumps(self.as_dict(), indent=1, default=str) + "\n"),
+                self.plot(folder / "plan.png")]
+
+    def plot(self, path: Path) -> Path:
+        """Error against cost: every priced candidate, the measured trials, the decision."""
+        plt = figures.pyplot()
+        fig, ax = plt.subplots(figsize=(7.5, 5))
+        floor = self.tolerance / 100
+        costs = [c for _, _, c in self.candidates]
+        ax.scatter(costs, [max(e, floor) for _, e, _ in self.candidates], s=12, color="0.7",
+                   label="candidates (predicted)")
+        ax.scatter([], [], marker="o", color="C0", label="one knob changed (measured)")
+        ref = self.reference.outcome.loop_seconds
+        for t in self.trials:
+            if not t.outcome.failure:
+                ax.scatter(t.outcome.loop_seconds / ref, max(t.error, floor), marker="o", color="C0")
+                ax.annotate(t.name, (t.outcome.loop_seconds / ref, max(t.error, floor)), fontsize=7,
+                            xytext=(3, 3), textcoords="offset points")
+        for t in self.verified:
+            if t.outcome.failure:
+                continue
+            if t is self.decision:
+                color, label = "C2", "decision (verified)"
+            else:
+                color, label = ("C3", "rejected on verification") if t.error > self.tolerance else ("C1", "verified, dearer")
+            ax.scatter(t.outcome.loop_seconds / ref, max(t.error, floor), marker="s", color=color, s=50, label=label)
+        ax.scatter([1.0], [floor], marker="*", s=120, color="k", label="reference (error 0)")
+        ax.axhline(self.tolerance, color="g", ls="--", lw=1, label=f"tolerance {self.tolerance:g}")
+        ax.set(xscale="log", yscale="log", xlabel="loop time / reference's",
+               ylabel="largest error of a reading [pp]" if self.unit == "pp" else "largest relative error",
+               title=f"{self.scene_name}: error against cost")
+        ax.legend(fontsize=7)
+        return figures.save(fig, path)
+
+
+def _describe(settings: dict) -> str:
+    return ", ".join(f"{k}={v}" for k, v in settings.items())
+
+
+def pin(scene, pins: dict[str, str]) -> None:
+    """Fixes knobs at the user's values (NAME=VALUE): they are no longer planned, and the reference
+    runs with them."""
+    knobs = {k.name: k for k in scene.knobs}
+    for name, text in pins.items():
+        if name not in knobs:
+            raise ValueError(f"unknown effect or resolution '{name}': this scene has {', '.join(knobs)}")
+        knob = knobs[name]
+        if knob.kind == "effect":
+            value = next((v for v in knob.values if str(v) == text), None)
+            if value is None:
+                raise ValueError(f"{name} takes {', '.join(str(v) for v in knob.values)}, not '{text}'")
+        else:
+            value = type(knob.values[0])(float(text)) if isinstance(knob.values[0], (int, float)) else text
+        knobs[name] = replace(knob, values=(value,), drops=())
+    scene.knobs = list(knobs.values())
+
+
+def plan_effects(scene, out: Path, tolerance: float, jobs: int = 2, seed: int = 1, measure_all: bool = False,
+                 progress: bool = True, name: str = "scene") -> Plan:
+    """Screens, measures, decides and verifies; writes the trial runs under ``out/runs`` and the
+    chosen scene under ``out/decision``.
+
+    Parameters
+    ----------
+    scene : TestScene or DeckScene
+        The knobs and how to run them.
+    out : Path
+        Output folder.
+    tolerance : float
+        Largest error allowed (pp of percent finer for a test, relative for a deck).
+    jobs : int
+        Trials run at once (one rank each).
+    seed : int
+        Placement seed of every run (a test), so the report is reproducible.
+    measure_all : bool
+        Measure every effect, also those the screening settled.
+    progress : bool
+        Show a progress bar.
+
+    Returns
+    -------
+    Plan
+    """
+    if not (math.isfinite(tolerance) and tolerance > 0):
+        raise ValueError(f"the tolerance must be > 0, not {tolerance:g}")
+    if jobs < 1:
+        raise ValueError("jobs must be >= 1")
+    out = Path(out)
+    runs = prepare(out / "runs")
+    reference = Trial("reference", {k.name: k.values[0] for k in scene.knobs})
+    if scene.screens_from_run:        # a deck prints its screening numbers: run it first
+        _run_all(scene, [reference], runs, seed, 1, progress, "reference")
+        scene.screen_printed(reference.outcome.printed)
+    screens = {s.effect: s for s in scene.screens}
+    fixed: dict[str, tuple] = {}      # knob -> (value, error bound, why) when screening settled it
+    trials: list[Trial] = []
+    for knob in scene.knobs:
+        settled = None if measure_all else _screened(knob, screens)
+        if settled is not None:
+            fixed[knob.name] = settled
+            continue
+        trials += [Trial(knob.label(v), dict(reference.settings, **{knob.name: v})) for v in knob.values[1:]]
+    _run_all(scene, trials if scene.screens_from_run else [reference, *trials], runs, seed, jobs, progress, "measure")
+    if reference.outcome.failure:
+        raise RuntimeError(f"the reference run failed: {reference.outcome.failure}")
+    for t in trials:
+        if not t.outcome.failure:
+            t.errors = scene.error(t.outcome.observations, reference.outcome.observations)
+
+    options = {}                      # knob -> [(value, error, cost ratio)]
+    for knob in scene.knobs:
+        if knob.name in fixed:
+            value, bound, _ = fixed[knob.name]
+            options[knob.name] = [(value, bound, 1.0)]
+            continue
+        options[knob.name] = [(knob.values[0], 0.0, 1.0)] + [
+            (t.settings[knob.name], t.error, t.outcome.loop_seconds / reference.outcome.loop_seconds)
+            for t in trials if t.settings[knob.name] != knob.values[0] and not t.outcome.failure]
+    candidates = []
+    for combo in itertools.product(*options.values()):
+        settings = dict(zip(options, (v for v, _, _ in combo)))
+        candidates.append((settings, sum(e for _, e, _ in combo), math.prod(c for _, _, c in combo)))
+    candidates.sort(key=lambda c: (c[2], c[1]))
+    # The cheapest candidates within the tolerance are verified `jobs` at a time (alike in load to the
+    # measured trials, so their loop times compare); of a batch, the fastest that holds is the decision.
+    within = [c for c in candidates if c[1] <= tolerance][:VERIFY_ATTEMPTS]
+    verified: list[Trial] = []
+    decision = None
+    while within and decision is None:
+        batch, within = within[:jobs], within[jobs:]
+        if batch[0][0] == reference.settings:
+            decision = reference
+            break
+        batch = [Trial(f"decision-{len(verified) + k + 1}", settings, predicted_error=error, predicted_cost=cost)
+                 for k, (settings, error, cost) in enumerate(batch) if settings != reference.settings]
+        _run_all(scene, batch, runs, seed, jobs, progress, "verify")
+        for trial in batch:
+            if not trial.outcome.failure:
+                trial.errors = scene.error(trial.outcome.observations, reference.outcome.observations)
+            verified.append(trial)
+        decision = min((t for t in batch if t.error <= tolerance), key=lambda t: t.outcome.loop_seconds, default=None)
+    if decision is None:
+        decision = reference
+    scene.write(decision.settings, out / "decision", seed)
+    plan = Plan(name, scene.unit, tolerance, scene.knobs, scene.screens, reference, trials, verified, decision, fixed,
+                candidates, scene.describe(decision.settings))
+    plan.save(out)
+    return plan
+
+
+def _screened(knob: Knob, screens: dict[str, Screen]) -> tuple | None:
+    """(value, error bound, reason) when the screening settles an effect knob: the cheapest value
+    that only leaves out effects screened as negligible, if the next step leaves out one screened as
+    needed (or there is none); None when a step in between needs measuring."""
+    if knob.kind != "effect" or not knob.drops or any(d not in screens for d in knob.drops):
+        return None
+    bound, reasons = 0.0, []
+    for k, dropped in enumerate(knob.drops):
+        s = screens[dropped]
+        if s.verdict == MEASURE:
+            return None
+        if s.verdict == INCLUDE:
+            return knob.values[k], bound, "; ".join(reasons + [f"needs {s.label}: {s.reason}"])
+        bound += s.change or 0.0
+        reasons.append(f"without {s.label}: {s.reason}")
+    return knob.values[-1], bound, "; ".join(reasons)
+
+
+def _run_all(scene, trials: list[Trial], runs: Path, seed: int, jobs: int, progress: bool, what: str) -> None:
+    """Runs the trials, `jobs` at a time, with a progress bar."""
+    if not trials:
+        return
+    bar = None
+    if progress:
+        from tqdm import tqdm
+        bar = tqdm(total=len(trials), desc=f"plan: {what}", unit="run")
+    with ThreadPoolExecutor(max_workers=jobs) as pool:
+        futures = {pool.submit(scene.run, t.settings, runs / t.name, seed): t for t in trials}
+        for future in as_completed(futures):
+            futures[future].outcome = future.result()
+            if bar is not None:
+                bar.update()
+    if bar is not None:
+        bar.close()

@@ -1,0 +1,285 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
+"""The scenes the planner can measure, each as a set of knobs (an effect or a resolution, values
+ordered from the richest to the cheapest) and a way to run one setting of them and score it.
+
+- `TestScene`: a sedimentation test written by `sediment sample`; knobs law, hindered, particles
+  and courant; observables the instruments' readings, errors in points of percent finer.
+- `DeckScene`: any deck that reads ``variable effect_NAME index yes`` for each effect it can switch
+  (and any ladder variables given), prints its observables as ``RESULT``/``SERIES`` lines (as for
+  `sediment sweep`) and may print ``SCREEN number value`` lines; errors relative.
+"""
+from __future__ import annotations
+
+import math
+import re
+import shutil
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from ..sim.run import run_batch
+from .screening import INCLUDE, MEASURE, OMIT, Screen, SedimentationTest, screen
+
+MARKER = ".sediment-plan"    # in a folder of trial runs: the planner owns it and may empty it
+
+
+@dataclass(frozen=True)
+class Knob:
+    """Something the planner can set: an effect or a resolution, richest value first. For an effect,
+    `drops[k]` names the screened effect that going from values[k] to values[k + 1] leaves out."""
+
+    name: str
+    values: tuple
+    kind: str                 # "effect" or "resolution"
+    drops: tuple = ()
+
+    def label(self, value) -> str:
+        """name=value, as trials and reports name a setting."""
+        return f"{self.name}={value}"
+
+
+@dataclass
+class Outcome:
+    """What one run of a setting gave."""
+
+    loop_seconds: float = math.nan
+    wall_seconds: float = math.nan
+    observations: dict[str, tuple[np.ndarray, np.ndarray]] = field(default_factory=dict)    # name: (x, y)
+    failure: str | None = None
+    printed: dict[str, float] = field(default_factory=dict)    # SCREEN numbers a deck printed
+
+
+def prepare(folder: Path) -> Path:
+    """A folder of trial runs, emptied if a previous plan left it (it carries the planner's marker);
+    any other existing non-empty folder is refused rather than overwritten."""
+    folder = Path(folder)
+    if folder.exists() and any(folder.iterdir()):
+        if not (folder / MARKER).is_file():
+            raise ValueError(f"{folder} exists and was not written by sediment plan: choose another --out")
+        shutil.rmtree(folder)
+    folder.mkdir(parents=True)
+    (folder / MARKER).write_text("runs of sediment plan; emptied by the next plan in this folder\n")
+    return folder
+
+
+# The drag of a test, richest first: Di Felice's hindrance on Dallavalle's curve, Dallavalle's curve,
+# Stokes' law; as (law, hindered) of sim.scene.Effects.
+DRAG = {"difelice": ("dallavalle", True), "dallavalle": ("dallavalle", False), "stokes": ("stokes", False)}
+
+
+class TestScene:
+    """A sedimentation test (`sediment sample` options) as knobs and runs."""
+
+    unit = "pp"
+    screens_from_run = False          # screened from the PSD and the cylinder, before any run
+
+    def __init__(self, test: SedimentationTest, options: dict, particles: list[int], courant: list[float],
+                 tolerance: float):
+        self.test = test
+        self.options = options              # further keyword arguments of scene.plan
+        self.tolerance = tolerance
+        self.screens = screen(test, tolerance)
+        if not particles or any(p < 1 for p in particles):
+            raise ValueError("the particle ladder needs at least one count >= 1")
+        if not courant or any(not c > 0 for c in courant):
+            raise ValueError("the courant ladder needs at least one value > 0")
+        self.knobs = [Knob("drag", tuple(DRAG), "effect", ("hindered", "law")),
+                      Knob("particles", tuple(sorted(set(particles), reverse=True)), "resolution"),
+                      Knob("courant", tuple(sorted(set(courant))), "resolution")]
+
+    def describe(self, settings: dict) -> str:
+        """The `sediment sample` options of a setting."""
+        law, hindered = DRAG[settings["drag"]]
+        return (f"--law {law}{' --hindered' if hindered else ''} "
+                f"--particles {settings['particles']} --courant {settings['courant']:g}")
+
+    def _scene(self, settings: dict, seed: int):
+        from ..sim.scene import Effects, plan
+        t = self.test
+        return plan(t.psd, cylinder=t.cylinder, mass=t.mass, suspension=t.suspension, seed=seed,
+                    particles=int(settings["particles"]), courant=float(settings["courant"]),
+                    effects=Effects(*DRAG[settings["drag"]]), **self.options)
+
+    def write(self, settings: dict, folder: Path, seed: int) -> Path:
+        """Writes the scene of a setting into `folder`; returns its deck."""
+        from ..sim.scene import write
+        write(self._scene(settings, seed), Path(folder))
+        return Path(folder) / "in.sedimentation"
+
+    def run(self, settings: dict, folder: Path, seed: int) -> Outcome:
+        """Writes and runs a setting (one rank) and reads the instruments from its layer file."""
+        from ..lab.granulometry import read_all
+        from ..lab.readout import Column
+        from ..sim.layers import read_layers
+
+        deck = self.write(settings, folder, seed)
+        out = run_batch(deck, {"overwrite": "yes"}, ranks=1, check=False)
+        outcome = Outcome(sum(s for s, _ in out.loops), out.wall_seconds)
+        if out.error:
+            outcome.failure = out.error
+            return outcome
+        layers = read_layers(Path(folder) / "layers.h5")
+        if not layers.complete:
+            outcome.failure = "the layer file is incomplete"
+            return outcome
+        readings, _ = read_all(Column.from_layers(layers), list(self.test.instruments),
+                               cylinder_area=self.test.cylinder.area)
+        outcome.observations = {r.instrument: (r.time, r.percent_finer) for r in readings}
+        return outcome
+
+    @staticmethod
+    def error(run: dict, reference: dict) -> dict[str, float]:
+        """Largest |P - P_ref| [pp] per instrument, over the reading times both have."""
+        errors = {}
+        for name, (x_ref, y_ref) in reference.items():
+            if name not in run:
+                errors[name] = math.inf
+                continue
+            x, y = run[name]
+            common, i, j = np.intersect1d(x, x_ref, return_indices=True)
+            errors[name] = float(np.max(np.abs(y[i] - y_ref[j]))) if len(common) else math.inf
+        return errors
+
+
+# Screening numbers a deck may print (SCREEN name value), the effect each settles, and how: a bound
+# on the relative change of the observables, or a rule on the number itself.
+def _hindrance_bound(phi: float) -> float:
+    return 1 - (1 - phi) ** 4.65            # Richardson & Zaki: the settling speed of the suspension
+
+
+def _inertial_drag_bound(reynolds: float) -> float:
+    return 0.15 * reynolds ** 0.687         # Schiller & Naumann's correction to Stokes drag
+
+
+DECK_SCREENS = {
+    "solid_fraction": ("hindered", "initial solid fraction", _hindrance_bound),
+    "reynolds": ("law", "largest particle Reynolds number", _inertial_drag_bound),
+    "yield_number": ("yield", "yield number tau_y / (drho g d)", None),
+    "grains": ("contacts", "grains in the scene", None),
+    "surface_crossings": ("submergence", "grains crossing the free surface", None),
+}
+
+
+def deck_text(deck: Path, depth: int = 0) -> str:
+    """A deck's text with the files it includes (by a literal name, from its folder) in place."""
+    if depth > 8:
+        raise ValueError(f"{deck}: includes nest more than 8 deep")
+    lines = []
+    for line in Path(deck).read_text().splitlines():
+        words = line.split()
+        if len(words) >= 2 and words[0] == "include" and "$" not in words[1]:
+            included = Path(deck).parent / words[1]
+            if included.is_file():
+                lines.append(deck_text(included, depth + 1))
+                continue
+        lines.append(line)
+    return "\n".join(lines)
+
+
+class DeckScene:
+    """A deck with effect variables (and ladder variables) as knobs and runs."""
+
+    unit = "relative"
+    screens_from_run = True           # screened from the SCREEN lines of the reference run
+
+    def __init__(self, deck: Path, observables: list[str], ladders: dict[str, list[str]], tolerance: float,
+                 variables: dict[str, str] | None = None, ranks: int = 1):
+        self.deck = Path(deck).resolve()
+        if not self.deck.is_file():
+            raise FileNotFoundError(f"{deck}: no such deck")
+        if not observables:
+            raise ValueError("nothing to observe: give at least one --observe NAME (a RESULT or SERIES the deck prints)")
+        text = deck_text(self.deck)
+        effects = re.findall(r"^\s*variable\s+effect_(\w+)\s+index\s+(\S+)", text, re.MULTILINE)
+        if not effects:
+            raise ValueError(f"{deck}: the deck exposes no effects (no 'variable effect_NAME index yes' lines)")
+        for name, default in effects:
+            if default not in ("yes", "no"):
+                raise ValueError(f"{deck}: effect_{name} must default to yes or no, not '{default}'")
+        for name in ladders:
+            if not re.search(rf"^\s*variable\s+{re.escape(name)}\s+index\s", text, re.MULTILINE):
+                raise ValueError(f"{deck}: the deck has no 'variable {name} index ...' for the ladder to set")
+        self.observables = observables
+        self.tolerance = tolerance
+        self.variables = dict(variables or {})
+        self.ranks = ranks
+        self.knobs = [Knob(name, ("yes", "no"), "effect", (name,)) for name, _ in effects]
+        self.knobs += [Knob(name, tuple(values), "resolution") for name, values in ladders.items()]
+        self.screens: list[Screen] = []
+
+    def describe(self, settings: dict) -> str:
+        """The -var options of a setting."""
+        return " ".join(f"-var {self._variable(k)} {v}" for k, v in settings.items())
+
+    def _variable(self, knob: str) -> str:
+        return knob if any(k.name == knob and k.kind == "resolution" for k in self.knobs) else f"effect_{knob}"
+
+    def screen_printed(self, printed: dict[str, float]) -> None:
+        """Screens the deck's effects from the numbers its reference run printed."""
+        effects = {k.name for k in self.knobs if k.kind == "effect"}
+        for number, value in printed.items():
+            if number not in DECK_SCREENS:
+                continue
+            effect, label, bound = DECK_SCREENS[number]
+            if effect not in effects and not (effect == "contacts" and "lubrication" in effects):
+                continue
+            if bound is not None:
+                change = bound(value)
+                verdict = OMIT if change <= 0.25 * self.tolerance else INCLUDE if change >= 4 * self.tolerance else MEASURE
+                reason = f"changes the observables by about {change:.3g} (relative)"
+            elif number == "grains":
+                change, verdict = None, OMIT if value <= 1 else MEASURE
+                reason = "a single grain has nothing to touch" if value <= 1 else f"{value:g} grains may touch"
+            elif number == "yield_number":
+                change, verdict = None, OMIT if value == 0 else INCLUDE
+                reason = "a Newtonian fluid: no yield machinery" if value == 0 else "the yield stress holds or slows the grains"
+            else:
+                change, verdict = None, OMIT if value == 0 else INCLUDE
+                reason = "no grain crosses the surface" if value == 0 else f"{value:g} grains cross the surface"
+            targets = [effect] + (["lubrication"] if effect == "contacts" and verdict == OMIT else [])
+            for target in targets:
+                if target in effects:
+                    self.screens.append(Screen(target, target, label, value, change, verdict, reason))
+
+    def write(self, settings: dict, folder: Path, seed: int) -> Path:
+        """The deck with the setting's values as the defaults of its index variables."""
+        text = self.deck.read_text()
+        for knob, value in settings.items():
+            name = self._variable(knob)
+            text = re.sub(rf"^(\s*variable\s+{re.escape(name)}\s+index\s+)\S+", lambda m: m.group(1) + str(value),
+                          text, count=1, flags=re.MULTILINE)
+        path = Path(folder) / self.deck.name
+        path.parent.mkdir(parents=True, exist_ok=True)
+        path.write_text(text)
+        return path
+
+    def run(self, settings: dict, folder: Path, seed: int) -> Outcome:
+        """Runs the deck from its own folder with the setting as -var pairs."""
+        from ..studies.sweep import observe
+
+        variables = dict(self.variables, **{self._variable(k): v for k, v in settings.items()})
+        out = run_batch(self.deck, variables, ranks=self.ranks, check=False)
+        outcome = Outcome(sum(s for s, _ in out.loops), out.wall_seconds)
+        if out.error:
+            outcome.failure = out.error
+            return outcome
+        try:
+            found = observe(out.text, self.observables, None)
+        except ValueError as exc:
+            outcome.failure = str(exc)
+            return outcome
+        outcome.observations = {k: (o.x if o.x is not None else np.zeros(1), o.y) for k, o in found.items()}
+        outcome.printed = {w[1]: float(w[2]) for w in (line.split() for line in out.text.splitlines())
+                           if len(w) == 3 and w[0] == "SCREEN"}
+        return outcome
+
+    @staticmethod
+    def error(run: dict, reference: dict) -> dict[str, float]:
+        """Relative error per observable (a series: largest difference over the reference's magnitude)."""
+        from ..studies.sweep import Observation, relative_error
+
+        def as_obs(xy):
+            x, y = xy
+            return Observation(y) if len(y) == 1 and len(x) == 1 and x[0] == 0 else Observation(y, x)
+        return {k: relative_error(as_obs(run[k]), as_obs(ref)) if k in run else math.inf for k, ref in reference.items()}

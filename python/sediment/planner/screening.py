@@ -1,0 +1,228 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
+"""Screening: each candidate effect of a sedimentation test with its dimensionless number and a
+bound on how far it can move the readings, before anything is simulated (docs/effects.md section 2).
+
+An effect that acts through the settling speed is estimated one way for all: each size class of the
+PSD settles at its speed with and without the effect in an analytic column (lab.synthetic), the
+instruments read both columns at their schedules, and the estimate is the largest change of any
+reading in points of percent finer. These are bounds: the column keeps its initial concentration for
+the hindrance and its initial grain counts for the collisions, while both only fall as grains leave.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from .. import _core
+from ..lab.granulometry import read_all
+from ..lab.psd import PSD, log_classes
+from ..lab.readout import SCHEDULES, Hydrometer, Pipette, Suspension
+from ..lab.synthetic import settling_column
+from ..sim.scene import Cylinder
+
+BOLTZMANN = 1.380649e-23      # J/K
+ROOM_TEMPERATURE = 293.15     # K, the 20 C of the water's properties
+BED_PACKING = 0.6             # solid fraction of a settled silt bed (random loose to close packing 0.55-0.64)
+PIPETTE_DEPTH = 0.10          # m, as in the readouts' default
+FILM_REBOUND_STOKES = 10.0    # approach Stokes number below which a squeeze film stops a rebound (Gondret et al. 2002)
+
+INCLUDE, OMIT, MEASURE, REPORT = "include", "omit", "measure", "report only"
+
+# Estimated changes at most OMIT_BELOW x tolerance are dropped without a run; at least INCLUDE_ABOVE x
+# tolerance are kept without one: the bounds are within a factor of a few of the measured changes.
+OMIT_BELOW = 0.25
+INCLUDE_ABOVE = 4.0
+
+
+@dataclass(frozen=True)
+class SedimentationTest:
+    """What the planner needs to know of a test: the sample, the water, the cylinder, the instruments."""
+
+    psd: PSD
+    suspension: Suspension = Suspension()
+    cylinder: Cylinder = Cylinder()
+    mass: float = 0.060
+    instruments: tuple[str, ...] = ("hydrometer", "buoyancy", "pipette")
+
+    @property
+    def initial_concentration(self) -> float:
+        """c0 [kg/m3]."""
+        return self.mass / (self.cylinder.area * self.cylinder.height)
+
+    @property
+    def solid_fraction(self) -> float:
+        """phi0 = c0 / rho_p."""
+        return self.initial_concentration / self.suspension.particle_density
+
+
+@dataclass(frozen=True)
+class Screen:
+    """One effect screened: its number, the estimated change of the readings and the verdict."""
+
+    effect: str            # key, as the planner's trials and the deck options name it
+    label: str
+    number: str            # what `value` is
+    value: float
+    change: float | None   # bound on the largest change of a reading [percentage points], if estimable
+    verdict: str           # include, omit, measure, report only
+    reason: str
+
+
+def terminal_speeds(suspension: Suspension, diameter: np.ndarray, law: str = "dallavalle",
+                    voidage: float = 1.0) -> np.ndarray:
+    """Terminal speed [m/s] of each diameter under a drag law (difelice: in a suspension of fluid
+    fraction `voidage`, with plain buoyancy)."""
+    model = _core.DragModel(law, suspension.fluid_density, suspension.viscosity)
+    weight = (suspension.particle_density - suspension.fluid_density) * suspension.gravity * math.pi / 6
+    return np.array([model.steady_speed(float(d), weight * float(d) ** 3, voidage)[0] for d in diameter])
+
+
+class ReadingModel:
+    """The instruments reading analytic columns of one test: `change(speed_a, speed_b)` is the
+    largest difference of any reading [percentage points] between two settling-speed laws."""
+
+    def __init__(self, test: SedimentationTest):
+        self.test = test
+        pipette = Pipette(PIPETTE_DEPTH).default_times(test.suspension)
+        self.times = np.unique(np.concatenate([[0.0], np.array(SCHEDULES["d422"] + SCHEDULES["bravo"]) * 60.0,
+                                               pipette]))
+
+        for name in test.instruments:    # an instrument that cannot read this suspension at all
+            try:
+                self.readings(None, [name])
+            except ValueError as exc:
+                raise ValueError(f"the {name} cannot read this test ({exc}): plan without it (--instruments)") from None
+
+    def readings(self, speed, instruments: list[str] | None = None) -> dict[str, np.ndarray]:
+        """Percent finer of every reading, per instrument, when the classes settle at `speed(d)`."""
+        t = self.test
+        column = settling_column(t.psd, t.cylinder.height, self.times, t.initial_concentration, t.suspension,
+                                 layers=1200, classes=300, speed=speed)
+        found, _ = read_all(column, instruments or list(t.instruments), cylinder_area=t.cylinder.area)
+        return {r.instrument: r.percent_finer for r in found}
+
+    def change(self, speed_a, speed_b) -> float:
+        """max |P_a - P_b| over the instruments' readings."""
+        a, b = self.readings(speed_a), self.readings(speed_b)
+        return max(float(np.max(np.abs(a[k] - b[k]))) for k in a)
+
+
+def encounters(test: SedimentationTest, classes: int = 120) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """The grain-grain contacts of grains settling through the column, per size class, counted with
+    the initial real grain numbers. Class j grains lie in the tube pi (r_i + r_j)^2 |v_i - v_j| / v_i
+    swept per metre of fall; of these the fraction E = 1 - 3 / (2 (1 + q)) + 1 / (2 (1 + q)^3)
+    (Stokes-flow interception, q = small / large radius) touches instead of being carried round. In
+    contact the pair settles at (xi_i v_i + xi_j v_j) / (xi_i + xi_j) (Stokes resistances xi ~ r)
+    until it has slid past, a time (r_i + r_j) / |v_i - v_j|, which costs grain i a distance r_j
+    (gains it, when j is the faster).
+
+    Returns (diameters, mass shares, contacts per grain over the column height, fraction of the fall
+    time lost to them)."""
+    t = test
+    lo, hi = t.psd.span()
+    diameter, share = log_classes(t.psd, lo, hi, classes)
+    share[0] += t.psd.percent_finer[0] / 100.0
+    speed = terminal_speeds(t.suspension, diameter)
+    number = share * t.initial_concentration / (t.suspension.particle_density * math.pi / 6 * diameter ** 3)
+    r = 0.5 * diameter
+    q = np.minimum(r[:, None], r[None, :]) / np.maximum(r[:, None], r[None, :])
+    touching = (1 - 1.5 / (1 + q) + 0.5 / (1 + q) ** 3) * math.pi * (r[:, None] + r[None, :]) ** 2 * number[None, :]
+    closing = (speed[:, None] - speed[None, :]) / speed[:, None]
+    contacts = t.cylinder.height * (touching * np.abs(closing)).sum(axis=1)
+    delay = (touching * closing * r[None, :]).sum(axis=1)
+    return diameter, share, contacts, delay
+
+
+def lowest_sensed_depth(test: SedimentationTest) -> float:
+    """The deepest point any instrument senses [m below the surface]: the hydrometer's bulb bottom
+    at a zero reading, the buoyancy sphere's bottom, the pipette sample's bottom."""
+    depths = []
+    if "hydrometer" in test.instruments:
+        h = Hydrometer.astm_152h()
+        depths.append(h.scale_zero + h.bulb_length)
+    if "buoyancy" in test.instruments:
+        depths.append(0.3 * test.cylinder.height + 0.0125)
+    if "pipette" in test.instruments:
+        depths.append(PIPETTE_DEPTH + (3 * 25e-6 / (4 * math.pi)) ** (1 / 3))
+    return max(depths)
+
+
+def _verdict(change: float, tolerance: float) -> str:
+    if change <= OMIT_BELOW * tolerance:
+        return OMIT
+    return INCLUDE if change >= INCLUDE_ABOVE * tolerance else MEASURE
+
+
+def screen(test: SedimentationTest, tolerance: float = 0.5) -> list[Screen]:
+    """Every candidate effect of a sedimentation test, screened against `tolerance` [percentage points]."""
+    if not tolerance > 0:
+        raise ValueError(f"the tolerance must be > 0 percentage points, not {tolerance:g}")
+    s, t = test.suspension, test
+    model = ReadingModel(test)
+    dallavalle = lambda d: terminal_speeds(s, d)    # noqa: E731 - the reference speeds
+    lo, hi = t.psd.span()
+    phi = t.solid_fraction
+    screens = []
+
+    v_max = float(terminal_speeds(s, np.array([hi]))[0])
+    reynolds = s.fluid_density * v_max * hi / s.viscosity
+    change = model.change(s.stokes_speed, dallavalle)
+    screens.append(Screen("law", "drag beyond Stokes (Dallavalle)", "largest particle Reynolds number", reynolds, change,
+                          _verdict(change, tolerance),
+                          f"Stokes' law instead of Dallavalle's moves a reading by up to {change:.3g} pp"))
+
+    change = model.change(lambda d: terminal_speeds(s, d, "difelice", 1 - phi), dallavalle)
+    screens.append(Screen("hindered", "hindered settling and mixture buoyancy (Di Felice)", "initial solid fraction",
+                          phi, change, _verdict(change, tolerance),
+                          f"settling {100 * (1 - (1 - phi) ** 4.65):.3g} % slower at phi0 = {phi:.3g} moves a "
+                          f"reading by up to {change:.3g} pp (bound: phi falls as grains leave)"))
+
+    diameter, share, contacts, delay = encounters(test)
+    slower = lambda d: dallavalle(d) / (1 + np.interp(np.log(d), np.log(diameter), delay))    # noqa: E731
+    change = model.change(slower, dallavalle)
+    bed = t.mass / (s.particle_density * t.cylinder.area * BED_PACKING)
+    clearance = t.cylinder.height - lowest_sensed_depth(test) - bed
+    in_bed = (f"the bed ({bed * 1e3:.3g} mm) stays {clearance * 1e3:.3g} mm below the deepest instrument"
+              if clearance > 0 else f"the bed ({bed * 1e3:.3g} mm) reaches the deepest instrument")
+    verdict = _verdict(change, tolerance) if clearance > 0 else MEASURE
+    screens.append(Screen("contacts", "contacts between grains and with the bed", "contacts per grain (mass mean)",
+                          float(share @ contacts / share.sum()), change, verdict,
+                          f"grains touch up to {contacts.max():.3g} times in their fall, losing up to "
+                          f"{100 * delay.max():.2g} % of their speed, which moves a reading by up to {change:.3g} pp; "
+                          + in_bed))
+
+    film = s.particle_density * hi * v_max / (9 * s.viscosity)
+    screens.append(Screen("lubrication", "lubrication (squeeze films between close grains)",
+                          "approach Stokes number of the largest grain", film, None,
+                          verdict if verdict != INCLUDE else MEASURE,
+                          f"films act only in the collisions above; at St = {film:.3g} "
+                          f"{'<' if film < FILM_REBOUND_STOKES else '>='} {FILM_REBOUND_STOKES:g} they "
+                          f"{'stop every rebound' if film < FILM_REBOUND_STOKES else 'let grains rebound'}"))
+
+    tau = float(_core.relaxation_time("dallavalle", s.fluid_density, s.viscosity, hi, s.particle_density))
+    first = float(model.times[1])
+    screens.append(Screen("inertia", "particle inertia", "relaxation time / first reading time", tau / first, None,
+                          INCLUDE, f"the largest grain reaches its terminal speed in {tau:.3g} s; DEM integrates "
+                          "inertia at no extra cost"))
+
+    drho = s.particle_density - s.fluid_density
+    d_unit = (6 * BOLTZMANN * ROOM_TEMPERATURE / (math.pi * drho * s.gravity)) ** 0.25    # Pe = 1
+    peclet = (lo / d_unit) ** 4
+    below = float(t.psd.at(np.array([d_unit]))[0])
+    screens.append(Screen("brownian", "Brownian motion", "Peclet number of the smallest grain", peclet, None, REPORT,
+                          f"{below:.3g} % of the mass is finer than {d_unit * 1e6:.3g} um (Pe < 1), where diffusion "
+                          "competes with settling; not simulated"))
+
+    ratio = hi / t.cylinder.diameter
+    change = model.change(lambda d: dallavalle(d) / (1 + 2.1 * d / t.cylinder.diameter), dallavalle)
+    screens.append(Screen("wall", "cylinder wall (Ladenburg)", "largest diameter / cylinder diameter", ratio, change,
+                          REPORT, f"the wall slows grains by up to {100 * 2.1 * ratio:.2g} %, moving a reading by up "
+                          f"to {change:.3g} pp; not simulated (the sub-volume is periodic)"))
+
+    screens.append(Screen("yield", "yield stress (Bingham)", "yield number tau_y / (drho g d)", 0.0, 0.0, OMIT,
+                          "water is Newtonian: the yield machinery is never needed"))
+    screens.append(Screen("surface", "partial submergence at the free surface", "grains crossing the surface", 0.0,
+                          0.0, OMIT, "every grain starts below the surface and settles away from it"))
+    return screens
