@@ -56,8 +56,8 @@ def add_parser(commands) -> argparse.ArgumentParser:
                       choices=["hydrometer", "buoyancy", "pipette"], help="the readings that make the answer")
     test.add_argument("--particles", type=_counts, default=[40000, 20000, 10000, 5000],
                       help="parcel ladder, comma-separated (default 40000,20000,10000,5000; the largest is the reference)")
-    test.add_argument("--courant", type=positive_list, default=[1.0, 2.0, 4.0],
-                      help="Courant ladder, comma-separated (default 1,2,4; the smallest is the reference)")
+    test.add_argument("--courant", type=positive_list, default=[1.0, 2.0, 4.0, 8.0],
+                      help="Courant ladder, comma-separated (default 1,2,4,8; the smallest is the reference)")
     deck = parser.add_argument_group("deck")
     deck.add_argument("--observe", nargs="+", metavar="NAME", help="RESULT or SERIES names the deck prints")
     deck.add_argument("--ladder", type=_ladder, action="append", metavar="NAME=V1,V2",
@@ -70,7 +70,7 @@ def add_parser(commands) -> argparse.ArgumentParser:
 def run(args: argparse.Namespace) -> int:
     """Screens (and unless --screen-only measures and decides), prints the tables, writes the report."""
     from ..planner.plan import pin, plan_effects
-    from ..planner.scenes import DeckScene, TestScene
+    from ..planner.scenes import DeckScene, SampleScene
 
     if (args.psd is None) == (args.deck is None):
         raise ValueError("give either a PSD table (a sedimentation test) or --deck DECK")
@@ -92,7 +92,7 @@ def run(args: argparse.Namespace) -> int:
                                  tuple(dict.fromkeys(args.instruments)))
         options = dict(geometry=args.geometry, width=args.width, classes=args.classes, layers=args.layers,
                        t_end=args.t_end)
-        scene = TestScene(test, options, args.particles, args.courant, tolerance)
+        scene = SampleScene(test, options, args.particles, args.courant, tolerance)
         name = args.psd.stem
         if args.screen_only:
             _print_screens(scene.screens)

@@ -6,6 +6,7 @@ import argparse
 from pathlib import Path
 
 from ..constants import SOIL_PARTICLE_DENSITY
+from ..sim.scene import DRAGS
 from .types import count, positive
 
 
@@ -21,12 +22,17 @@ def add_parser(commands) -> argparse.ArgumentParser:
     parser.add_argument("--real-grains", action="store_true",
                         help="one atom per real grain at the real concentration (eq. 15 counts, at least one "
                              "per class); needed with --contacts or --lubrication")
-    parser.add_argument("--law", default="dallavalle", choices=["stokes", "schiller-naumann", "dallavalle"])
-    parser.add_argument("--hindered", action="store_true", help="Di Felice drag on the local concentration")
+    parser.add_argument("--drag", default="difelice", choices=DRAGS,
+                        help="difelice: Dallavalle's drag hindered by the local concentration (Di Felice; the "
+                        "default), or a single-sphere law without hindrance")
     parser.add_argument("--contacts", action="store_true", help="Hertz contacts between grains and with the floor")
     parser.add_argument("--lubrication", action="store_true", help="squeeze-film lubrication (with contacts)")
-    parser.add_argument("--courant", type=positive, default=1.0,
-                        help="layers the fastest grain in suspension may cross per step")
+    parser.add_argument("--courant", type=positive, default=4.0,
+                        help="layers the fastest grain in suspension may cross per step (default 4: within 0.25 "
+                        "points of percent finer of Courant 1 for the five samples of docs/effects.md)")
+    parser.add_argument("--plan", type=Path, metavar="REPORT",
+                        help="take the drag, parcels and Courant number that `sediment plan` decided (its "
+                        "report.json) instead of --drag, --particles and --courant")
     return parser
 
 
@@ -61,10 +67,28 @@ def run(args: argparse.Namespace) -> int:
     from ..lab.readout import Suspension
     from ..sim.scene import Effects, describe, plan, write
 
+    if args.plan is not None:
+        from ..planner.scenes import decided_options
+
+        if args.real_grains:
+            raise ValueError("--plan decides a number of parcels: it does not go with --real-grains")
+        decided, planned = decided_options(args.plan)
+        for name, value in decided.items():
+            setattr(args, name, value)
+        cylinder = cylinder_of(args)
+        here = dict(geometry=args.geometry, width=args.width, classes=args.classes, layers=args.layers,
+                    t_end=args.t_end, mass=args.mass, particle_density=args.particle_density,
+                    cylinder_area=cylinder.area, height=cylinder.height)
+        differ = [f"{k} {planned[k]} (here {v})" for k, v in here.items() if k in planned and planned[k] != v]
+        if differ:
+            print("warning: the plan was made for another test: " + ", ".join(differ))
+        print(f"the plan's decision ({args.plan}): --drag {args.drag} --particles {args.particles} "
+              f"--courant {args.courant:g}")
+
     scene = plan(read_psd(args.psd), geometry=args.geometry, cylinder=cylinder_of(args), mass=args.mass,
                  suspension=Suspension(particle_density=args.particle_density), width=args.width,
                  classes=args.classes, particles=None if args.real_grains else args.particles,
-                 effects=Effects(args.law, args.hindered, args.contacts, args.lubrication),
+                 effects=Effects(args.drag, args.contacts, args.lubrication),
                  layers=args.layers, t_end=args.t_end, courant=args.courant, seed=args.seed)
     print(describe(scene))
     for path in write(scene, args.out):

@@ -61,6 +61,7 @@ class Plan:
     fixed: dict[str, tuple]           # knob -> (value, error bound, reason) settled by screening
     candidates: list[tuple[dict, float, float]]    # every priced combination (settings, error, cost)
     command: str = ""
+    scene_options: dict = field(default_factory=dict)    # what the scene was, besides the knobs
 
     @property
     def speedup(self) -> float:
@@ -142,7 +143,7 @@ class Plan:
                 "screening": [s.__dict__ for s in self.screens], "fixed": {k: {"value": v, "bound": b, "reason": w} for k, (v, b, w) in self.fixed.items()},
                 "reference": trial(self.reference), "trials": [trial(t) for t in self.trials],
                 "verified": [trial(t) for t in self.verified], "decision": trial(self.decision),
-                "speedup": self.speedup, "command": self.command,
+                "speedup": self.speedup, "command": self.command, "scene_options": self.scene_options,
                 "candidates": [{"settings": s, "predicted_error": e, "predicted_cost_ratio": c}
                                for s, e, c in self.candidates]}
 
@@ -215,7 +216,7 @@ def plan_effects(scene, out: Path, tolerance: float, jobs: int = 2, seed: int = 
 
     Parameters
     ----------
-    scene : TestScene or DeckScene
+    scene : SampleScene or DeckScene
         The knobs and how to run them.
     out : Path
         Output folder.
@@ -239,7 +240,7 @@ def plan_effects(scene, out: Path, tolerance: float, jobs: int = 2, seed: int = 
     if jobs < 1:
         raise ValueError("jobs must be >= 1")
     out = Path(out)
-    runs = prepare(out / "runs")
+    runs, decided = prepare(out / "runs"), prepare(out / "decision")
     reference = Trial("reference", {k.name: k.values[0] for k in scene.knobs})
     if scene.screens_from_run:        # a deck prints its screening numbers: run it first
         _run_all(scene, [reference], runs, seed, 1, progress, "reference")
@@ -256,6 +257,7 @@ def plan_effects(scene, out: Path, tolerance: float, jobs: int = 2, seed: int = 
     _run_all(scene, trials if scene.screens_from_run else [reference, *trials], runs, seed, jobs, progress, "measure")
     if reference.outcome.failure:
         raise RuntimeError(f"the reference run failed: {reference.outcome.failure}")
+    reference.errors = {name: 0.0 for name in reference.outcome.observations}
     for t in trials:
         if not t.outcome.failure:
             t.errors = scene.error(t.outcome.observations, reference.outcome.observations)
@@ -294,9 +296,9 @@ def plan_effects(scene, out: Path, tolerance: float, jobs: int = 2, seed: int = 
         decision = min((t for t in batch if t.error <= tolerance), key=lambda t: t.outcome.loop_seconds, default=None)
     if decision is None:
         decision = reference
-    scene.write(decision.settings, out / "decision", seed)
+    scene.write(decision.settings, decided, seed)
     plan = Plan(name, scene.unit, tolerance, scene.knobs, scene.screens, reference, trials, verified, decision, fixed,
-                candidates, scene.describe(decision.settings))
+                candidates, scene.describe(decision.settings), scene.options_record())
     plan.save(out)
     return plan
 

@@ -2,8 +2,8 @@
 """The scenes the planner can measure, each as a set of knobs (an effect or a resolution, values
 ordered from the richest to the cheapest) and a way to run one setting of them and score it.
 
-- `TestScene`: a sedimentation test written by `sediment sample`; knobs law, hindered, particles
-  and courant; observables the instruments' readings, errors in points of percent finer.
+- `SampleScene`: a sedimentation test written by `sediment sample`; knobs drag (difelice, dallavalle,
+  stokes), particles and courant; observables the instruments' readings, errors in points of percent finer.
 - `DeckScene`: any deck that reads ``variable effect_NAME index yes`` for each effect it can switch
   (and any ladder variables given), prints its observables as ``RESULT``/``SERIES`` lines (as for
   `sediment sweep`) and may print ``SCREEN number value`` lines; errors relative.
@@ -19,6 +19,7 @@ from pathlib import Path
 import numpy as np
 
 from ..sim.run import run_batch
+from ..sim.scene import DRAGS
 from .screening import INCLUDE, MEASURE, OMIT, Screen, SedimentationTest, screen
 
 MARKER = ".sediment-plan"    # in a folder of trial runs: the planner owns it and may empty it
@@ -51,24 +52,42 @@ class Outcome:
 
 
 def prepare(folder: Path) -> Path:
-    """A folder of trial runs, emptied if a previous plan left it (it carries the planner's marker);
-    any other existing non-empty folder is refused rather than overwritten."""
+    """A folder the planner writes (its runs, its decision), emptied if a previous plan left it (it
+    carries the planner's marker). Refused rather than emptied: a folder the planner did not write,
+    and one where a run has since left its results (a layer file or log beside the deck)."""
     folder = Path(folder)
     if folder.exists() and any(folder.iterdir()):
         if not (folder / MARKER).is_file():
             raise ValueError(f"{folder} exists and was not written by sediment plan: choose another --out")
+        results = sorted(p.name for p in folder.iterdir() if p.suffix == ".h5" or p.name.startswith("log.lammps"))
+        if results:
+            raise ValueError(f"{folder} holds the results of a run ({', '.join(results)}): move them or choose "
+                             "another --out")
         shutil.rmtree(folder)
     folder.mkdir(parents=True)
     (folder / MARKER).write_text("runs of sediment plan; emptied by the next plan in this folder\n")
     return folder
 
 
-# The drag of a test, richest first: Di Felice's hindrance on Dallavalle's curve, Dallavalle's curve,
-# Stokes' law; as (law, hindered) of sim.scene.Effects.
-DRAG = {"difelice": ("dallavalle", True), "dallavalle": ("dallavalle", False), "stokes": ("stokes", False)}
+def decided_options(report: Path) -> tuple[dict, dict]:
+    """The `sediment sample` options (drag, particles, courant) a plan of a sedimentation
+    test decided, and the test it was made for, from its report.json."""
+    import json
+
+    try:
+        content = json.loads(Path(report).read_text())
+        decision = content["decision"]["settings"]
+        if decision["drag"] not in DRAGS:
+            raise ValueError(f"drag '{decision['drag']}'")
+        return ({"drag": decision["drag"], "particles": int(decision["particles"]),
+                 "courant": float(decision["courant"])}, dict(content.get("scene_options", {})))
+    except (json.JSONDecodeError, UnicodeDecodeError) as exc:
+        raise ValueError(f"{report} is not a plan's report.json: {exc}") from None
+    except (KeyError, TypeError, ValueError) as exc:
+        raise ValueError(f"{report} is not the plan of a sedimentation test (no decided {exc})") from None
 
 
-class TestScene:
+class SampleScene:
     """A sedimentation test (`sediment sample` options) as knobs and runs."""
 
     unit = "pp"
@@ -84,22 +103,26 @@ class TestScene:
             raise ValueError("the particle ladder needs at least one count >= 1")
         if not courant or any(not c > 0 for c in courant):
             raise ValueError("the courant ladder needs at least one value > 0")
-        self.knobs = [Knob("drag", tuple(DRAG), "effect", ("hindered", "law")),
+        self.knobs = [Knob("drag", ("difelice", "dallavalle", "stokes"), "effect", ("hindered", "law")),
                       Knob("particles", tuple(sorted(set(particles), reverse=True)), "resolution"),
                       Knob("courant", tuple(sorted(set(courant))), "resolution")]
 
     def describe(self, settings: dict) -> str:
         """The `sediment sample` options of a setting."""
-        law, hindered = DRAG[settings["drag"]]
-        return (f"--law {law}{' --hindered' if hindered else ''} "
-                f"--particles {settings['particles']} --courant {settings['courant']:g}")
+        return f"--drag {settings['drag']} --particles {settings['particles']} --courant {settings['courant']:g}"
+
+    def options_record(self) -> dict:
+        """The test besides the knobs, as `sediment sample --plan` checks it."""
+        t = self.test
+        return dict(self.options, mass=t.mass, particle_density=t.suspension.particle_density,
+                    cylinder_area=t.cylinder.area, height=t.cylinder.height)
 
     def _scene(self, settings: dict, seed: int):
         from ..sim.scene import Effects, plan
         t = self.test
         return plan(t.psd, cylinder=t.cylinder, mass=t.mass, suspension=t.suspension, seed=seed,
                     particles=int(settings["particles"]), courant=float(settings["courant"]),
-                    effects=Effects(*DRAG[settings["drag"]]), **self.options)
+                    effects=Effects(settings["drag"]), **self.options)
 
     def write(self, settings: dict, folder: Path, seed: int) -> Path:
         """Writes the scene of a setting into `folder`; returns its deck."""
@@ -207,6 +230,10 @@ class DeckScene:
         self.knobs = [Knob(name, ("yes", "no"), "effect", (name,)) for name, _ in effects]
         self.knobs += [Knob(name, tuple(values), "resolution") for name, values in ladders.items()]
         self.screens: list[Screen] = []
+
+    def options_record(self) -> dict:
+        """The deck and the variables every run had."""
+        return {"deck": str(self.deck), "variables": self.variables, "ranks": self.ranks}
 
     def describe(self, settings: dict) -> str:
         """The -var options of a setting."""

@@ -1,0 +1,73 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
+"""Time to answer of the main job (sample 5, 24 h in the D422 column) at the planner's decision
+against the all-effects configuration, as a ratio measured in one run on this machine.
+
+    /usr/bin/python3 benchmarks/planner.py [--plan out/sample5/plan/report.json] [--ranks 2] [--repeats 2]
+
+The all-effects run is what a user would run without the planner: every drag effect (Di Felice on
+Dallavalle), the parcels of the old default main job (50 000) and the Courant number 1. The planner's
+run is its decision (from --plan, or a plan made here). Both take turns; the best loop time of each
+is kept, and the largest difference between their readings is printed next to the ratio.
+"""
+from __future__ import annotations
+
+import argparse
+import sys
+import tempfile
+from pathlib import Path
+
+HERE = Path(__file__).resolve().parent
+sys.path.insert(0, str(HERE.parent / "python"))
+from sediment.cli.types import count  # noqa: E402
+
+PSD = HERE.parent / "examples" / "granulometry" / "psd" / "sample5.csv"
+ALL_EFFECTS = {"drag": "difelice", "particles": 50000, "courant": 1.0}
+
+
+def main() -> None:
+    from sediment.lab.granulometry import read_all
+    from sediment.lab.psd import read_psd
+    from sediment.lab.readout import Column
+    from sediment.planner.scenes import decided_options
+    from sediment.sim.layers import read_layers
+    from sediment.sim.run import run_batch
+    from sediment.sim.scene import Effects, plan, write
+
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--plan", type=Path, help="a plan's report.json (default: plan sample 5 here first)")
+    parser.add_argument("--ranks", type=count, default=2)
+    parser.add_argument("--repeats", type=count, default=2)
+    args = parser.parse_args()
+    with tempfile.TemporaryDirectory() as tmp:
+        tmp = Path(tmp)
+        report = args.plan
+        if report is None:
+            from sediment import cli
+            if cli.main(["plan", str(PSD), "--out", str(tmp / "plan")]) != 0:
+                raise SystemExit("the plan failed")
+            report = tmp / "plan" / "report.json"
+        decided, _ = decided_options(report)
+        configs = {"all effects": ALL_EFFECTS, "planner's decision": decided}
+        best, readings = {}, {}
+        for _ in range(args.repeats):
+            for name, c in configs.items():
+                folder = tmp / name.replace(" ", "_").replace("'", "")
+                scene = plan(read_psd(PSD), particles=c["particles"], courant=c["courant"],
+                             effects=Effects(c["drag"]))
+                write(scene, folder)
+                out = run_batch(folder / "in.sedimentation", {"overwrite": "yes"}, args.ranks)
+                best[name] = min(best.get(name, float("inf")), sum(t for t, _ in out.loops))
+                found, _ = read_all(Column.from_layers(read_layers(folder / "layers.h5")),
+                                    ["hydrometer", "buoyancy", "pipette"])
+                readings[name] = {r.instrument: r.percent_finer for r in found}
+    full, chosen = best["all effects"], best["planner's decision"]
+    gap = max(float(abs(readings["all effects"][k] - readings["planner's decision"][k]).max()) for k in readings["all effects"])
+    print(f"main job (sample 5, 24 h, {args.ranks} ranks), best loop time of {args.repeats}:")
+    for name, c in configs.items():
+        print(f"  {name:19s} {best[name]:7.2f} s  (drag {c['drag']}, {c['particles']} parcels, Courant {c['courant']:g})")
+    print(f"  time to answer: {full / chosen:.1f}x faster at the planner's decision; readings differ by at most "
+          f"{gap:.2f} points of percent finer")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,154 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
+"""`sediment plan`: scenes whose answer is known, the decision and its verification, a reproducible
+report, bad input refused with the reason."""
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+import pytest
+
+from sediment import cli
+from sediment.lab.psd import read_psd
+from sediment.planner.plan import plan_effects
+from sediment.planner.scenes import DeckScene, SampleScene
+from sediment.planner.screening import INCLUDE, OMIT, SedimentationTest, screen
+
+REPO = Path(__file__).resolve().parents[2]
+SUSPENSION = REPO / "examples" / "planner" / "in.suspension"
+PASTE = REPO / "examples" / "paste" / "in.ball_in_paste"
+SAMPLE5 = REPO / "examples" / "granulometry" / "psd" / "sample5.csv"
+
+
+def _plan(out: Path, *args: str) -> dict:
+    assert cli.main(["plan", *map(str, args), "--out", str(out)]) == 0
+    return json.loads((out / "report.json").read_text())
+
+
+def _trial_names(report: dict) -> set[str]:
+    return {t["name"] for t in report["trials"]}
+
+
+def test_a_dilute_suspension_does_not_call_for_hindrance(tmp_path):
+    """phi = 1e-3: Richardson & Zaki slow the suspension by 1 - 0.999^4.65 = 0.46 %, which the
+    screening cannot dismiss at a 1 % tolerance (it is above a quarter of it), so it is measured,
+    found within the tolerance, and left out."""
+    report = _plan(tmp_path, "--deck", SUSPENSION, "--observe", "speed", "--var", "phi", "0.001")
+    assert "hindered=no" in _trial_names(report)
+    change = next(t for t in report["trials"] if t["name"] == "hindered=no")["error"]
+    assert change == pytest.approx(1 - 0.999 ** 4.65, rel=0.05)
+    assert report["decision"]["settings"]["hindered"] == "no"
+    assert report["decision"]["error"] <= 0.01
+    assert (tmp_path / "decision" / "in.suspension").read_text().count("effect_hindered index no") == 1
+
+
+def test_a_suspension_at_a_tenth_calls_for_hindrance(tmp_path):
+    """phi = 0.1: 39 % slower; the screening keeps the hindrance without a run."""
+    report = _plan(tmp_path, "--deck", SUSPENSION, "--observe", "speed", "--var", "phi", "0.1")
+    assert report["fixed"]["hindered"]["value"] == "yes"
+    assert "hindered=no" not in _trial_names(report)
+    assert report["decision"]["settings"]["hindered"] == "yes"
+
+
+def test_a_single_grain_never_calls_for_contacts(tmp_path):
+    report = _plan(tmp_path, "--deck", SUSPENSION, "--observe", "speed", "--var", "cells", "1")
+    assert report["fixed"]["contacts"]["value"] == "no"
+    assert "contacts=no" not in _trial_names(report)
+    assert report["decision"]["settings"]["contacts"] == "no"
+
+
+def test_a_newtonian_fluid_never_calls_for_the_yield_machinery(tmp_path):
+    for k in range(1, 6):
+        yield_screen = next(s for s in screen(SedimentationTest(read_psd(SAMPLE5.with_name(f"sample{k}.csv"))))
+                            if s.effect == "yield")
+        assert yield_screen.verdict == OMIT
+    newtonian = _plan(tmp_path / "newtonian", "--deck", PASTE, "--observe", "depth", "--var", "tau_y", "0",
+                      "--var", "t_max", "0.3", "--var", "hold", "0.01")
+    assert newtonian["fixed"]["yield"]["value"] == "no"
+    assert newtonian["decision"]["settings"]["yield"] == "no"
+    paste = _plan(tmp_path / "paste", "--deck", PASTE, "--observe", "depth", "--var", "hold", "0.01")
+    assert paste["fixed"]["yield"]["value"] == "yes"
+    assert paste["fixed"]["submergence"]["value"] == "yes"    # the ball crosses the surface
+
+
+def test_screening_of_a_test_bounds_what_the_runs_measure():
+    """Sample 5 at c0 = 60 g/L: every effect screened, the bounds of the drag steps within a factor
+    of two of the changes the planner measured for docs/effects.md."""
+    screens = {s.effect: s for s in screen(SedimentationTest(read_psd(SAMPLE5)))}
+    assert set(screens) >= {"law", "hindered", "contacts", "lubrication", "inertia", "brownian", "wall", "yield", "surface"}
+    assert screens["hindered"].value == pytest.approx(0.060 / (27.8e-4 * 0.36) / 2650)
+    assert 1.0 < screens["hindered"].change < 4.0
+    assert 0.7 < screens["law"].change < 3.0
+    assert screens["inertia"].verdict == INCLUDE
+    assert screens["surface"].verdict == OMIT
+    dilute = {s.effect: s for s in screen(SedimentationTest(read_psd(SAMPLE5), mass=0.060 / 100))}
+    assert dilute["hindered"].change < 0.25 * 0.5 and dilute["hindered"].verdict == OMIT
+
+
+def _small_test(seed: int, out: Path) -> dict:
+    test = SedimentationTest(read_psd(SAMPLE5))
+    scene = SampleScene(test, {"t_end": 1800.0, "classes": 20, "layers": 100}, [2000, 1000], [1.0, 4.0], 0.5)
+    plan_effects(scene, out, 0.5, jobs=2, seed=seed, measure_all=True, progress=False, name="sample5")
+    return json.loads((out / "report.json").read_text())
+
+
+def test_the_report_of_a_test_is_reproducible_with_a_seed(tmp_path):
+    first, again, other = (_small_test(s, tmp_path / n) for s, n in ((3, "a"), (3, "b"), (4, "c")))
+    errors = [{t["name"]: t["errors"] for t in r["trials"]} for r in (first, again, other)]
+    assert set(errors[0]) == {"drag=dallavalle", "drag=stokes", "particles=1000", "courant=4.0"}
+    assert errors[0] == errors[1]
+    assert first["decision"]["settings"] == again["decision"]["settings"]
+    assert errors[0] != errors[2]
+    assert all(math.isfinite(e) for trial in errors[0].values() for e in trial.values())
+    for name in ("effects.csv", "trials.csv", "plan.png"):
+        assert (tmp_path / "a" / name).stat().st_size > 0
+    assert (tmp_path / "a" / "decision" / "in.sedimentation").is_file()
+
+
+def test_a_rerun_replaces_its_own_runs_and_spares_other_folders(tmp_path):
+    out = tmp_path / "plan"
+    args = ("--deck", SUSPENSION, "--observe", "speed", "--var", "cells", "1")
+    _plan(out, *args)
+    stale = out / "runs" / "stale.txt"
+    stale.write_text("from the previous plan")
+    _plan(out, *args)
+    assert not stale.exists()
+    mine = tmp_path / "mine"
+    (mine / "runs").mkdir(parents=True)
+    (mine / "runs" / "results.csv").write_text("precious")
+    assert cli.main(["plan", *map(str, args), "--out", str(mine)]) == 2
+    assert (mine / "runs" / "results.csv").read_text() == "precious"
+
+
+@pytest.mark.parametrize("args, message", [
+    (["--set", "foo=1"], "unknown effect or resolution 'foo'"),
+    (["--set", "hindered=maybe"], "hindered takes yes, no, not 'maybe'"),
+    (["--ladder", "nothing=1,2"], "no 'variable nothing index"),
+])
+def test_bad_deck_plans_are_refused_with_the_reason(tmp_path, capsys, args, message):
+    code = cli.main(["plan", "--deck", str(SUSPENSION), "--observe", "speed", "--out", str(tmp_path / "o"), *args])
+    assert code == 2
+    assert message in capsys.readouterr().err
+    assert not (tmp_path / "o").exists()
+
+
+def test_bad_input_is_refused_with_the_reason(tmp_path, capsys):
+    bare = tmp_path / "in.bare"
+    bare.write_text("print 'RESULT x 1'\n")
+    assert cli.main(["plan", "--deck", str(bare), "--observe", "x", "--out", str(tmp_path / "o")]) == 2
+    assert "exposes no effects" in capsys.readouterr().err
+    odd = tmp_path / "in.odd"
+    odd.write_text("variable effect_drag index maybe\n")
+    assert cli.main(["plan", "--deck", str(odd), "--observe", "x", "--out", str(tmp_path / "o")]) == 2
+    assert "effect_drag must default to yes or no" in capsys.readouterr().err
+    with pytest.raises(SystemExit):
+        cli.main(["plan", str(SAMPLE5), "--tolerance", "0"])
+    assert "--tolerance: must be > 0" in capsys.readouterr().err
+    with pytest.raises(ValueError, match="tolerance must be > 0"):
+        plan_effects(DeckScene(SUSPENSION, ["speed"], {}, 0.01), tmp_path / "o", -1.0)
+    assert cli.main(["plan", str(SAMPLE5), "--deck", str(SUSPENSION)]) == 2
+    assert "either a PSD table" in capsys.readouterr().err
+    assert cli.main(["plan", str(SAMPLE5), "--screen-only", "--mass", "0.265"]) == 2
+    assert "the hydrometer cannot read this test" in capsys.readouterr().err
+    assert not (tmp_path / "o").exists()
