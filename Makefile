@@ -23,7 +23,7 @@ build: deps $(BUILD)/CMakeCache.txt
 	cmake --build $(BUILD) -j $(JOBS)
 
 # Sample 5 of Bravo et al. end to end: the effects planner decides what the test calls for (drag,
-# hindrance, parcels, Courant number; its runs take about 2 min on 2 cores), then the decided scene
+# hindrance, parcels, Courant number; its runs take about a minute on 2 cores), then the decided scene
 # runs in the D422 column for 24 h of settling, then the hydrometer, buoyancy-sphere and pipette readouts.
 # A rerun replaces the demo's previous results.
 demo: build

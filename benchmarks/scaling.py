@@ -24,7 +24,7 @@ HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE.parent / "python"))
 from sediment.lab.psd import read_psd  # noqa: E402
 from sediment.sim.run import run_batch  # noqa: E402
-from sediment.sim.scene import plan, write  # noqa: E402
+from sediment.sim.scene import Effects, plan, write  # noqa: E402
 
 PSD = HERE.parent / "examples" / "granulometry" / "psd" / "sample5.csv"
 
@@ -67,7 +67,7 @@ def main() -> None:
           "wall_1440min_s,"
           "ns_per_particle_step,extrapolated", flush=True)
     for n in [int(float(p)) for p in args.particles.split(",")]:
-        scene = plan(psd, particles=n)
+        scene = plan(psd, particles=n, effects=Effects("dallavalle"), courant=1.0)    # the scene of the README's table
         deck = write(scene, work / f"n{n}")[1]
         total = sum(steps for _, steps in scene.stages())
         full = n <= args.full_up_to

@@ -51,6 +51,10 @@ class Table:
         return "\n".join(",".join(cell(c) for c in row) for row in [list(self.columns), *self.rows]) + "\n"
 
 
+_UMASK = os.umask(0o022)    # read once (umask can only be read by setting it), then restored
+os.umask(_UMASK)
+
+
 class Result(Protocol):
     """What every study and readout returns."""
 
@@ -73,6 +77,7 @@ def write_atomic(path: Path, write: Callable[[Path], None]) -> Path:
     os.close(handle)
     try:
         write(Path(temporary))
+        os.chmod(temporary, 0o666 & ~_UMASK)    # as open() would create it, not mkstemp's owner-only 0600
         os.replace(temporary, path)
     except BaseException:
         Path(temporary).unlink(missing_ok=True)

@@ -35,6 +35,16 @@ def test_an_interrupted_write_keeps_the_previous_file_and_leaves_no_temporary(tm
     assert sorted(p.name for p in path.parent.iterdir()) == ["result.csv"]
 
 
+def test_written_files_have_the_permissions_of_any_new_file(tmp_path):
+    """Not mkstemp's owner-only 0600: others on a shared machine read results as they read any file."""
+    import os
+
+    umask = os.umask(0o022)
+    os.umask(umask)
+    path = write_text(tmp_path / "result.csv", "x\n")
+    assert path.stat().st_mode & 0o777 == 0o666 & ~umask
+
+
 def test_a_result_tabulates_and_saves(tmp_path):
     result = restitution_from_drops([95, 188], [37.0, 72.0])
     assert result.table().notes[0].startswith("coefficient of restitution (drop test): mean 0.62")

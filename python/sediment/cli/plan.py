@@ -100,7 +100,7 @@ def run(args: argparse.Namespace) -> int:
     pin(scene, dict(args.set or []))
     plan = plan_effects(scene, args.out, tolerance, args.jobs, args.seed if args.deck is None else 1,
                         args.measure_all, name=name)
-    print(plan.effect_table().text(), end="")
+    print(plan.text(), end="")
     print(f"wrote {args.out}/effects.csv, trials.csv, report.json, plan.png; the chosen scene: {args.out / 'decision'}")
     return 0
 

@@ -23,7 +23,7 @@ from pathlib import Path
 from .. import figures
 from ..results import Table, write_text
 from .scenes import Knob, Outcome, prepare
-from .screening import INCLUDE, MEASURE, OMIT, Screen
+from .screening import INCLUDE, MEASURE, Screen
 
 VERIFY_ATTEMPTS = 3
 
@@ -58,7 +58,7 @@ class Plan:
     trials: list[Trial]               # one-knob variations of the reference
     verified: list[Trial]             # the candidates run to verify them, in order
     decision: Trial
-    fixed: dict[str, tuple]           # knob -> (value, error bound, reason) settled by screening
+    fixed: dict[str, tuple]           # knob -> (value, estimated error, reason) settled by screening
     candidates: list[tuple[dict, float, float]]    # every priced combination (settings, error, cost)
     command: str = ""
     scene_options: dict = field(default_factory=dict)    # what the scene was, besides the knobs
@@ -74,25 +74,47 @@ class Plan:
         unit = "pp" if self.unit == "pp" else "rel"
         table = Table(["knob", "value", "leaves_out", "screening_number", "screening_value", f"estimated_change_{unit}",
                        f"measured_change_{unit}", "cost_ratio", "verdict"], notes=self.notes())
-        screens = {s.effect: s for s in self.screens}
-        ref_loop = self.reference.outcome.loop_seconds
-        for knob in self.knobs:
+        for knob, value, s, trial in self._rows():
             chosen = self.decision.settings[knob.name]
             why = self.fixed[knob.name][2] if knob.name in self.fixed else "measured"
-            for k, value in enumerate(knob.values[1:]):
-                s = screens.get(knob.drops[k]) if k < len(knob.drops) else None
-                trial = next((t for t in self.trials if t.settings[knob.name] == value), None)
-                table.add(knob.name, value, s.label if s else "", s.number if s else "", f"{s.value:.4g}" if s else "",
-                          f"{s.change:.3g}" if s and s.change is not None else "",
-                          f"{trial.error:.3g}" if trial else "",
-                          f"{trial.outcome.loop_seconds / ref_loop:.3g}" if trial and not trial.outcome.failure else "",
-                          ("chosen" if chosen == value else f"keep {chosen}") + f" ({why})")
+            table.add(knob.name, value, s.label if s else "", s.number if s else "", f"{s.value:.4g}" if s else "",
+                      f"{s.change:.3g}" if s and s.change is not None else "", f"{trial.error:.3g}" if trial else "",
+                      self._cost(trial), ("chosen" if chosen == value else f"keep {chosen}") + f" ({why})")
         knobbed = {d for k in self.knobs for d in k.drops}
         for s in self.screens:
             if s.effect not in knobbed:
                 table.add(s.effect, "", s.label, s.number, f"{s.value:.4g}", f"{s.change:.3g}" if s.change is not None else "",
                           "", "", f"{s.verdict}: {s.reason}")
         return table
+
+    def text(self) -> str:
+        """A terminal's view: one short row per knob value, then the other effects and the decision."""
+        unit = "pp" if self.unit == "pp" else "rel"
+        table = Table(["knob", "value", f"estimated_{unit}", f"measured_{unit}", "cost_ratio", ""])
+        for knob, value, screen, trial in self._rows():
+            chosen = self.decision.settings[knob.name]
+            mark = "<- chosen" if chosen == value else (f"screened: keep {chosen}" if knob.name in self.fixed else "")
+            table.add(knob.name, value, "" if screen is None or screen.change is None else f"{screen.change:.3g}",
+                      f"{trial.error:.3g}" if trial else "", self._cost(trial), mark)
+        knobbed = {d for k in self.knobs for d in k.drops}
+        lines = [f"{k} screened: {why}" for k, (_, _, why) in self.fixed.items()]
+        lines += [f"{s.effect} ({s.number} {s.value:.3g}): {s.verdict}: {s.reason}" for s in self.screens
+                  if s.effect not in knobbed]
+        return table.text() + "\n".join(lines + self.notes()) + "\n"
+
+    def _rows(self):
+        """(knob, value, the screen of what the value leaves out, its one-knob trial) per non-reference value."""
+        screens = {s.effect: s for s in self.screens}
+        for knob in self.knobs:
+            for k, value in enumerate(knob.values[1:]):
+                screen = screens.get(knob.drops[k]) if k < len(knob.drops) else None
+                trial = next((t for t in self.trials if t.settings[knob.name] == value), None)
+                yield knob, value, screen, trial
+
+    def _cost(self, trial: Trial | None) -> str:
+        if trial is None or trial.outcome.failure:
+            return ""
+        return f"{trial.outcome.loop_seconds / self.reference.outcome.loop_seconds:.3g}"
 
     def notes(self) -> list[str]:
         """The decision in words."""
@@ -111,8 +133,8 @@ class Plan:
         knobbed = {d for k in self.knobs for d in k.drops}
         for s in self.screens:
             if s.verdict == MEASURE and s.effect not in knobbed:
-                lines.append(f"not measurable in this scene: {s.label} (bound {s.change if s.change is not None else '?'}"
-                             f"{'' if s.change is None else ' ' + unit}): left out")
+                estimate = "no estimate" if s.change is None else f"estimated change {s.change:.3g} {unit}"
+                lines.append(f"not measurable in this scene: {s.label} ({estimate}): left out")
         return lines
 
     def table(self) -> Table:
@@ -140,7 +162,7 @@ class Plan:
                     "predicted_error": t.predicted_error, "predicted_cost_ratio": t.predicted_cost}
         return {"scene": self.scene_name, "unit": self.unit, "tolerance": self.tolerance,
                 "knobs": [{"name": k.name, "kind": k.kind, "values": list(k.values)} for k in self.knobs],
-                "screening": [s.__dict__ for s in self.screens], "fixed": {k: {"value": v, "bound": b, "reason": w} for k, (v, b, w) in self.fixed.items()},
+                "screening": [s.__dict__ for s in self.screens], "fixed": {k: {"value": v, "estimated_error": e, "reason": w} for k, (v, e, w) in self.fixed.items()},
                 "reference": trial(self.reference), "trials": [trial(t) for t in self.trials],
                 "verified": [trial(t) for t in self.verified], "decision": trial(self.decision),
                 "speedup": self.speedup, "command": self.command, "scene_options": self.scene_options,
@@ -246,7 +268,7 @@ def plan_effects(scene, out: Path, tolerance: float, jobs: int = 2, seed: int = 
         _run_all(scene, [reference], runs, seed, 1, progress, "reference")
         scene.screen_printed(reference.outcome.printed)
     screens = {s.effect: s for s in scene.screens}
-    fixed: dict[str, tuple] = {}      # knob -> (value, error bound, why) when screening settled it
+    fixed: dict[str, tuple] = {}      # knob -> (value, estimated error, why) when screening settled it
     trials: list[Trial] = []
     for knob in scene.knobs:
         settled = None if measure_all else _screened(knob, screens)
@@ -265,19 +287,24 @@ def plan_effects(scene, out: Path, tolerance: float, jobs: int = 2, seed: int = 
     options = {}                      # knob -> [(value, error, cost ratio)]
     for knob in scene.knobs:
         if knob.name in fixed:
-            value, bound, _ = fixed[knob.name]
-            options[knob.name] = [(value, bound, 1.0)]
+            value, estimate, _ = fixed[knob.name]
+            options[knob.name] = [(value, estimate, 1.0)]
             continue
+        # Leaving an effect out does not make a step dearer: a ratio above 1 is timing noise.
+        ceiling = 1.0 if knob.kind == "effect" else math.inf
         options[knob.name] = [(knob.values[0], 0.0, 1.0)] + [
-            (t.settings[knob.name], t.error, t.outcome.loop_seconds / reference.outcome.loop_seconds)
+            (t.settings[knob.name], t.error, min(ceiling, t.outcome.loop_seconds / reference.outcome.loop_seconds))
             for t in trials if t.settings[knob.name] != knob.values[0] and not t.outcome.failure]
     candidates = []
     for combo in itertools.product(*options.values()):
         settings = dict(zip(options, (v for v, _, _ in combo)))
         candidates.append((settings, sum(e for _, e, _ in combo), math.prod(c for _, _, c in combo)))
-    candidates.sort(key=lambda c: (c[2], c[1]))
+    # Cheapest first; at equal cost, the one that simulates fewer effects (a scene simulates only the
+    # effects it calls for), then the smaller error.
+    effects = [k for k in scene.knobs if k.kind == "effect"]
+    candidates.sort(key=lambda c: (c[2], sum(len(k.values) - 1 - k.values.index(c[0][k.name]) for k in effects), c[1]))
     # The cheapest candidates within the tolerance are verified `jobs` at a time (alike in load to the
-    # measured trials, so their loop times compare); of a batch, the fastest that holds is the decision.
+    # measured trials, so their loop times compare); the first in that order that holds is the decision.
     within = [c for c in candidates if c[1] <= tolerance][:VERIFY_ATTEMPTS]
     verified: list[Trial] = []
     decision = None
@@ -293,7 +320,7 @@ def plan_effects(scene, out: Path, tolerance: float, jobs: int = 2, seed: int = 
             if not trial.outcome.failure:
                 trial.errors = scene.error(trial.outcome.observations, reference.outcome.observations)
             verified.append(trial)
-        decision = min((t for t in batch if t.error <= tolerance), key=lambda t: t.outcome.loop_seconds, default=None)
+        decision = next((t for t in batch if t.error <= tolerance), None)
     if decision is None:
         decision = reference
     scene.write(decision.settings, decided, seed)
@@ -304,21 +331,21 @@ def plan_effects(scene, out: Path, tolerance: float, jobs: int = 2, seed: int = 
 
 
 def _screened(knob: Knob, screens: dict[str, Screen]) -> tuple | None:
-    """(value, error bound, reason) when the screening settles an effect knob: the cheapest value
+    """(value, estimated error, reason) when the screening settles an effect knob: the cheapest value
     that only leaves out effects screened as negligible, if the next step leaves out one screened as
     needed (or there is none); None when a step in between needs measuring."""
     if knob.kind != "effect" or not knob.drops or any(d not in screens for d in knob.drops):
         return None
-    bound, reasons = 0.0, []
+    estimate, reasons = 0.0, []
     for k, dropped in enumerate(knob.drops):
         s = screens[dropped]
         if s.verdict == MEASURE:
             return None
         if s.verdict == INCLUDE:
-            return knob.values[k], bound, "; ".join(reasons + [f"needs {s.label}: {s.reason}"])
-        bound += s.change or 0.0
+            return knob.values[k], estimate, "; ".join(reasons + [f"needs {s.label}: {s.reason}"])
+        estimate += s.change or 0.0
         reasons.append(f"without {s.label}: {s.reason}")
-    return knob.values[-1], bound, "; ".join(reasons)
+    return knob.values[-1], estimate, "; ".join(reasons)
 
 
 def _run_all(scene, trials: list[Trial], runs: Path, seed: int, jobs: int, progress: bool, what: str) -> None:

@@ -20,7 +20,7 @@ import numpy as np
 
 from ..sim.run import run_batch
 from ..sim.scene import DRAGS
-from .screening import INCLUDE, MEASURE, OMIT, Screen, SedimentationTest, screen
+from .screening import INCLUDE, MEASURE, OMIT, Screen, SedimentationTest, screen, verdict_of
 
 MARKER = ".sediment-plan"    # in a folder of trial runs: the planner owns it and may empty it
 
@@ -165,19 +165,19 @@ class SampleScene:
         return errors
 
 
-# Screening numbers a deck may print (SCREEN name value), the effect each settles, and how: a bound
-# on the relative change of the observables, or a rule on the number itself.
-def _hindrance_bound(phi: float) -> float:
+# Screening numbers a deck may print (SCREEN name value), the effect each settles, and how: an
+# estimate of the relative change of the observables, or a rule on the number itself.
+def _hindrance_change(phi: float) -> float:
     return 1 - (1 - phi) ** 4.65            # Richardson & Zaki: the settling speed of the suspension
 
 
-def _inertial_drag_bound(reynolds: float) -> float:
+def _inertial_drag_change(reynolds: float) -> float:
     return 0.15 * reynolds ** 0.687         # Schiller & Naumann's correction to Stokes drag
 
 
 DECK_SCREENS = {
-    "solid_fraction": ("hindered", "initial solid fraction", _hindrance_bound),
-    "reynolds": ("law", "largest particle Reynolds number", _inertial_drag_bound),
+    "solid_fraction": ("hindered", "initial solid fraction", _hindrance_change),
+    "reynolds": ("law", "largest particle Reynolds number", _inertial_drag_change),
     "yield_number": ("yield", "yield number tau_y / (drho g d)", None),
     "grains": ("contacts", "grains in the scene", None),
     "surface_crossings": ("submergence", "grains crossing the free surface", None),
@@ -248,12 +248,12 @@ class DeckScene:
         for number, value in printed.items():
             if number not in DECK_SCREENS:
                 continue
-            effect, label, bound = DECK_SCREENS[number]
+            effect, label, estimate = DECK_SCREENS[number]
             if effect not in effects and not (effect == "contacts" and "lubrication" in effects):
                 continue
-            if bound is not None:
-                change = bound(value)
-                verdict = OMIT if change <= 0.25 * self.tolerance else INCLUDE if change >= 4 * self.tolerance else MEASURE
+            if estimate is not None:
+                change = estimate(value)
+                verdict = verdict_of(change, self.tolerance)
                 reason = f"changes the observables by about {change:.3g} (relative)"
             elif number == "grains":
                 change, verdict = None, OMIT if value <= 1 else MEASURE
