@@ -14,6 +14,7 @@ from sediment.lab.psd import read_psd
 from sediment.planner.plan import plan_effects
 from sediment.planner.scenes import DeckScene, SampleScene
 from sediment.planner.screening import INCLUDE, OMIT, SedimentationTest, screen
+from sediment.sim.run import run_batch
 
 REPO = Path(__file__).resolve().parents[2]
 SUSPENSION = REPO / "examples" / "planner" / "in.suspension"
@@ -40,7 +41,10 @@ def test_a_dilute_suspension_does_not_call_for_hindrance(tmp_path):
     assert change == pytest.approx(1 - 0.999 ** 4.65, rel=0.05)
     assert report["decision"]["settings"]["hindered"] == "no"
     assert report["decision"]["error"] <= 0.01
-    assert (tmp_path / "decision" / "in.suspension").read_text().count("effect_hindered index no") == 1
+    # the decided deck runs the planned one with the decision, from anywhere
+    decided = run_batch(tmp_path / "decision" / "in.suspension", cwd=tmp_path).results["speed"]
+    settings = {f"effect_{k}": v for k, v in report["decision"]["settings"].items()}
+    assert decided == run_batch(SUSPENSION, dict(settings, phi=0.001)).results["speed"]
 
 
 def test_a_suspension_at_a_tenth_calls_for_hindrance(tmp_path):
@@ -152,3 +156,25 @@ def test_bad_input_is_refused_with_the_reason(tmp_path, capsys):
     assert cli.main(["plan", str(SAMPLE5), "--screen-only", "--mass", "0.265"]) == 2
     assert "the hydrometer cannot read this test" in capsys.readouterr().err
     assert not (tmp_path / "o").exists()
+
+
+def test_an_interrupted_plan_stops_every_run_and_says_so(tmp_path):
+    """Ctrl-C while trials run in parallel: exit 130 with one line, no LAMMPS left running, and no
+    decision written."""
+    import signal
+    import subprocess
+
+    from test_faults import processes_in, wait_for
+
+    out = tmp_path / "plan"
+    plan = subprocess.Popen([str(REPO / "bin" / "sediment"), "plan", str(SAMPLE5), "--out", str(out), "--particles",
+                             "40000,20000", "--courant", "1,2", "--t-end", "7200"], stderr=subprocess.PIPE, text=True)
+    def busy() -> list[Path]:
+        return [f for f in (out / "runs").glob("*") if f.is_dir() and processes_in(f)]
+
+    wait_for(lambda: len(busy()) == 2)      # two trials at once (--jobs 2)
+    plan.send_signal(signal.SIGINT)
+    _, err = plan.communicate(timeout=20)     # not after the runs end (about 40 s each)
+    assert plan.returncode == 130 and "Traceback" not in err and "interrupted" in err
+    wait_for(lambda: not busy(), seconds=10)
+    assert not (out / "report.json").exists()

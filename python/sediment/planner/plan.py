@@ -22,6 +22,7 @@ from pathlib import Path
 
 from .. import figures
 from ..results import Table, write_text
+from ..sim.run import stop_all
 from .scenes import Knob, Outcome, prepare
 from .screening import INCLUDE, MEASURE, Screen
 
@@ -356,11 +357,18 @@ def _run_all(scene, trials: list[Trial], runs: Path, seed: int, jobs: int, progr
     if progress:
         from tqdm import tqdm
         bar = tqdm(total=len(trials), desc=f"plan: {what}", unit="run")
-    with ThreadPoolExecutor(max_workers=jobs) as pool:
+    pool = ThreadPoolExecutor(max_workers=jobs)
+    try:
         futures = {pool.submit(scene.run, t.settings, runs / t.name, seed): t for t in trials}
         for future in as_completed(futures):
             futures[future].outcome = future.result()
             if bar is not None:
                 bar.update()
+    except BaseException:             # Ctrl-C, SIGTERM or a failed trial: no run outlives the plan
+        pool.shutdown(wait=False, cancel_futures=True)
+        stop_all(scene.running)
+        raise
+    finally:
+        pool.shutdown(wait=True)
     if bar is not None:
         bar.close()

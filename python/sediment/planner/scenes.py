@@ -18,6 +18,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..results import write_text
 from ..sim.run import run_batch
 from ..sim.scene import DRAGS
 from .screening import INCLUDE, MEASURE, OMIT, Screen, SedimentationTest, screen, verdict_of
@@ -98,11 +99,14 @@ class SampleScene:
         self.test = test
         self.options = options              # further keyword arguments of scene.plan
         self.tolerance = tolerance
-        self.screens = screen(test, tolerance)
+        self.running: set = set()           # runs under way (stopped together on an interrupt)
         if not particles or any(p < 1 for p in particles):
             raise ValueError("the particle ladder needs at least one count >= 1")
         if not courant or any(not c > 0 for c in courant):
             raise ValueError("the courant ladder needs at least one value > 0")
+        for count in (max(particles), min(particles)):    # a scene the test cannot have fails here, not in a run
+            self._scene({"drag": "difelice", "particles": count, "courant": min(courant)}, 1)
+        self.screens = screen(test, tolerance)
         self.knobs = [Knob("drag", ("difelice", "dallavalle", "stokes"), "effect", ("hindered", "law")),
                       Knob("particles", tuple(sorted(set(particles), reverse=True)), "resolution"),
                       Knob("courant", tuple(sorted(set(courant))), "resolution")]
@@ -137,7 +141,7 @@ class SampleScene:
         from ..sim.layers import read_layers
 
         deck = self.write(settings, folder, seed)
-        out = run_batch(deck, {"overwrite": "yes"}, ranks=1, check=False)
+        out = run_batch(deck, {"overwrite": "yes"}, ranks=1, check=False, running=self.running)
         outcome = Outcome(sum(s for s, _ in out.loops), out.wall_seconds)
         if out.error:
             outcome.failure = out.error
@@ -225,6 +229,7 @@ class DeckScene:
                 raise ValueError(f"{deck}: the deck has no 'variable {name} index ...' for the ladder to set")
         self.observables = observables
         self.tolerance = tolerance
+        self.running: set = set()           # runs under way (stopped together on an interrupt)
         self.variables = dict(variables or {})
         self.ranks = ranks
         self.knobs = [Knob(name, ("yes", "no"), "effect", (name,)) for name, _ in effects]
@@ -270,23 +275,22 @@ class DeckScene:
                     self.screens.append(Screen(target, target, label, value, change, verdict, reason))
 
     def write(self, settings: dict, folder: Path, seed: int) -> Path:
-        """The deck with the setting's values as the defaults of its index variables."""
-        text = self.deck.read_text()
-        for knob, value in settings.items():
-            name = self._variable(knob)
-            text = re.sub(rf"^(\s*variable\s+{re.escape(name)}\s+index\s+)\S+", lambda m: m.group(1) + str(value),
-                          text, count=1, flags=re.MULTILINE)
-        path = Path(folder) / self.deck.name
-        path.parent.mkdir(parents=True, exist_ok=True)
-        path.write_text(text)
-        return path
+        """A deck that runs the planned one with the setting: it defines the index variables first
+        (LAMMPS keeps the first definition of an index variable, also in included files), moves to
+        the deck's folder, as the trials ran, so that its relative paths hold, and includes it."""
+        values = dict(self.variables, **{self._variable(k): v for k, v in settings.items()})
+        lines = [f"# The setting `sediment plan` decided for {self.deck.name} (and the variables it was planned with).",
+                 f"#   lmp_sediment -in {self.deck.name}     (runs {self.deck} in its own folder)"]
+        lines += [f"variable        {name} index {value}" for name, value in values.items()]
+        lines += [f'shell           cd "{self.deck.parent}"', f'include         "{self.deck}"']
+        return write_text(Path(folder) / self.deck.name, "\n".join(lines) + "\n")
 
     def run(self, settings: dict, folder: Path, seed: int) -> Outcome:
         """Runs the deck from its own folder with the setting as -var pairs."""
         from ..studies.sweep import observe
 
         variables = dict(self.variables, **{self._variable(k): v for k, v in settings.items()})
-        out = run_batch(self.deck, variables, ranks=self.ranks, check=False)
+        out = run_batch(self.deck, variables, ranks=self.ranks, check=False, running=self.running)
         outcome = Outcome(sum(s for s, _ in out.loops), out.wall_seconds)
         if out.error:
             outcome.failure = out.error

@@ -255,7 +255,7 @@ class DeckOutput:
 
 
 def run_batch(deck: Path, variables: dict[str, object] | None = None, ranks: int = 1, cwd: Path | None = None,
-              timeout: float | None = None, check: bool = True) -> DeckOutput:
+              timeout: float | None = None, check: bool = True, running: set | None = None) -> DeckOutput:
     """Runs a deck quietly (no log file) and collects what it prints.
 
     Parameters
@@ -272,6 +272,9 @@ def run_batch(deck: Path, variables: dict[str, object] | None = None, ranks: int
         Seconds before the run is killed.
     check : bool
         Raise RuntimeError with LAMMPS's message if the run fails.
+    running : set, optional
+        Holds the run's process while it runs, for a caller running several at once to stop them
+        (`stop_all`).
 
     Returns
     -------
@@ -284,11 +287,16 @@ def run_batch(deck: Path, variables: dict[str, object] | None = None, ranks: int
     cmd, env = _launch(str(deck), "none", ranks, variables)
     start = time.monotonic()
     proc = _start(cmd, env, cwd or deck.parent, stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    if running is not None:
+        running.add(proc)
     try:
         stdout, stderr = proc.communicate(timeout=timeout)
     except BaseException:
         _stop(proc)
         raise
+    finally:
+        if running is not None:
+            running.discard(proc)
     wall = time.monotonic() - start
     rows, results = [], {}
     for line in stdout.splitlines():
@@ -301,6 +309,12 @@ def run_batch(deck: Path, variables: dict[str, object] | None = None, ranks: int
     if check and out.error:
         raise RuntimeError(f"{deck.name} failed: {out.error}")
     return out
+
+
+def stop_all(running: set) -> None:
+    """Stops every run in `running` (see run_batch) and its ranks."""
+    for proc in list(running):
+        _stop(proc, grace=2.0)
 
 
 def _is_float(word: str) -> bool:
