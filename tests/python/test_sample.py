@@ -49,11 +49,13 @@ def test_slab_is_the_axial_section_in_2d():
 
 
 def test_time_steps_double_after_the_largest_grains_have_left():
-    scene = plan(read_psd(PSDS / "sample5.csv"), particles=2000, layers=200, t_end=86400.0)
+    scene = plan(read_psd(PSDS / "sample5.csv"), particles=2000, layers=200, t_end=86400.0, courant=1.0)
     stages = scene.stages()
     v_max = terminal_speed(scene.suspension, scene.classes.diameter.max(), "dallavalle")
     layer = scene.height / scene.layers
     assert stages[0][0] == pytest.approx(layer / v_max)                 # one layer per step at first
+    default = plan(read_psd(PSDS / "sample5.csv"), particles=2000, layers=200, t_end=86400.0)
+    assert 3 * layer / v_max < default.stages()[0][0] <= 4 * layer / v_max    # default Courant 4 (at most: whole frames)
     for (dt, n), (dt_next, _) in zip(stages[1:-2], stages[2:-1]):
         assert dt_next == pytest.approx(2 * dt)
     assert stages[-1][0] <= 2 * stages[-2][0]                          # the last is cut to end on time
