@@ -196,11 +196,13 @@ def screen(test: SedimentationTest, tolerance: float = 0.5) -> list[Screen]:
                           f"{100 * delay.max():.2g} % of their speed, which moves a reading by up to {change:.3g} pp; "
                           + in_bed))
 
-    film = s.particle_density * hi * v_max / (9 * s.viscosity)
+    closing = v_max - float(terminal_speeds(s, np.array([lo]))[0])    # the largest grain onto the finest
+    film = s.particle_density * hi * closing / (9 * s.viscosity)
     screens.append(Screen("lubrication", "lubrication (squeeze films between close grains)",
                           "approach Stokes number of the largest grain", film, None,
                           verdict if verdict != INCLUDE else MEASURE,
-                          f"films act only in the collisions above; at St = {film:.3g} "
+                          f"films act only in the contacts above; gaps close at up to {closing:.3g} m/s, and at "
+                          f"St = {film:.3g} "
                           f"{'<' if film < FILM_REBOUND_STOKES else '>='} {FILM_REBOUND_STOKES:g} they "
                           f"{'stop every rebound' if film < FILM_REBOUND_STOKES else 'let grains rebound'}"))
 
