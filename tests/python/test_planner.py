@@ -153,6 +153,10 @@ def test_bad_input_is_refused_with_the_reason(tmp_path, capsys):
         plan_effects(DeckScene(SUSPENSION, ["speed"], {}, 0.01), tmp_path / "o", -1.0)
     assert cli.main(["plan", str(SAMPLE5), "--deck", str(SUSPENSION)]) == 2
     assert "either a PSD table" in capsys.readouterr().err
+    assert cli.main(["plan", "--deck", str(SUSPENSION), "--observe", "speed", "--particles", "1000"]) == 2
+    assert "--particles is an option of a sedimentation test, not of a deck" in capsys.readouterr().err
+    assert cli.main(["plan", str(SAMPLE5), "--observe", "speed"]) == 2
+    assert "--observe is an option of a deck" in capsys.readouterr().err
     assert cli.main(["plan", str(SAMPLE5), "--screen-only", "--mass", "0.265"]) == 2
     assert "the hydrometer cannot read this test" in capsys.readouterr().err
     assert not (tmp_path / "o").exists()

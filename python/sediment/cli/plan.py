@@ -64,6 +64,9 @@ def add_parser(commands) -> argparse.ArgumentParser:
                       help="a resolution variable of the deck, richest value first (e.g. dt=1e-5,2e-5,4e-5)")
     deck.add_argument("--var", nargs=2, action="append", metavar=("NAME", "VALUE"), help="LAMMPS -var for every run")
     deck.add_argument("--np", type=count, default=1, help="MPI ranks per deck run")
+    # which options belong to which kind of scene, to refuse those that would be ignored
+    parser.set_defaults(kinds={"test": {a.dest: a.default for a in test._group_actions},
+                               "deck": {a.dest: a.default for a in deck._group_actions}})
     return parser
 
 
@@ -74,6 +77,11 @@ def run(args: argparse.Namespace) -> int:
 
     if (args.psd is None) == (args.deck is None):
         raise ValueError("give either a PSD table (a sedimentation test) or --deck DECK")
+    other = "test" if args.deck is not None else "deck"
+    ignored = [name for name, default in args.kinds[other].items() if getattr(args, name) != default]
+    if ignored:
+        raise ValueError(f"--{ignored[0].replace('_', '-')} is an option of a {'sedimentation test' if other == 'test' else 'deck'}"
+                         f", not of {'a deck' if other == 'test' else 'a sedimentation test'}")
     if args.deck is not None:
         tolerance = args.tolerance or 0.01
         scene = DeckScene(args.deck, args.observe or [], dict(args.ladder or []), tolerance, dict(args.var or []),
