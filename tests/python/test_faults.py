@@ -26,7 +26,8 @@ def sediment(*args, cwd: Path | None = None, **kwargs) -> subprocess.CompletedPr
 
 
 def sample(out: Path, *options) -> Path:
-    done = sediment("sample", PSD, "--out", out, "--t-end", 7200, *options)
+    # Courant 1: runs long enough (about 4x the default's steps) for a signal to find them running
+    done = sediment("sample", PSD, "--out", out, "--t-end", 7200, "--courant", 1, *options)
     assert done.returncode == 0, done.stderr
     return out / "in.sedimentation"
 
