@@ -8,8 +8,9 @@ decide the cheapest setting within the tolerance, verify it with a run, and repo
    against the reference and its cost ratio (loop time over the reference's).
 3. Every combination of the measured values is priced: predicted error the sum of its knobs' errors
    (each effect moves the observables on its own; errors of separate causes add at worst), predicted
-   cost the product of their cost ratios. The cheapest within the tolerance is run to verify it; if it
-   misses, the next cheapest is tried, and the reference is the last resort.
+   cost the product of their cost ratios (an effect left out never prices dearer; at equal cost fewer
+   effects come first). The cheapest within the tolerance run to verify them, as many at once as
+   trials ran; the first in that order that holds is the decision, and the reference the last resort.
 """
 from __future__ import annotations
 
