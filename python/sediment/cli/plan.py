@@ -13,18 +13,16 @@ def _counts(text: str) -> list[int]:
     return [count(word) for word in text.split(",")]
 
 
-def _ladder(text: str) -> tuple[str, list[str]]:
-    name, sep, values = text.partition("=")
-    if not sep or not name.strip() or not values.strip():
-        raise argparse.ArgumentTypeError(f"a ladder is NAME=RICHEST,...,CHEAPEST, got '{text}'")
-    return name.strip(), [v.strip() for v in values.split(",")]
-
-
-def _setting(text: str) -> tuple[str, str]:
+def _setting(text: str, what: str = "a setting is NAME=VALUE") -> tuple[str, str]:
     name, sep, value = text.partition("=")
     if not sep or not name.strip() or not value.strip():
-        raise argparse.ArgumentTypeError(f"a setting is NAME=VALUE, got '{text}'")
+        raise argparse.ArgumentTypeError(f"{what}, got '{text}'")
     return name.strip(), value.strip()
+
+
+def _ladder(text: str) -> tuple[str, list[str]]:
+    name, values = _setting(text, "a ladder is NAME=RICHEST,...,CHEAPEST")
+    return name, [v.strip() for v in values.split(",")]
 
 
 def add_parser(commands) -> argparse.ArgumentParser:

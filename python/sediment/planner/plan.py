@@ -70,7 +70,7 @@ class Plan:
         """Reference loop time over the decision's."""
         return self.reference.outcome.loop_seconds / self.decision.outcome.loop_seconds
 
-    def effect_table(self) -> Table:
+    def table(self) -> Table:
         """Per knob value: what it leaves out, the screening number, estimated and measured change,
         cost ratio, verdict; then the effects that are not knobs, with their screening."""
         unit = "pp" if self.unit == "pp" else "rel"
@@ -82,11 +82,9 @@ class Plan:
             table.add(knob.name, value, s.label if s else "", s.number if s else "", f"{s.value:.4g}" if s else "",
                       f"{s.change:.3g}" if s and s.change is not None else "", f"{trial.error:.3g}" if trial else "",
                       self._cost(trial), ("chosen" if chosen == value else f"keep {chosen}") + f" ({why})")
-        knobbed = {d for k in self.knobs for d in k.drops}
-        for s in self.screens:
-            if s.effect not in knobbed:
-                table.add(s.effect, "", s.label, s.number, f"{s.value:.4g}", f"{s.change:.3g}" if s.change is not None else "",
-                          "", "", f"{s.verdict}: {s.reason}")
+        for s in self._other_screens():
+            table.add(s.effect, "", s.label, s.number, f"{s.value:.4g}", f"{s.change:.3g}" if s.change is not None else "",
+                      "", "", f"{s.verdict}: {s.reason}")
         return table
 
     def text(self) -> str:
@@ -98,10 +96,8 @@ class Plan:
             mark = "<- chosen" if chosen == value else (f"screened: keep {chosen}" if knob.name in self.fixed else "")
             table.add(knob.name, value, "" if screen is None or screen.change is None else f"{screen.change:.3g}",
                       f"{trial.error:.3g}" if trial else "", self._cost(trial), mark)
-        knobbed = {d for k in self.knobs for d in k.drops}
         lines = [f"{k} screened: {why}" for k, (_, _, why) in self.fixed.items()]
-        lines += [f"{s.effect} ({s.number} {s.value:.3g}): {s.verdict}: {s.reason}" for s in self.screens
-                  if s.effect not in knobbed]
+        lines += [f"{s.effect} ({s.number} {s.value:.3g}): {s.verdict}: {s.reason}" for s in self._other_screens()]
         return table.text() + "\n".join(lines + self.notes()) + "\n"
 
     def _rows(self):
@@ -112,6 +108,11 @@ class Plan:
                 screen = screens.get(knob.drops[k]) if k < len(knob.drops) else None
                 trial = next((t for t in self.trials if t.settings[knob.name] == value), None)
                 yield knob, value, screen, trial
+
+    def _other_screens(self) -> list[Screen]:
+        """The screened effects that no knob switches."""
+        knobbed = {d for k in self.knobs for d in k.drops}
+        return [s for s in self.screens if s.effect not in knobbed]
 
     def _cost(self, trial: Trial | None) -> str:
         if trial is None or trial.outcome.failure:
@@ -132,16 +133,11 @@ class Plan:
                 verdict = "rejected" if t.error > self.tolerance else "also within the tolerance"
                 lines.append(f"verified, {verdict}: {_describe(t.settings)} (predicted {t.predicted_error:.3g}, "
                              f"measured {t.error:.3g}, loop {t.outcome.loop_seconds:.3g} s)")
-        knobbed = {d for k in self.knobs for d in k.drops}
-        for s in self.screens:
-            if s.verdict == MEASURE and s.effect not in knobbed:
+        for s in self._other_screens():
+            if s.verdict == MEASURE:
                 estimate = "no estimate" if s.change is None else f"estimated change {s.change:.3g} {unit}"
                 lines.append(f"not measurable in this scene: {s.label} ({estimate}): left out")
         return lines
-
-    def table(self) -> Table:
-        """The effects table (see effect_table)."""
-        return self.effect_table()
 
     def trial_table(self) -> Table:
         """Every run: its settings, loop time, errors per observable."""
@@ -174,7 +170,7 @@ class Plan:
     def save(self, folder: Path) -> list[Path]:
         """effects.csv, trials.csv, report.json, plan.png."""
         folder = Path(folder)
-        return [write_text(folder / "effects.csv", self.effect_table().csv()),
+        return [write_text(folder / "effects.csv", self.table().csv()),
                 write_text(folder / "trials.csv", self.trial_table().csv()),
                 write_text(folder / "report.json", json.dumps(self.as_dict(), indent=1, default=str) + "\n"),
                 self.plot(folder / "plan.png")]

@@ -47,7 +47,7 @@ class Outcome:
 
     loop_seconds: float = math.nan
     wall_seconds: float = math.nan
-    observations: dict[str, tuple[np.ndarray, np.ndarray]] = field(default_factory=dict)    # name: (x, y)
+    observations: dict = field(default_factory=dict)    # name: what the scene's error() compares
     failure: str | None = None
     printed: dict[str, float] = field(default_factory=dict)    # SCREEN numbers a deck printed
 
@@ -98,7 +98,6 @@ class SampleScene:
                  tolerance: float):
         self.test = test
         self.options = options              # further keyword arguments of scene.plan
-        self.tolerance = tolerance
         self.running: set = set()           # runs under way (stopped together on an interrupt)
         if not particles or any(p < 1 for p in particles):
             raise ValueError("the particle ladder needs at least one count >= 1")
@@ -242,10 +241,16 @@ class DeckScene:
 
     def describe(self, settings: dict) -> str:
         """The -var options of a setting."""
-        return " ".join(f"-var {self._variable(k)} {v}" for k, v in settings.items())
+        return " ".join(f"-var {name} {value}" for name, value in self._knob_values(settings).items())
 
-    def _variable(self, knob: str) -> str:
-        return knob if any(k.name == knob and k.kind == "resolution" for k in self.knobs) else f"effect_{knob}"
+    def _knob_values(self, settings: dict) -> dict:
+        """The deck variables a setting sets: effect_NAME for an effect, the ladder's own name."""
+        resolutions = {k.name for k in self.knobs if k.kind == "resolution"}
+        return {k if k in resolutions else f"effect_{k}": v for k, v in settings.items()}
+
+    def _values(self, settings: dict) -> dict:
+        """Every deck variable of a run of a setting: those every run has, then the setting's."""
+        return dict(self.variables, **self._knob_values(settings))
 
     def screen_printed(self, printed: dict[str, float]) -> None:
         """Screens the deck's effects from the numbers its reference run printed."""
@@ -278,7 +283,7 @@ class DeckScene:
         """A deck that runs the planned one with the setting: it defines the index variables first
         (LAMMPS keeps the first definition of an index variable, also in included files), moves to
         the deck's folder, as the trials ran, so that its relative paths hold, and includes it."""
-        values = dict(self.variables, **{self._variable(k): v for k, v in settings.items()})
+        values = self._values(settings)
         lines = [f"# The setting `sediment plan` decided for {self.deck.name} (and the variables it was planned with).",
                  f"#   lmp_sediment -in {self.deck.name}     (runs {self.deck} in its own folder)"]
         lines += [f"variable        {name} index {value}" for name, value in values.items()]
@@ -289,8 +294,7 @@ class DeckScene:
         """Runs the deck from its own folder with the setting as -var pairs."""
         from ..studies.sweep import observe
 
-        variables = dict(self.variables, **{self._variable(k): v for k, v in settings.items()})
-        out = run_batch(self.deck, variables, ranks=self.ranks, check=False, running=self.running)
+        out = run_batch(self.deck, self._values(settings), ranks=self.ranks, check=False, running=self.running)
         outcome = Outcome(sum(s for s, _ in out.loops), out.wall_seconds)
         if out.error:
             outcome.failure = out.error
@@ -300,7 +304,7 @@ class DeckScene:
         except ValueError as exc:
             outcome.failure = str(exc)
             return outcome
-        outcome.observations = {k: (o.x if o.x is not None else np.zeros(1), o.y) for k, o in found.items()}
+        outcome.observations = found
         outcome.printed = {w[1]: float(w[2]) for w in (line.split() for line in out.text.splitlines())
                            if len(w) == 3 and w[0] == "SCREEN"}
         return outcome
@@ -308,9 +312,6 @@ class DeckScene:
     @staticmethod
     def error(run: dict, reference: dict) -> dict[str, float]:
         """Relative error per observable (a series: largest difference over the reference's magnitude)."""
-        from ..studies.sweep import Observation, relative_error
+        from ..studies.sweep import relative_error
 
-        def as_obs(xy):
-            x, y = xy
-            return Observation(y) if len(y) == 1 and len(x) == 1 and x[0] == 0 else Observation(y, x)
-        return {k: relative_error(as_obs(run[k]), as_obs(ref)) if k in run else math.inf for k, ref in reference.items()}
+        return {k: relative_error(run[k], ref) if k in run else math.inf for k, ref in reference.items()}

@@ -82,33 +82,32 @@ def terminal_speeds(suspension: Suspension, diameter: np.ndarray, law: str = "da
 
 
 class ReadingModel:
-    """The instruments reading analytic columns of one test: `change(speed_a, speed_b)` is the
-    largest difference of any reading [percentage points] between two settling-speed laws."""
+    """The instruments reading analytic columns of one test: `change(speed)` is the largest
+    difference of any reading [percentage points] from the readings at the reference speeds."""
 
-    def __init__(self, test: SedimentationTest):
+    def __init__(self, test: SedimentationTest, reference_speed):
         self.test = test
         pipette = Pipette(PIPETTE_DEPTH).default_times(test.suspension)
         self.times = np.unique(np.concatenate([[0.0], np.array(SCHEDULES["d422"] + SCHEDULES["bravo"]) * 60.0,
                                                pipette]))
-
-        for name in test.instruments:    # an instrument that cannot read this suspension at all
+        column = self._column(reference_speed)
+        self.reference: dict[str, np.ndarray] = {}
+        for name in test.instruments:    # one at a time: an instrument that cannot read this test is named
             try:
-                self.readings(None, [name])
+                found, _ = read_all(column, [name], cylinder_area=test.cylinder.area)
             except ValueError as exc:
                 raise ValueError(f"the {name} cannot read this test ({exc}): plan without it (--instruments)") from None
+            self.reference.update({r.instrument: r.percent_finer for r in found})
 
-    def readings(self, speed, instruments: list[str] | None = None) -> dict[str, np.ndarray]:
-        """Percent finer of every reading, per instrument, when the classes settle at `speed(d)`."""
+    def _column(self, speed):
         t = self.test
-        column = settling_column(t.psd, t.cylinder.height, self.times, t.initial_concentration, t.suspension,
-                                 layers=1200, classes=300, speed=speed)
-        found, _ = read_all(column, instruments or list(t.instruments), cylinder_area=t.cylinder.area)
-        return {r.instrument: r.percent_finer for r in found}
+        return settling_column(t.psd, t.cylinder.height, self.times, t.initial_concentration, t.suspension,
+                               layers=1200, classes=300, speed=speed)
 
-    def change(self, speed_a, speed_b) -> float:
-        """max |P_a - P_b| over the instruments' readings."""
-        a, b = self.readings(speed_a), self.readings(speed_b)
-        return max(float(np.max(np.abs(a[k] - b[k]))) for k in a)
+    def change(self, speed) -> float:
+        """max |P - P_reference| over the instruments' readings when the classes settle at `speed(d)`."""
+        found, _ = read_all(self._column(speed), list(self.test.instruments), cylinder_area=self.test.cylinder.area)
+        return max(float(np.max(np.abs(r.percent_finer - self.reference[r.instrument]))) for r in found)
 
 
 def encounters(test: SedimentationTest, classes: int = 120) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
@@ -163,20 +162,20 @@ def screen(test: SedimentationTest, tolerance: float = 0.5) -> list[Screen]:
     if not tolerance > 0:
         raise ValueError(f"the tolerance must be > 0 percentage points, not {tolerance:g}")
     s, t = test.suspension, test
-    model = ReadingModel(test)
     dallavalle = lambda d: terminal_speeds(s, d)    # noqa: E731 - the reference speeds
+    model = ReadingModel(test, dallavalle)
     lo, hi = t.psd.span()
     phi = t.solid_fraction
     screens = []
 
     v_max = float(terminal_speeds(s, np.array([hi]))[0])
     reynolds = s.fluid_density * v_max * hi / s.viscosity
-    change = model.change(s.stokes_speed, dallavalle)
+    change = model.change(s.stokes_speed)
     screens.append(Screen("law", "drag beyond Stokes (Dallavalle)", "largest particle Reynolds number", reynolds, change,
                           verdict_of(change, tolerance),
                           f"Stokes' law instead of Dallavalle's moves a reading by up to {change:.3g} pp"))
 
-    change = model.change(lambda d: terminal_speeds(s, d, "difelice", 1 - phi), dallavalle)
+    change = model.change(lambda d: terminal_speeds(s, d, "difelice", 1 - phi))
     screens.append(Screen("hindered", "hindered settling and mixture buoyancy (Di Felice)", "initial solid fraction",
                           phi, change, verdict_of(change, tolerance),
                           f"settling {100 * (1 - (1 - phi) ** 4.65):.3g} % slower at phi0 = {phi:.3g} moves a "
@@ -184,7 +183,7 @@ def screen(test: SedimentationTest, tolerance: float = 0.5) -> list[Screen]:
 
     diameter, share, contacts, delay = encounters(test)
     slower = lambda d: dallavalle(d) / (1 + np.interp(np.log(d), np.log(diameter), delay))    # noqa: E731
-    change = model.change(slower, dallavalle)
+    change = model.change(slower)
     bed = t.mass / (s.particle_density * t.cylinder.area * BED_PACKING)
     clearance = t.cylinder.height - lowest_sensed_depth(test) - bed
     in_bed = (f"the bed ({bed * 1e3:.3g} mm) stays {clearance * 1e3:.3g} mm below the deepest instrument"
@@ -221,7 +220,7 @@ def screen(test: SedimentationTest, tolerance: float = 0.5) -> list[Screen]:
                           "competes with settling; not simulated"))
 
     ratio = hi / t.cylinder.diameter
-    change = model.change(lambda d: dallavalle(d) / (1 + 2.1 * d / t.cylinder.diameter), dallavalle)
+    change = model.change(lambda d: dallavalle(d) / (1 + 2.1 * d / t.cylinder.diameter))
     screens.append(Screen("wall", "cylinder wall (Ladenburg)", "largest diameter / cylinder diameter", ratio, change,
                           REPORT, f"the wall slows grains by up to {100 * 2.1 * ratio:.2g} %, moving a reading by up "
                           f"to {change:.3g} pp; not simulated (the sub-volume is periodic)"))
