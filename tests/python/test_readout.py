@@ -48,6 +48,20 @@ def test_measured_instrument_is_a_parameter_set():
     assert heavier.read(column, [0.5]).reading[0] < nominal.read(column, [0.5]).reading[0] - 5    # sinks deeper
 
 
+def test_default_buoyancy_sphere_reads_what_a_balance_shows():
+    """The 25 mm, 20 g Teflon sphere: 20 g less the liquid it displaces (8.18 cm3), so 11.8 g in water and
+    0.31 g less in 60 g/L of 2650 kg/m3 solids (rho_s - rho_w = 60 (1 - rho_w / 2650) kg/m3)."""
+    sphere = BuoyancySphere(depth=0.1)
+    volume_cm3 = np.pi / 6 * 2.5 ** 3
+    water = sphere.read(uniform(0.0), [0.5])
+    loaded = sphere.read(uniform(60.0), [0.5])
+    rho_w, rho_p = Suspension().fluid_density / 1000, Suspension().particle_density / 1000    # g/cm3
+    assert water.reading[0] == pytest.approx(20 - rho_w * volume_cm3, abs=1e-9)
+    assert water.reading[0] - loaded.reading[0] == pytest.approx(60e-3 * (1 - rho_w / rho_p) * volume_cm3, rel=1e-9)
+    # 100 % within the formula's Gs / (Gs - 1), Gs = rho_s / 1000, against water at 998.2: 0.11 % high
+    assert loaded.percent_finer[0] == pytest.approx(100 * (1 - rho_w / rho_p) / (1 - 1 / rho_p), rel=1e-9)
+
+
 def recovered_error(readings, psd: PSD, lo: float, hi: float) -> float:
     resolved = (readings.diameter >= lo) & (readings.diameter <= hi)
     assert resolved.sum() >= 3

@@ -237,11 +237,12 @@ class Hydrometer:
 
 @dataclass(frozen=True)
 class BuoyancySphere:
-    """A sphere hung from a balance at a fixed centre depth (Bardet & Young 1997)."""
+    """A sphere hung from a balance at a fixed centre depth (Bardet & Young 1997). The default is the
+    Teflon sphere of 25 mm and 20 g, so the apparent mass is what the balance shows (11.8 g in water)."""
 
     depth: float
     diameter: float = 0.025
-    mass: float = 0.0       # its own mass [kg]; only shifts the apparent mass
+    mass: float = 0.020     # its own mass [kg]; shifts the apparent mass, not the percent finer
 
     def read(self, column: Column, times_s) -> Readings:
         """Apparent mass [g] of the sphere at each time, with the diameter and percent finer it gives."""
