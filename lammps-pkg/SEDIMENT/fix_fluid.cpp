@@ -9,9 +9,11 @@
 #include "domain.h"
 #include "error.h"
 #include "force.h"
+#include "input.h"
 #include "modify.h"
 #include "region.h"
 #include "update.h"
+#include "variable.h"
 
 #include <cmath>
 #include <cstring>
@@ -20,7 +22,8 @@ using namespace LAMMPS_NS;
 using namespace FixConst;
 
 FixFluid::FixFluid(LAMMPS *lmp, int narg, char **arg) :
-    Fix(lmp, narg, arg), has_surface(0), surface_offset(0.0), region_id(nullptr), region(nullptr)
+    Fix(lmp, narg, arg), has_surface(0), surface_offset(0.0), surface_variable(nullptr), surface_ivar(-1),
+    centre_crossing(false), region_id(nullptr), region(nullptr)
 {
   flow[0] = flow[1] = flow[2] = 0.0;
   surface_normal[0] = surface_normal[1] = 0.0;
@@ -64,11 +67,24 @@ FixFluid::FixFluid(LAMMPS *lmp, int narg, char **arg) :
         const int dim = sediment_axis(args.text(1));
         if (dim < 0) args.fail("surface axis must be x, y, z or plane, not '{}'", args.text(1));
         normal[dim] = 1.0;
-        surface_offset = args.number(2);
+        delete[] surface_variable;
+        surface_variable = nullptr;
+        if (strncmp(args.text(2), "v_", 2) == 0)
+          surface_variable = utils::strdup(args.text(2) + 2);
+        else
+          surface_offset = args.number(2);
         nvalues = 2;
       }
       for (int k = 0; k < 3; ++k) surface_normal[k] = normal[k];
       has_surface = 1;
+    } else if (args.is("crossing")) {
+      args.need(1, "cap or centre");
+      if (strcmp(args.text(1), "cap") == 0)
+        centre_crossing = false;
+      else if (strcmp(args.text(1), "centre") == 0)
+        centre_crossing = true;
+      else
+        args.fail("crossing must be cap or centre, not '{}'", args.text(1));
     } else if (args.is("region")) {
       args.need(1, "a region ID");
       delete[] region_id;
@@ -78,13 +94,15 @@ FixFluid::FixFluid(LAMMPS *lmp, int narg, char **arg) :
       for (int k = 0; k < 3; ++k) flow[k] = args.number(1 + k);
       nvalues = 3;
     } else {
-      args.unknown("density, viscosity, bingham, surface, region or velocity");
+      args.unknown("density, viscosity, bingham, surface, crossing, region or velocity");
     }
     args.next(nvalues);
   }
   if (!has_density) error->all(FLERR, "Fix fluid: keyword 'density' is required");
   if (has_viscosity == has_bingham)
     error->all(FLERR, "Fix fluid: give exactly one of 'viscosity MU' or 'bingham TAU_Y ETA_B'");
+  if (centre_crossing && !has_surface)
+    error->all(FLERR, "Fix fluid: keyword 'crossing' needs a 'surface'");
   if (has_surface && !std::isfinite(surface_offset))
     error->all(FLERR, "Fix fluid: surface position must be finite");
   if (domain->dimension == 2 && has_surface && surface_normal[2] != 0.0)
@@ -93,6 +111,7 @@ FixFluid::FixFluid(LAMMPS *lmp, int narg, char **arg) :
 
 FixFluid::~FixFluid()
 {
+  delete[] surface_variable;
   delete[] region_id;
 }
 
@@ -112,11 +131,27 @@ void FixFluid::init()
     region = sediment_region_by_id(domain, region_id);
     if (!region) error->all(FLERR, "Fix fluid: region '{}' does not exist", region_id);
   }
+  if (surface_variable) {
+    surface_ivar = input->variable->find(surface_variable);
+    if (surface_ivar < 0)
+      error->all(FLERR, "Fix fluid: surface variable '{}' does not exist", surface_variable);
+    if (!input->variable->equalstyle(surface_ivar))
+      error->all(FLERR, "Fix fluid: surface variable '{}' must be equal-style", surface_variable);
+  }
 }
 
 void FixFluid::prepare()
 {
   if (region) region->prematch();
+  if (surface_variable) {
+    // The variable may read other fixes' results of the previous step (the volume the spheres
+    // displace, for a level that rises as they sink), as fix wall does with its position.
+    modify->clearstep_compute();
+    surface_offset = input->variable->compute_equal(surface_ivar);
+    modify->addstep_compute(update->ntimestep + 1);
+    if (!std::isfinite(surface_offset))
+      error->all(FLERR, "Fix fluid: surface variable '{}' gave {}", surface_variable, surface_offset);
+  }
 }
 
 sediment::Submergence FixFluid::bounded_immersion(const double *x, double radius) const
@@ -125,6 +160,7 @@ sediment::Submergence FixFluid::bounded_immersion(const double *x, double radius
   if (!has_surface) return {1.0, 1.0, 1.0};
   const double height = x[0] * surface_normal[0] + x[1] * surface_normal[1] +
       x[2] * surface_normal[2] - surface_offset;
+  if (centre_crossing) return height <= 0.0 ? sediment::Submergence{1.0, 1.0, 1.0} : sediment::Submergence{0.0, 0.0, 0.0};
   return sediment::submergence(radius, height);
 }
 

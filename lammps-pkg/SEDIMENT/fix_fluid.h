@@ -29,7 +29,8 @@ class FixFluid : public Fix {
   int setmask() override;
   void init() override;
 
-  // Call once per step before immersion(): refreshes a moving region.
+  // Call once per step before immersion(): refreshes a moving region and a surface given by a
+  // variable.
   void prepare();
   // How much of sphere (centre x, radius r) is in the fluid (inline: called per atom and step).
   sediment::Submergence immersion(const double *x, double radius) const
@@ -53,6 +54,9 @@ class FixFluid : public Fix {
   int has_surface;
   double surface_normal[3];    // unit normal pointing out of the fluid
   double surface_offset;       // surface is {x : x . normal = offset}
+  char *surface_variable;      // equal-style variable giving the offset (nullptr: fixed)
+  int surface_ivar;
+  bool centre_crossing;        // the whole sphere is in the fluid once its centre is (no cap)
   char *region_id;
   class Region *region;
   sediment::Submergence bounded_immersion(const double *x, double radius) const;

@@ -157,11 +157,46 @@ def paste(np_ranks: int):
     e = math.sqrt(out.results["rebound"] / 0.252)
     report(f"drop test from 252 mm: rebound {out.results['rebound'] * 1e3:.2f} mm, e = {e:.4f}")
     assert abs(e - 0.612) < 1e-3
+    out = run_deck(PASTE_DECKS / "in.collision", {"speed": 1.7}, np_ranks, cwd=PASTE_DECKS)
+    report(f"two 12.6 mm balls head-on at 1.7 m/s with the wall's damping input: e = {out.results['restitution']:.4f}")
+    assert abs(out.results["restitution"] - 0.612) < 1e-3
     out = run_deck(PASTE_DECKS / "in.ball_in_paste", {"d": 0.0126, "fall": 0.255}, np_ranks, cwd=PASTE_DECKS)
     r = out.results
     report(f"12.6 mm ball from 255 mm: at rest {r['depth'] * 1e3:.3f} mm below the surface after {r['t_rest']} s, "
            f"creep over the hold {r['creep']}, speed {r['vz']}")
     assert r["stuck"] == 1 and r["creep"] == 0 and r["vz"] == 0 and 0 < r["depth"] < 0.150 - 0.0126
+
+
+@check
+def struck_ball(np_ranks: int):
+    # A ball held by the paste's yield stress takes a blow from above as a free ball would: the blow's
+    # impulse (about 1e-2 N s in 50 us) dwarfs the yield's (0.26 N over the same 50 us, 1.3e-5 N s).
+    v0, e = 1.0, 0.612
+    after = {}
+    for rheology in ("bingham 136 0.7", "viscosity 0.7"):
+        out = run_deck("struck_ball.lmp", {"mode": "impact", "v0": v0, "rheology": rheology, "dt": 1e-7,
+                                           "steps": 1000, "every": 1000}, np_ranks)
+        after[rheology.split()[0]] = out.samples[-1, [2, 4]]    # vz of A and B 100 us after the blow
+    free = np.array([-(1 - e) / 2 * v0, -(1 + e) / 2 * v0])
+    report(f"held ball struck at {v0} m/s: vz (A, B) after the blow {after['bingham']} in paste, "
+           f"{after['viscosity']} without yield stress, free-ball collision {free}")
+    assert np.all(np.abs(after["bingham"] - free) < 0.01 * v0)
+    assert np.all(np.abs(after["bingham"] - after["viscosity"]) < 0.005 * v0)
+    # Loaded through a contact, it stays exactly still up to its yield resistance and sinks beyond.
+    d, rho, rho_paste, tau_y = 0.0126, 8135.0, 1843.0, 136.0
+    volume = math.pi * d ** 3 / 6
+    resistance = (math.pi ** 2 / 4 + 3 * math.pi) * d * d * tau_y    # spec/physics.md section 4
+    for ratio in (0.98, 1.02):
+        weight_a = ratio * resistance - (rho - rho_paste) * G * volume
+        out = run_deck("struck_ball.lmp", {"mode": "load", "rho_A": weight_a / (G * volume), "dt": 1e-6,
+                                           "steps": 50000, "every": 500}, np_ranks)
+        z_b, vz_b = out.samples[:, 3], out.samples[:, 4]
+        report(f"held ball loaded to {ratio} of its yield resistance through a contact: B moved "
+               f"{abs(z_b[-1] - z_b[0]):.3g} m in 0.05 s, vz {vz_b[-1]:.3g} m/s, held {out.results['stuck_B']:.0f}")
+        if ratio < 1:
+            assert np.all(z_b == z_b[0]) and np.all(vz_b == 0) and out.results["stuck_B"] == 1
+        else:
+            assert vz_b[-1] < -1e-3 and out.results["stuck_B"] == 0
 
 
 # ---- Bingham hard cases -----------------------------------------------------------------------
@@ -222,17 +257,28 @@ def bingham_jump(np_ranks: int):
 # ---- free surface -------------------------------------------------------------------------------
 @check
 def surface_crossing(np_ranks: int):
-    out = run_deck("surface_crossing.lmp", {}, np_ranks)
-    z, force = out.samples[:, 1], out.samples[:, 2]
     r = 0.5e-3
     volume = 4 / 3 * math.pi * r ** 3
-    expected = np.array([1000 * G * volume * _core.submergence(r, zc)["volume"] for zc in z])
-    err = float(np.max(np.abs(force - expected)) / (1000 * G * volume))
-    steps = np.abs(np.diff(force)) / (1000 * G * volume)
-    report(f"surface crossing: max |F_b - rho g V_cap| / (rho g V) = {err:.1e}; largest change between "
-           f"samples {steps.max():.3e} of the full buoyancy (sample spacing {abs(z[1] - z[0]) / (2 * r):.3f} d)")
-    assert err < 1e-12
-    assert steps.max() < 3 * abs(z[1] - z[0]) / (2 * r)    # slope of V_cap is at most 1.5 V / d
+    full = 1000 * G * volume
+    # A fixed surface, one that rises at 0.5 mm/s (a variable), and the paper's switch at the centre.
+    for crossing, rise in (("cap", 0.0), ("cap", 5e-4), ("centre", 0.0)):
+        out = run_deck("surface_crossing.lmp", {"crossing": crossing, "rise": rise}, np_ranks)
+        t, z, force = out.samples[:, 0], out.samples[:, 1], out.samples[:, 2]
+        height = z - rise * t
+        if crossing == "cap":
+            expected = np.array([full * _core.submergence(r, h)["volume"] for h in height])
+        else:
+            expected = np.where(height <= 0, full, 0.0)
+        err = float(np.max(np.abs(force - expected)) / full)
+        steps = np.abs(np.diff(force)) / full
+        report(f"surface crossing ({crossing}, surface rising at {rise} m/s): max |F_b - expected| / (rho g V) = "
+               f"{err:.1e}; largest change between samples {steps.max():.3e} of the full buoyancy (sample spacing "
+               f"{abs(height[1] - height[0]) / (2 * r):.3f} d)")
+        assert err < 1e-12
+        if crossing == "cap":    # continuous: the slope of V_cap is at most 1.5 V / d
+            assert steps.max() < 3 * abs(height[1] - height[0]) / (2 * r)
+        else:
+            assert np.sum(steps > 0.5) == 1
 
 
 @check
@@ -713,6 +759,10 @@ BAD_INPUT = [
     ("fix f all fluid density 1000 bingham -3 0.1", "bingham yield stress must be finite and > 0"),
     ("fix f all fluid density 1000 bingham 3 -0.1", "bingham plastic viscosity must be finite and > 0"),
     ("fix f all fluid density 1000 viscosity 1e-3 surface w 0", "surface axis must be x, y, z or plane"),
+    ("fix f all fluid density 1000 viscosity 1e-3 surface z v_nolevel\nrun 0", "surface variable 'nolevel' does not exist"),
+    ("variable h atom z\nfix f all fluid density 1000 viscosity 1e-3 surface z v_h\nrun 0", "surface variable 'h' must be equal-style"),
+    ("fix f all fluid density 1000 viscosity 1e-3 surface z 0 crossing middle", "crossing must be cap or centre, not 'middle'"),
+    ("fix f all fluid density 1000 viscosity 1e-3 crossing centre", "keyword 'crossing' needs a 'surface'"),
     ("fix f all fluid density 1000 viscosity", "keyword 'viscosity' needs 1 value"),
     ("fix f all fluid density abc viscosity 1e-3", "Expected floating point parameter"),
     ("fix f all fluid density 1000 viscosity 1e-3 region nowhere\nrun 0", "region 'nowhere' does not exist"),
