@@ -61,7 +61,9 @@ def test_unknown_submergence_is_refused():
     assert out.error == "ERROR: effect_submergence must be yes or no, not maybe"
 
 
-def test_funnel_pours_every_ball_into_the_mould():
+def test_funnel_pours_every_ball_into_the_paste():
+    """Two of the default study's pours: every ball accounted for, inside the mould, and (the paper's
+    result) every ball wholly below the paste surface, none spilled."""
     pours = [funnel.pour(seed) for seed in (1, 2)]
     r = funnel.DIAMETER / 2
     for p in pours:
@@ -71,7 +73,18 @@ def test_funnel_pours_every_ball_into_the_mould():
         # Hertz overlaps under these loads are micrometres: 1 % of the radius is a generous bound.
         assert radial.max() <= funnel.MOULD_RADIUS - r + 0.01 * r
         assert p.positions[:, 2].min() >= r - 0.01 * r
-        assert p.positions[:, 2].max() < funnel.OUTLET_HEIGHT
+        assert p.spilled == 0 and p.depths().min() > r
+        assert p.surface == paste.PASTE["surface"]    # filled to the brim: the displaced paste overflows
+
+
+def test_displaced_paste_raises_the_level_to_the_brim():
+    """Filled 16 mm below the brim, the level rises by the volume of the balls below it over the mould's
+    cross-section, and stops at the brim."""
+    volume, area = math.pi / 6 * funnel.DIAMETER**3, math.pi * funnel.MOULD_RADIUS**2
+    for fill in (0.140, 0.130):
+        p = funnel.pour(1, settings={"surface": str(fill), "effect_displacement": "yes"})
+        assert p.depths().min() > funnel.DIAMETER / 2    # every ball wholly under the final level
+        assert p.surface == pytest.approx(min(fill + p.balls * volume / area, 0.150), rel=1e-9)
 
 
 def test_random_packing_is_clear_of_walls_and_balls():
@@ -85,14 +98,58 @@ def test_random_packing_is_clear_of_walls_and_balls():
 
 
 def test_presence_probability_of_one_ball():
-    ball = funnel.Pour(1, 1, 1, 0, np.array([[0.0, 0.0, 0.1]]), 0.0, 0.0, 0.0)
-    centres, prob = funnel.presence_probability([ball, ball], plane=0.1, cell=0.001)
+    ball = funnel.Pour(1, 1, 1, 0, np.array([[0.0, 0.0, 0.1]]), 0.15, 0.0, 0.0, 0.0)    # 50 mm below the level
+    centres, prob = funnel.presence_probability([ball, ball], depth=0.05, cell=0.001)
     gx, gy = np.meshgrid(centres, centres, indexing="ij")
     radial = np.hypot(gx, gy)
     assert np.all(prob[radial < funnel.DIAMETER / 2 - 1e-9] == 1.0)
     assert np.all(prob[(radial > funnel.DIAMETER / 2 + 1e-9) & (radial < funnel.MOULD_RADIUS)] == 0.0)
     assert np.all(np.isnan(prob[radial > funnel.MOULD_RADIUS + 1e-9]))
     # A plane through the ball's cap cuts a smaller disc.
-    _, cap = funnel.presence_probability([ball], plane=0.1 + 0.8 * funnel.DIAMETER / 2, cell=0.001)
+    _, cap = funnel.presence_probability([ball], depth=0.05 - 0.8 * funnel.DIAMETER / 2, cell=0.001)
     assert 0 < np.nansum(cap) < np.nansum(prob) / 2
     assert math.isclose(np.nansum(prob) * 1e-6, math.pi * (funnel.DIAMETER / 2) ** 2, rel_tol=0.05)
+    # Depths count from each pour's own final level: the same ball under a level 10 mm higher.
+    risen = funnel.Pour(2, 1, 1, 0, np.array([[0.0, 0.0, 0.1]]), 0.16, 0.0, 0.0, 0.0)
+    _, shifted = funnel.presence_probability([risen], depth=0.06, cell=0.001)
+    assert np.array_equal(np.nan_to_num(shifted), np.nan_to_num(funnel.presence_probability([ball], 0.05, 0.001)[1]))
+
+
+def test_funnel_summary_counts_what_the_paper_reports(tmp_path):
+    r = funnel.DIAMETER / 2
+    level = 0.16
+    depths = np.array([-0.001, 0.5 * r, 2 * r, 0.030, 0.045])    # centre above; top above; three inside
+    positions = np.column_stack([np.zeros(5), np.zeros(5), level - depths])
+    pours = [funnel.Pour(1, 6, 5, 1, positions, level, 0.0, 0.1, 1.0),
+             funnel.Pour(2, 6, 5, 0, positions + [0.01, 0, 0], level, 0.0, 0.1, 1.0)]
+    study = funnel.FunnelStudy(pours, {"stem": "0.05"}, 1e-6)
+    s = study.summary()
+    assert (s.runs, s.balls, s.spilled, s.centre_above, s.top_above) == (2, 10, 1, 2, 4)
+    assert s.depth_mm["min"] == pytest.approx(-1.0) and s.depth_mm["max"] == pytest.approx(45.0)
+    study.save(tmp_path / "stem")
+    back = funnel.FunnelStudy.load(tmp_path / "stem")
+    assert back.settings == {"stem": "0.05"} and back.dt == 1e-6 and back.summary() == s
+    table = funnel.compare([tmp_path / "stem", tmp_path / "stem"]).table().text()
+    assert "stem=0.05" in table
+    with pytest.raises(ValueError, match="not a saved funnel study"):
+        funnel.compare([tmp_path])
+    # A save interrupted between its two files (here: positions of another study) is refused.
+    other = funnel.FunnelStudy(pours[:1], {}, 1e-6)
+    other.save(tmp_path / "other")
+    (tmp_path / "stem" / "funnel_positions.csv").write_text((tmp_path / "other" / "funnel_positions.csv").read_text())
+    with pytest.raises(ValueError, match="not the one funnel_summary.json was saved with"):
+        funnel.FunnelStudy.load(tmp_path / "stem")
+
+
+def test_funnel_settings_are_checked_before_any_run():
+    with pytest.raises(ValueError, match="sets packing itself"):
+        funnel.pour(1, settings={"packing": "mine.lmp"})
+    with pytest.raises(ValueError, match="in.funnel has no variable stemm"):    # LAMMPS would ignore it
+        funnel.funnel_study(runs=1, settings={"stemm": "0.05"}, progress=False)
+    for bad in ({"stem": "-0.01"}, {"fall": "0"}, {"surface": "0.2"}, {"stem": "long"}):
+        with pytest.raises(ValueError, match="stem"):
+            funnel.funnel_study(runs=1, settings=bad, progress=False)
+    # The packing follows the funnel: a longer stem lifts the cone and the balls in it.
+    low, high = (funnel.random_packing(3, funnel=funnel.Funnel.of({"stem": s})) for s in ("0", "0.05"))
+    assert np.allclose(high[:, 2] - low[:, 2], 0.05)
+    assert high[:, 2].min() > funnel.Funnel.of({"stem": "0.05"}).outlet_height

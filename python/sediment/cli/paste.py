@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from .types import count, nonnegative, positive
+from .types import count, nonnegative, positive, setting
 
 
 def add_parser(commands) -> argparse.ArgumentParser:
@@ -29,7 +29,14 @@ def add_parser(commands) -> argparse.ArgumentParser:
     pour.add_argument("--runs", type=count, default=15)
     pour.add_argument("--jobs", type=count, default=2, help="runs at a time")
     pour.add_argument("--dt", type=positive, default=1e-6, help="[s]")
+    pour.add_argument("--set", type=setting, action="append", default=[], metavar="NAME=VALUE",
+                      help="a variable of examples/paste/in.funnel (or of the steel.lmp and mould.lmp it includes), "
+                      "for a variant: stem=0.05, fall=0.15, effect_submergence=no, tsuji=0.2, ...; repeatable")
     pour.add_argument("--out", type=Path, default=Path("out/paste"), help="output folder")
+    variants = studies.add_parser("funnel-compare", help="funnel studies saved by 'funnel --out DIR' side by side: "
+                                  "spills, balls at the surface, depths; funnel_variants.csv and .png")
+    variants.add_argument("folders", type=Path, nargs="+", help="folders of saved studies (labelled by their names)")
+    variants.add_argument("--out", type=Path, default=Path("out/paste"), help="output folder")
     return parser
 
 
@@ -48,8 +55,10 @@ def run(args: argparse.Namespace) -> int:
         result = paste.ball_study()
     elif args.study == "energy":
         result = paste.energy_balance(args.diameter, args.fall, args.dt)
+    elif args.study == "funnel-compare":
+        result = funnel.compare(args.folders)
     else:
-        result = funnel.funnel_study(runs=args.runs, jobs=args.jobs, dt=args.dt)
+        result = funnel.funnel_study(runs=args.runs, jobs=args.jobs, dt=args.dt, settings=dict(args.set))
     print(result.table().text(), end="")
     if args.out is not None:
         print("wrote " + ", ".join(str(p) for p in result.save(args.out)))

@@ -6,22 +6,15 @@ import argparse
 from pathlib import Path
 
 from .sample import add_test_options, cylinder_of
-from .types import count, positive, positive_list
+from .types import count, positive, positive_list, setting
 
 
 def _counts(text: str) -> list[int]:
     return [count(word) for word in text.split(",")]
 
 
-def _setting(text: str, what: str = "a setting is NAME=VALUE") -> tuple[str, str]:
-    name, sep, value = text.partition("=")
-    if not sep or not name.strip() or not value.strip():
-        raise argparse.ArgumentTypeError(f"{what}, got '{text}'")
-    return name.strip(), value.strip()
-
-
 def _ladder(text: str) -> tuple[str, list[str]]:
-    name, values = _setting(text, "a ladder is NAME=RICHEST,...,CHEAPEST")
+    name, values = setting(text, "a ladder is NAME=RICHEST,...,CHEAPEST")
     return name, [v.strip() for v in values.split(",")]
 
 
@@ -45,7 +38,7 @@ def add_parser(commands) -> argparse.ArgumentParser:
     parser.add_argument("--measure-all", action="store_true",
                         help="measure every effect, also those the screening settled")
     parser.add_argument("--screen-only", action="store_true", help="print the screening and stop (no runs)")
-    parser.add_argument("--set", type=_setting, action="append", metavar="NAME=VALUE",
+    parser.add_argument("--set", type=setting, action="append", metavar="NAME=VALUE",
                         help="fix an effect or resolution instead of planning it (e.g. drag=difelice, "
                         "particles=20000, contacts=no)")
     test = parser.add_argument_group("sedimentation test")

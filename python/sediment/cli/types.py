@@ -54,3 +54,11 @@ def count(text: str) -> int:
 def positive_list(text: str) -> list[float]:
     """Comma-separated numbers > 0."""
     return [positive(word) for word in text.split(",")]
+
+
+def setting(text: str, what: str = "a setting is NAME=VALUE") -> tuple[str, str]:
+    """NAME=VALUE, both non-empty (a deck variable and its value)."""
+    name, sep, value = text.partition("=")
+    if not sep or not name.strip() or not value.strip():
+        raise argparse.ArgumentTypeError(f"{what}, got '{text}'")
+    return name.strip(), value.strip()

@@ -19,6 +19,7 @@ from pathlib import Path
 import numpy as np
 
 from ..results import write_text
+from ..sim.deck import deck_text, index_variables
 from ..sim.run import run_batch
 from ..sim.scene import DRAGS
 from .screening import INCLUDE, MEASURE, OMIT, Screen, SedimentationTest, screen, verdict_of
@@ -187,22 +188,6 @@ DECK_SCREENS = {
 }
 
 
-def deck_text(deck: Path, depth: int = 0) -> str:
-    """A deck's text with the files it includes (by a literal name, from its folder) in place."""
-    if depth > 8:
-        raise ValueError(f"{deck}: includes nest more than 8 deep")
-    lines = []
-    for line in Path(deck).read_text().splitlines():
-        words = line.split()
-        if len(words) >= 2 and words[0] == "include" and "$" not in words[1]:
-            included = Path(deck).parent / words[1]
-            if included.is_file():
-                lines.append(deck_text(included, depth + 1))
-                continue
-        lines.append(line)
-    return "\n".join(lines)
-
-
 class DeckScene:
     """A deck with effect variables (and ladder variables) as knobs and runs."""
 
@@ -223,8 +208,9 @@ class DeckScene:
         for name, default in effects:
             if default not in ("yes", "no"):
                 raise ValueError(f"{deck}: effect_{name} must default to yes or no, not '{default}'")
+        declared = index_variables(self.deck)
         for name in ladders:
-            if not re.search(rf"^\s*variable\s+{re.escape(name)}\s+index\s", text, re.MULTILINE):
+            if name not in declared:
                 raise ValueError(f"{deck}: the deck has no 'variable {name} index ...' for the ladder to set")
         self.observables = observables
         self.tolerance = tolerance
