@@ -22,4 +22,32 @@ double rayleigh_time(double radius, double density, double youngs_modulus, doubl
   return pi * radius * std::sqrt(density / shear_modulus) / (0.1631 * poisson_ratio + 0.8766);
 }
 
+namespace {
+// (delta/d)^(5/2) E* / (rho v^2) of the impact.
+double impact_factor(Impact impact)
+{
+  return 15.0 * pi / 96.0 * (impact == Impact::Wall ? std::sqrt(2.0) : 1.0);
+}
+}    // namespace
+
+double hertz_impact_overlap(Impact impact, double density, double speed, double youngs_modulus,
+                            double poisson_ratio)
+{
+  const double reduced_modulus = youngs_modulus / (2.0 * (1.0 - poisson_ratio * poisson_ratio));
+  return std::pow(impact_factor(impact) * density * speed * speed / reduced_modulus, 0.4);
+}
+
+double hertz_modulus_for_overlap(Impact impact, double density, double speed, double overlap,
+                                 double poisson_ratio)
+{
+  const double reduced_modulus = impact_factor(impact) * density * speed * speed / std::pow(overlap, 2.5);
+  return 2.0 * (1.0 - poisson_ratio * poisson_ratio) * reduced_modulus;
+}
+
+double hertz_modulus_for_load(double pressure, double overlap, double poisson_ratio)
+{
+  const double reduced_modulus = 3.0 * std::sqrt(2.0) * pressure / (4.0 * std::pow(overlap, 1.5));
+  return 2.0 * (1.0 - poisson_ratio * poisson_ratio) * reduced_modulus;
+}
+
 }    // namespace sediment

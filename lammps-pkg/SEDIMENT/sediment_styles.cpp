@@ -6,6 +6,7 @@
 #include "sediment_styles.h"
 
 #include "compute_concentration_grid.h"
+#include "compute_contact_overlap.h"
 #include "fix_fluid.h"
 #include "fix_fluid_buoyancy.h"
 #include "fix_fluid_drag.h"
@@ -49,6 +50,7 @@ const StyleEntry<Modify::FixCreator> fix_styles[] = {
 
 const StyleEntry<Modify::ComputeCreator> compute_styles[] = {
     {"concentration/grid", "solid fraction per layer, size class and type", &create<Compute, ComputeConcentrationGrid>},
+    {"contact/overlap", "largest overlap of touching spheres", &create<Compute, ComputeContactOverlap>},
 };
 
 const StyleEntry<Force::PairCreator> pair_styles[] = {

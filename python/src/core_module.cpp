@@ -183,6 +183,25 @@ PYBIND11_MODULE(_core, m)
   m.def("rayleigh_time", &rayleigh_time, py::arg("radius"), py::arg("density"), py::arg("youngs_modulus"),
         py::arg("poisson_ratio"), "Rayleigh time [s].");
 
+  const auto impact_of = [](const std::string &name) {
+    if (name == "wall") return Impact::Wall;
+    if (name == "pair") return Impact::Pair;
+    throw py::value_error("impact must be 'wall' or 'pair', not '" + name + "'");
+  };
+  m.def("hertz_impact_overlap", [impact_of](const std::string &impact, double density, double speed, double youngs,
+                                            double poisson) {
+    return hertz_impact_overlap(impact_of(impact), density, speed, youngs, poisson);
+  }, py::arg("impact"), py::arg("density"), py::arg("speed"), py::arg("youngs_modulus"), py::arg("poisson_ratio"),
+     "Largest overlap / diameter of an undamped Hertz impact at `speed` ('wall' or 'pair' of equal spheres).");
+  m.def("hertz_modulus_for_overlap", [impact_of](const std::string &impact, double density, double speed,
+                                                 double overlap, double poisson) {
+    return hertz_modulus_for_overlap(impact_of(impact), density, speed, overlap, poisson);
+  }, py::arg("impact"), py::arg("density"), py::arg("speed"), py::arg("overlap"), py::arg("poisson_ratio"),
+     "Young's modulus [Pa] whose impacts at `speed` reach `overlap` (relative to the diameter).");
+  m.def("hertz_modulus_for_load", &hertz_modulus_for_load, py::arg("pressure"), py::arg("overlap"),
+        py::arg("poisson_ratio"),
+        "Young's modulus [Pa] at which a sphere pressed on a wall by pressure * d^2 overlaps by `overlap` of d.");
+
   m.def("submergence", [](double radius, double centre_height) {
     const Submergence sub = submergence(radius, centre_height);
     return py::dict(py::arg("volume") = sub.volume, py::arg("area") = sub.area, py::arg("wetted") = sub.wetted);

@@ -2,6 +2,8 @@
 // Submergence below a free surface and the Rayleigh time (docs/physics.md sections 1 and 6).
 #include "sediment/geometry.hpp"
 
+#include <cmath>
+
 #include <gtest/gtest.h>
 
 using namespace sediment;
@@ -69,4 +71,29 @@ TEST(Buoyancy, MixtureDensityAndDisplacedMass)
   EXPECT_DOUBLE_EQ(displaced_mass(998.2, r, submergence(r, -3 * r)), 998.2 * sphere_volume(2 * r));
   EXPECT_DOUBLE_EQ(displaced_mass(998.2, r, submergence(r, 0.0)), 0.5 * 998.2 * sphere_volume(2 * r));
   EXPECT_EQ(displaced_mass(998.2, r, submergence(r, 3 * r)), 0.0);
+}
+
+TEST(HertzImpact, OverlapAndModulusAreInverse)
+{
+  // 75 um grains of 2650 kg/m3 at 4e-3 m/s (the largest settling speeds of the samples) with 1 % overlap.
+  for (const Impact impact : {Impact::Wall, Impact::Pair}) {
+    const double youngs = hertz_modulus_for_overlap(impact, 2650.0, 4e-3, 0.01, 0.3);
+    EXPECT_NEAR(hertz_impact_overlap(impact, 2650.0, 4e-3, youngs, 0.3), 0.01, 1e-15);
+  }
+  // On a wall the overlap is 2^(1/5) that of two equal spheres at the same speed; it grows as v^(4/5).
+  const double pair = hertz_impact_overlap(Impact::Pair, 8135.0, 1.7, 200e9, 0.3);
+  EXPECT_NEAR(hertz_impact_overlap(Impact::Wall, 8135.0, 1.7, 200e9, 0.3) / pair, std::pow(2.0, 0.2), 1e-14);
+  EXPECT_NEAR(hertz_impact_overlap(Impact::Pair, 8135.0, 3.4, 200e9, 0.3) / pair, std::pow(2.0, 0.8), 1e-14);
+  // Steel balls of case E meeting at 1.7 m/s: (15 pi rho v^2 / (96 E*))^(2/5), E* = 200e9 / (2 (1 - 0.09)).
+  const double pi = std::acos(-1.0);
+  EXPECT_NEAR(pair, std::pow(15.0 * pi * 8135.0 * 1.7 * 1.7 / (96.0 * 200e9 / 1.82), 0.4), 1e-16);
+}
+
+TEST(HertzLoad, OverlapUnderAPressedWeight)
+{
+  // Back through Hertz: F = (4/3) E* sqrt(R) delta^(3/2) with R = d/2 must equal p d^2 at the given overlap.
+  const double d = 75e-6, p = 170.0, overlap = 0.01, nu = 0.3;
+  const double reduced = hertz_modulus_for_load(p, overlap, nu) / (2.0 * (1.0 - nu * nu));
+  const double delta = overlap * d;
+  EXPECT_NEAR(4.0 / 3.0 * reduced * std::sqrt(d / 2) * std::pow(delta, 1.5), p * d * d, 1e-12 * p * d * d);
 }

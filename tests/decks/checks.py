@@ -199,6 +199,35 @@ def struck_ball(np_ranks: int):
             assert vz_b[-1] < -1e-3 and out.results["stuck_B"] == 0
 
 
+@check
+def contact_overlap(np_ranks: int):
+    # A: 10 um between two 1 mm spheres, relative 10 um / 1 mm; B: 2 um between 2 mm and 0.5 mm spheres,
+    # relative 2 um / (4 a) with a = 0.2 mm; C apart. Newton on and off (a pair across ranks seen twice).
+    for newton in ("on", "off"):
+        r = run_deck("contact_overlap.lmp", {"newton": newton}, np_ranks).results
+        report(f"contact/overlap (newton {newton}): relative {r['relative']:.15g}, largest {r['largest']:.6g} m, "
+               f"contacts {r['contacts']:.0f}")
+        assert abs(r["relative"] - 0.01) < 1e-9 and abs(r["largest"] - 1e-5) < 1e-15 and r["contacts"] == 2
+
+
+@check
+def hertz_impact(np_ranks: int):
+    # The soft-contact rule: two 75 um grains of 2650 kg/m3 meeting at 4 mm/s with the modulus the
+    # rule gives for a 1 % overlap reach 1 % (undamped Hertz), whatever the step that resolves the contact.
+    d, rho, v, tolerance = 75e-6, 2650.0, 4e-3, 0.01
+    youngs = _core.hertz_modulus_for_overlap("pair", rho, v, tolerance, 0.3)
+    rayleigh = _core.rayleigh_time(d / 2, rho, youngs, 0.3)
+    dt = rayleigh / 50
+    # The initial gap (0.2 um) and the contact (Hertz: 2.94 delta_max / v) with room to spare.
+    contact = (2e-7 + 4 * d * tolerance) / v
+    out = run_deck("hertz_impact.lmp", {"d": d, "rho": rho, "v": v, "E": youngs, "dt": dt,
+                                        "steps": round(contact / dt)}, np_ranks)
+    largest = float(out.samples[:, 1].max())
+    report(f"Hertz impact at {v} m/s with E = {youngs:.4g} Pa (rule for {tolerance:.0%}): largest overlap "
+           f"{largest:.5%} of d, dt = Rayleigh time / 50 = {dt:.3g} s")
+    assert abs(largest - tolerance) < 2e-3 * tolerance and out.samples[-1, 1] == 0.0
+
+
 # ---- Bingham hard cases -----------------------------------------------------------------------
 CLAY = dict(rho_f=1280.0, eta=0.0131, tau_y=30.5)
 D_BALL = 0.02
@@ -789,6 +818,8 @@ BAD_INPUT = [
     ("fix w all fluid density 1000 viscosity 1e-3\npair_style lubricate/fluid w\npair_coeff * *\nrun 0",
      "use 'comm_modify vel yes'"),
     ("comm_modify vel yes\npair_style lubricate/fluid nowater\npair_coeff * *\nrun 0", "Pair lubricate/fluid: fluid fix 'nowater' does not exist"),
+    ("compute o all contact/overlap every", "unknown keyword 'every'"),
+    ("compute o all contact/overlap\nthermo_style custom c_o\nrun 0", "needs a pair style"),
     ("compute c all concentration/grid", "the grid is required: 'layers AXIS N' or 'cells NX NY NZ'"),
     ("compute c all concentration/grid cells 4 4", "'cells' needs 3 counts in a 3d simulation"),
     ("compute c all concentration/grid cells 4 4 4 bounds 0 1 0 1", "'bounds' needs 6 values (xlo xhi ylo yhi zlo zhi)"),

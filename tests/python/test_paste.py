@@ -144,6 +144,8 @@ def test_funnel_summary_counts_what_the_paper_reports(tmp_path):
 def test_funnel_settings_are_checked_before_any_run():
     with pytest.raises(ValueError, match="sets packing itself"):
         funnel.pour(1, settings={"packing": "mine.lmp"})
+    with pytest.raises(ValueError, match="d cannot be set"):    # the packing is for 12.6 mm balls
+        funnel.pour(1, settings={"d": "0.02"})
     with pytest.raises(ValueError, match="in.funnel has no variable stemm"):    # LAMMPS would ignore it
         funnel.funnel_study(runs=1, settings={"stemm": "0.05"}, progress=False)
     for bad in ({"stem": "-0.01"}, {"fall": "0"}, {"surface": "0.2"}, {"stem": "long"}):

@@ -9,7 +9,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from sediment import cli
+from sediment import _core, cli
 from sediment.lab.psd import discretise, read_psd
 from sediment.sim.scene import Cylinder, Effects, plan, terminal_speed, write
 
@@ -81,9 +81,18 @@ def test_contacts_need_real_grains_and_set_the_step(tmp_path):
         plan(read_psd(PSDS / "sample3.csv"), particles=None, width=1e-3)
     # a 3 mm column at the sample's concentration (60 g per 1000 mL): about 1900 real grains
     scene = plan(psd, particles=None, width=3e-4, cylinder=Cylinder(27.8e-4, 0.003), mass=0.06 * 0.003 / 0.36,
-                 t_end=2e-6, effects=Effects(lubrication=True))
+                 t_end=2e-5, effects=Effects(lubrication=True))
     dt, steps = scene.stages()[0]
-    assert dt < 1e-7 and steps == math.ceil(2e-6 / dt) and len(scene.diameter) > 1000
+    assert steps == math.ceil(2e-5 / dt) and len(scene.diameter) > 1000
+    # The contacts: the softest modulus keeping a 1 % overlap for the fastest grain's impact on the floor
+    # (here it is the bound: the 3 mm deposit weighs little), and a fifth of the smallest grain's Rayleigh time.
+    f, sizes = scene.suspension, scene.classes.diameter[scene.classes.count > 0]
+    v_max = terminal_speed(f, sizes.max(), scene.effects.drag)
+    youngs = _core.hertz_modulus_for_overlap("wall", f.particle_density, v_max, 0.01, 0.3)
+    assert scene.contact_modulus() == pytest.approx(youngs, rel=1e-12)
+    assert _core.hertz_impact_overlap("wall", f.particle_density, v_max, scene.contact_modulus(), 0.3) == \
+        pytest.approx(0.01, rel=1e-9)
+    assert dt == pytest.approx(0.2 * _core.rayleigh_time(sizes.min() / 2, f.particle_density, youngs, 0.3), rel=1e-12)
     # no two grains overlap (periodic across, not along the height)
     p, r = scene.position, scene.diameter / 2
     delta = p[:, None, :] - p[None, :, :]
@@ -93,6 +102,8 @@ def test_contacts_need_real_grains_and_set_the_step(tmp_path):
     assert gap.min() >= 0
     # the deck with contacts, lubrication and the wall runs (a few steps, 2 ranks)
     write(scene, tmp_path)
+    deck = (tmp_path / "in.sedimentation").read_text()
+    assert "compute         overlap all contact/overlap" in deck and "halt 100 v_overlap > 0.02 error hard" in deck
     assert cli.main(["run", str(tmp_path / "in.sedimentation"), "--np", "2", "--quiet"]) == 0
 
 

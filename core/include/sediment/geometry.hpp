@@ -41,4 +41,21 @@ inline double displaced_mass(double density, double radius, const Submergence &s
 // Rayleigh time pi r sqrt(rho / G) / (0.1631 nu + 0.8766), G = E / (2 (1 + nu)).
 double rayleigh_time(double radius, double density, double youngs_modulus, double poisson_ratio);
 
+// Largest overlap, relative to the diameter, of an undamped Hertz impact at normal speed v: a sphere
+// on a wall of its own material (R = d/2, m_eff = m) or two equal spheres (R = d/4, m_eff = m/2).
+// From m_eff v^2 / 2 = (8/15) E* sqrt(R) delta^(5/2) with E* = E / (2 (1 - nu^2)):
+//   wall: (delta/d)^(5/2) = 15 sqrt(2) pi rho v^2 / (96 E*),  pair: 15 pi rho v^2 / (96 E*),
+// independent of the size. Damping only lowers it.
+enum class Impact { Wall, Pair };
+double hertz_impact_overlap(Impact impact, double density, double speed, double youngs_modulus,
+                            double poisson_ratio);
+// The Young's modulus whose impacts at `speed` reach `overlap` (relative to the diameter): the
+// softest contact that keeps the overlap within that tolerance.
+double hertz_modulus_for_overlap(Impact impact, double density, double speed, double overlap,
+                                 double poisson_ratio);
+// The Young's modulus at which a sphere pressed on a wall of its own material by the force p d^2 (a
+// pressure p carried over its cross-section, e.g. the buoyant weight of a deposit above it) overlaps
+// by `overlap` of its diameter: F = (4/3) E* sqrt(d/2) delta^(3/2) gives E* = 3 sqrt(2) p / (4 (delta/d)^(3/2)).
+double hertz_modulus_for_load(double pressure, double overlap, double poisson_ratio);
+
 }    // namespace sediment

@@ -145,10 +145,23 @@ class Scene:
             return max(1, math.ceil(self.t_end / self.contact_time_step() / 400))
         return max(1, math.ceil(self.layers / self.courant / FRAMES_PER_STAGE))
 
+    def contact_modulus(self) -> float:
+        """Young's modulus of the grains' contacts [Pa]: the softest that keeps the overlap within
+        OVERLAP_TOLERANCE of the diameter (docs/effects.md section 5) both when the fastest grain lands on
+        the floor at its terminal speed (Hertz impact) and under the buoyant weight of the whole
+        deposit pressing one grain's cross-section (static Hertz contact). The largest overlap is
+        measured during the run (compute contact/overlap) and the run stops at twice the tolerance."""
+        f = self.suspension
+        v_max = terminal_speed(f, self.classes.diameter[self.classes.count > 0].max(), self.effects.drag)
+        impact = _core.hertz_modulus_for_overlap("wall", f.particle_density, v_max, OVERLAP_TOLERANCE, POISSON_RATIO)
+        pressure = self.initial_concentration * self.height * (1 - f.fluid_density / f.particle_density) * f.gravity
+        return max(impact, _core.hertz_modulus_for_load(pressure, OVERLAP_TOLERANCE, POISSON_RATIO))
+
     def contact_time_step(self) -> float:
-        """A fifth of the Rayleigh time of the smallest grain (Young's modulus as in `write`)."""
+        """A fifth of the Rayleigh time of the smallest grain at the contact modulus."""
         radius = 0.5 * self.classes.diameter[self.classes.count > 0].min()
-        return 0.2 * _core.rayleigh_time(radius, self.suspension.particle_density, YOUNGS_MODULUS, POISSON_RATIO)
+        return 0.2 * _core.rayleigh_time(radius, self.suspension.particle_density, self.contact_modulus(),
+                                         POISSON_RATIO)
 
     def simulated_psd(self) -> PSD:
         """The PSD the scene's particles stand for."""
@@ -157,8 +170,8 @@ class Scene:
 
 FRAMES_PER_STAGE = 20
 MAX_PARTICLES = 10_000_000
-YOUNGS_MODULUS = 1e7    # Pa: a soft grain (contact time long enough to be affordable), as in the examples
 POISSON_RATIO = 0.3
+OVERLAP_TOLERANCE = 0.01    # largest contact overlap / diameter the soft contacts are made for
 
 
 def terminal_speed(suspension: Suspension, diameter: float, law: str) -> float:
@@ -437,8 +450,8 @@ def _deck(scene: Scene, data: str, layer_file: str) -> str:
         lines.append("fix             drag all fluid/drag water law difelice concentration c_conc")
     else:
         lines.append(f"fix             drag all fluid/drag water law {e.drag}")
-    granular = (f"granular hertz/material {YOUNGS_MODULUS:g} 0.3 {POISSON_RATIO:g} tangential mindlin NULL 1.0 0.5 "
-                "damping tsuji")
+    granular = (f"granular hertz/material {scene.contact_modulus():.6g} 0.3 {POISSON_RATIO:g} tangential mindlin "
+                "NULL 1.0 0.5 damping tsuji") if e.interacting else ""
     if e.interacting:
         if e.lubrication:
             lines += ["pair_style      hybrid/overlay granular lubricate/fluid water inner 0.01 outer 0.5 limit yes",
@@ -446,14 +459,19 @@ def _deck(scene: Scene, data: str, layer_file: str) -> str:
         else:
             lines += ["pair_style      granular", f"pair_coeff      * * {granular.split(' ', 1)[1]}"]
         lines += [f"fix             floor all wall/gran {granular} {up}plane 0 NULL",
-                  "fix             step all nve/sphere/fluid"]
+                  "fix             step all nve/sphere/fluid",
+                  "# Soft contacts, made for overlaps up to "
+                  f"{OVERLAP_TOLERANCE:.0%} of a diameter: the largest is reported, and twice that stops the run.",
+                  "compute         overlap all contact/overlap",
+                  "variable        overlap equal c_overlap",
+                  f"fix             overlap_guard all halt 100 v_overlap > {2 * OVERLAP_TOLERANCE:g} error hard message yes"]
     else:
         lines.append(f"fix             step all nve/sphere/fluid floor {up} 0.0")
     lines += [
         f"fix             layers all layers/hdf5 $(round({frames_every}/v_dt_scale)+(round({frames_every}/v_dt_scale)<1)) "
         f"${{layers_file}} c_conc fluid water particle_density {f.particle_density:.12g} overwrite ${{overwrite}}",
         "",
-        "thermo_style    custom step time dt f_layers",
+        "thermo_style    custom step time dt f_layers" + (" c_overlap" if e.interacting else ""),
         f"thermo          {frames_every * 5}",
         "thermo_modify   norm no",
         f'print           "SEDIMENT plan steps $(ceil({total_steps}/v_dt_scale)) t_end {scene.t_end:.12g}"',
@@ -489,6 +507,9 @@ def describe(scene: Scene) -> str:
         lines.append(f"note: the PSD table runs from {first:g} to {last:g} % finer; the {first + 100 - last:g} % of the "
                      "mass outside its diameters is not simulated, and the simulated PSD is renormalised to 100 %")
     if scene.effects.interacting:
+        lines.append(f"contacts: E = {scene.contact_modulus():.3g} Pa, the softest keeping overlaps within "
+                     f"{OVERLAP_TOLERANCE:.0%} (fastest grain's impact, the deposit's weight); largest overlap in the "
+                     f"thermo output, the run stops at {2 * OVERLAP_TOLERANCE:.0%}")
         lines.append(f"contacts: dt = {stages[0][0]:.3g} s (Rayleigh time / 5 of the smallest grain): "
                      f"{stages[0][1]:.3g} steps x {len(scene.diameter)} particles")
     return "\n".join(lines)

@@ -113,8 +113,9 @@ class Pour:
         return self.surface - self.positions[:, 2]
 
 
-# Deck variables a study sets itself.
+# Deck variables a study sets itself, and those its packing and readouts assume (case E's balls).
 OWN_VARIABLES = ("packing", "out", "dt", "settle")
+FIXED_VARIABLES = ("d", "balls")
 
 
 def check_settings(settings: dict[str, str]) -> Funnel:
@@ -122,6 +123,9 @@ def check_settings(settings: dict[str, str]) -> Funnel:
     or a funnel that cannot stand; returns the funnel."""
     if clash := sorted(set(settings) & set(OWN_VARIABLES)):
         raise ValueError(f"the study sets {', '.join(clash)} itself")
+    if fixed := sorted(set(settings) & set(FIXED_VARIABLES)):
+        raise ValueError(f"the study is case E's {BALLS} balls of {DIAMETER * 1e3} mm: {', '.join(fixed)} cannot be set "
+                         "(run examples/paste/in.funnel directly with a packing of your own)")
     if unknown := sorted(set(settings) - set(index_variables(EXAMPLES / "in.funnel"))):
         raise ValueError(f"in.funnel has no variable {', '.join(unknown)} (see its 'variable NAME index' lines and "
                          "those of steel.lmp and mould.lmp)")
