@@ -228,6 +228,34 @@ def hertz_impact(np_ranks: int):
     assert abs(largest - tolerance) < 2e-3 * tolerance and out.samples[-1, 1] == 0.0
 
 
+@check(ranks=(1,))
+def soft_bed(np_ranks: int):
+    # 320 quartz grains of 60-100 um settle onto a floor in water with the soft-contact rule's modulus (1 %
+    # overlap for the fastest grain's impact at its Dallavalle terminal speed) and with 16 times that
+    # (a quarter of the step). The soft bed keeps its overlaps within the 1 %, and its height and packing
+    # fraction match the stiff bed's. (Serial: the compute's ranks are checked by contact_overlap.)
+    rho, v_max = 2650.0, float(_core.terminal_velocity("dallavalle", 1000.0, 1e-3, 0.0, 1e-4, 2650.0, G)[0])
+    soft = _core.hertz_modulus_for_overlap("wall", rho, v_max, 0.01, 0.3)
+    beds = {}
+    with tempfile.TemporaryDirectory() as tmp:
+        for name, youngs in (("soft", soft), ("stiff", 16 * soft)):
+            dt = 0.2 * _core.rayleigh_time(30e-6, rho, youngs, 0.3)
+            final = Path(tmp) / f"{name}.txt"
+            out = run_deck("soft_bed.lmp", {"E": youngs, "dt": dt, "t_end": 0.5, "every": 100, "final": final},
+                           np_ranks)
+            grains = np.loadtxt(final, skiprows=9)
+            volume = np.pi / 6 * grains[:, 4] ** 3
+            mean_height = float(np.sum(volume * grains[:, 3]) / volume.sum())    # half the bed's height
+            beds[name] = (out.samples[:, 1].max(), mean_height, volume.sum() / (1e-6 * 2 * mean_height), grains)
+    (o_soft, h_soft, phi_soft, g_soft), (o_stiff, h_stiff, phi_stiff, _) = beds["soft"], beds["stiff"]
+    report(f"soft bed: E = {soft:.3g} Pa (rule for 1 % at {v_max:.3g} m/s): largest overlap {o_soft:.3%}, "
+           f"mean height {h_soft * 1e3:.4f} mm, packing fraction {phi_soft:.4f}; 16 x stiffer: largest overlap "
+           f"{o_stiff:.3%}, mean height {h_stiff * 1e3:.4f} mm, packing fraction {phi_stiff:.4f}")
+    assert o_soft < 0.01 and o_stiff < o_soft
+    assert abs(h_soft / h_stiff - 1) < 0.02 and abs(phi_soft / phi_stiff - 1) < 0.02
+    assert g_soft[:, 3].max() < 0.00025    # every grain came down into the bed (it started 0.3 mm up or higher)
+
+
 # ---- Bingham hard cases -----------------------------------------------------------------------
 CLAY = dict(rho_f=1280.0, eta=0.0131, tau_y=30.5)
 D_BALL = 0.02
