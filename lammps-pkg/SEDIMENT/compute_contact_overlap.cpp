@@ -5,12 +5,12 @@
 
 #include "compute_contact_overlap.h"
 #include "sediment_args.h"
+#include "sediment_lammps_api.h"
 
 #include "atom.h"
 #include "error.h"
 #include "force.h"
 #include "neigh_list.h"
-#include "neigh_request.h"
 #include "neighbor.h"
 #include "update.h"
 
@@ -44,11 +44,7 @@ void ComputeContactOverlap::init()
 {
   if (!force->pair)
     error->all(FLERR, "Compute contact/overlap needs a pair style (its cutoff reaches the touching spheres)");
-  // An occasional half list, built when the compute is invoked (the same call in LAMMPS 2021 and now).
-  const int irequest = neighbor->request(this, instance_me);
-  neighbor->requests[irequest]->pair = 0;
-  neighbor->requests[irequest]->compute = 1;
-  neighbor->requests[irequest]->occasional = 1;
+  sediment_request_compute_list(neighbor, this, instance_me);
 }
 
 void ComputeContactOverlap::init_list(int /*id*/, NeighList *ptr)
@@ -73,7 +69,6 @@ void ComputeContactOverlap::measure()
 {
   if (measured_step == update->ntimestep) return;
   measured_step = update->ntimestep;
-  neighbor->build_one(list);
 
   double **x = atom->x;
   const double *radius = atom->radius;

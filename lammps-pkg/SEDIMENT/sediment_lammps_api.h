@@ -17,6 +17,7 @@
 #include "exceptions.h"
 #include "fix.h"
 #include "modify.h"
+#include "neigh_request.h"
 #include "neighbor.h"
 #include "pair.h"
 #include "region.h"
@@ -79,6 +80,18 @@ namespace sediment_api {
     neighbor->request(pair, instance);
   }
 
+  template <class N, class C>
+  auto request_compute_list(N *neighbor, C *compute, int, int) -> decltype(neighbor->add_request(compute), void())
+  {
+    neighbor->add_request(compute);
+  }
+  template <class N, class C> void request_compute_list(N *neighbor, C *compute, int instance, long)
+  {
+    const int irequest = neighbor->request(compute, instance);
+    neighbor->requests[irequest]->pair = 0;
+    neighbor->requests[irequest]->compute = 1;
+  }
+
   template <class C, class P> auto forward_comm(C *comm, P *pair, int) -> decltype(comm->forward_comm(pair), void())
   {
     comm->forward_comm(pair);
@@ -133,6 +146,12 @@ inline Region *sediment_region_by_id(Domain *domain, const std::string &id)
 inline void sediment_request_half_list(Neighbor *neighbor, Pair *pair, int instance)
 {
   sediment_api::request_half_list(neighbor, pair, instance, 0);
+}
+// A half neighbour list for a compute, kept with the pair style's (built at every reneighboring, a
+// copy of the pair's list where they agree); requested in init().
+inline void sediment_request_compute_list(Neighbor *neighbor, Compute *compute, int instance)
+{
+  sediment_api::request_compute_list(neighbor, compute, instance, 0);
 }
 // Ghost values of a pair style's pack/unpack_forward_comm, and the reverse sum.
 inline void sediment_forward_comm(Comm *comm, Pair *pair)

@@ -948,7 +948,8 @@ def fuzz_input(np_ranks: int):
 
 # ---- the plugin route (an lmp built with the PLUGIN package) -----------------------------------------------
 PLUGIN_STYLES = {("fix", "fluid"), ("fix", "fluid/buoyancy"), ("fix", "fluid/drag"), ("fix", "nve/sphere/fluid"),
-                 ("fix", "layers/hdf5"), ("compute", "concentration/grid"), ("pair", "lubricate/fluid")}
+                 ("fix", "layers/hdf5"), ("compute", "concentration/grid"), ("compute", "contact/overlap"),
+                 ("pair", "lubricate/fluid")}
 
 
 @check(ranks=None)
