@@ -45,6 +45,7 @@ void ComputeContactOverlap::init()
   if (!force->pair)
     error->all(FLERR, "Compute contact/overlap needs a pair style (its cutoff reaches the touching spheres)");
   sediment_request_compute_list(neighbor, this, instance_me);
+  measured_step = -1;    // a run may start again at a step already measured (reset_timestep)
 }
 
 void ComputeContactOverlap::init_list(int /*id*/, NeighList *ptr)
