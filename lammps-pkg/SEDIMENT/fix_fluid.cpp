@@ -23,7 +23,7 @@ using namespace FixConst;
 
 FixFluid::FixFluid(LAMMPS *lmp, int narg, char **arg) :
     Fix(lmp, narg, arg), has_surface(0), surface_offset(0.0), surface_variable(nullptr), surface_ivar(-1),
-    centre_crossing(false), region_id(nullptr), region(nullptr)
+    centre_crossing(false), prepared_step(-1), region_id(nullptr), region(nullptr)
 {
   flow[0] = flow[1] = flow[2] = 0.0;
   surface_normal[0] = surface_normal[1] = 0.0;
@@ -131,6 +131,7 @@ void FixFluid::init()
     region = sediment_region_by_id(domain, region_id);
     if (!region) error->all(FLERR, "Fix fluid: region '{}' does not exist", region_id);
   }
+  prepared_step = -1;    // a new run may start at the step of the last one, with other positions
   if (surface_variable) {
     surface_ivar = input->variable->find(surface_variable);
     if (surface_ivar < 0)
@@ -142,6 +143,9 @@ void FixFluid::init()
 
 void FixFluid::prepare()
 {
+  // Buoyancy and drag both ask, at the same step and with the same result.
+  if (prepared_step == update->ntimestep) return;
+  prepared_step = update->ntimestep;
   if (region) region->prematch();
   if (surface_variable) {
     // The variable may read other fixes' results of the previous step (the volume the spheres

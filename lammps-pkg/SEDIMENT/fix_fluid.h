@@ -29,8 +29,8 @@ class FixFluid : public Fix {
   int setmask() override;
   void init() override;
 
-  // Call once per step before immersion(): refreshes a moving region and a surface given by a
-  // variable.
+  // Call before immersion() in every step: refreshes a moving region and a surface given by a
+  // variable, once per step however many styles ask.
   void prepare();
   // How much of sphere (centre x, radius r) is in the fluid (inline: called per atom and step).
   sediment::Submergence immersion(const double *x, double radius) const
@@ -57,6 +57,7 @@ class FixFluid : public Fix {
   char *surface_variable;      // equal-style variable giving the offset (nullptr: fixed)
   int surface_ivar;
   bool centre_crossing;        // the whole sphere is in the fluid once its centre is (no cap)
+  bigint prepared_step;        // the step prepare() last refreshed (-1: none in this run)
   char *region_id;
   class Region *region;
   sediment::Submergence bounded_immersion(const double *x, double radius) const;

@@ -127,7 +127,7 @@ class Scene:
             return [(dt, math.ceil(self.t_end / dt))]
         every = self.frame_steps()
         steps = FRAMES_PER_STAGE * every
-        v_max = terminal_speed(self.suspension, self.classes.diameter[self.classes.count > 0].max(), self.effects.drag)
+        v_max = self.largest_terminal_speed()
         time, dt, result = 0.0, self.height / v_max / steps, []
         while time < self.t_end * (1 - 1e-12):
             n = min(steps, every * math.ceil((self.t_end - time) / (dt * every)))
@@ -145,6 +145,10 @@ class Scene:
             return max(1, math.ceil(self.t_end / self.contact_time_step() / 400))
         return max(1, math.ceil(self.layers / self.courant / FRAMES_PER_STAGE))
 
+    def largest_terminal_speed(self) -> float:
+        """Terminal speed of the largest grain present under the scene's drag law [m/s]."""
+        return terminal_speed(self.suspension, self.classes.diameter[self.classes.count > 0].max(), self.effects.drag)
+
     def contact_modulus(self) -> float:
         """Young's modulus of the grains' contacts [Pa]: the softest that keeps the overlap within
         OVERLAP_TOLERANCE of the diameter (docs/effects.md section 5) both when the fastest grain lands on
@@ -152,8 +156,8 @@ class Scene:
         deposit pressing one grain's cross-section (static Hertz contact). The largest overlap is
         measured during the run (compute contact/overlap) and the run stops at twice the tolerance."""
         f = self.suspension
-        v_max = terminal_speed(f, self.classes.diameter[self.classes.count > 0].max(), self.effects.drag)
-        impact = _core.hertz_modulus_for_overlap("wall", f.particle_density, v_max, OVERLAP_TOLERANCE, POISSON_RATIO)
+        impact = _core.hertz_modulus_for_overlap("wall", f.particle_density, self.largest_terminal_speed(),
+                                                 OVERLAP_TOLERANCE, POISSON_RATIO)
         pressure = self.initial_concentration * self.height * (1 - f.fluid_density / f.particle_density) * f.gravity
         return max(impact, _core.hertz_modulus_for_load(pressure, OVERLAP_TOLERANCE, POISSON_RATIO))
 
