@@ -15,11 +15,12 @@ namespace {
 double below(double radius, double u)
 {
   const double v = std::clamp(u, -radius, radius);
-  return pi * (radius * radius * v - v * v * v / 3.0);
+  return pi * v * (radius * radius - v * v * (1.0 / 3.0));    // no division: this runs per atom and layer face
 }
 
 int wrap(int k, int n)
 {
+  if (k >= 0 && k < n) return k;    // most indices: no integer division
   k %= n;
   return k < 0 ? k + n : k;
 }
@@ -35,8 +36,9 @@ int cell_of(const Layers &axis, int k)
 // the axis unless it is periodic; first > last when it misses a bounded axis.
 void touched(const Layers &axis, double lo, double hi, int &first, int &last)
 {
-  first = static_cast<int>(std::floor((lo - axis.lo) / axis.thickness));
-  last = static_cast<int>(std::floor((hi - axis.lo) / axis.thickness));
+  const double per_thickness = 1.0 / axis.thickness;    // one division: this runs per atom and step
+  first = static_cast<int>(std::floor((lo - axis.lo) * per_thickness));
+  last = static_cast<int>(std::floor((hi - axis.lo) * per_thickness));
   if (!axis.periodic) {
     first = std::max(first, 0);
     last = std::min(last, axis.count - 1);

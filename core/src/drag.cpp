@@ -25,11 +25,6 @@ constexpr LawName law_names[] = {
     {DragLaw::DiFelice, "difelice"},
 };
 
-// Reynolds numbers where the faithful laws switch branch.
-constexpr double schiller_naumann_switch = 1000.0;
-constexpr double zhang_li_low = 1.0;
-constexpr double zhang_li_high = 150.0;
-
 }    // namespace
 
 std::optional<DragLaw> drag_law_from_name(std::string_view name)
@@ -56,65 +51,14 @@ std::string drag_law_names()
   return names;
 }
 
-DragCurve drag_curve(DragLaw law, double re)
-{
-  switch (law) {
-    case DragLaw::Stokes:
-      return {24.0, 0.0};
-    case DragLaw::SchillerNaumann:
-      if (re <= schiller_naumann_switch) {
-        const double p = 0.15 * std::pow(re, 0.687);
-        return {24.0 * (1.0 + p), re > 0.0 ? 24.0 * 0.687 * p / re : 0.0};
-      }
-      return {0.44 * re, 0.44};
-    case DragLaw::Dallavalle:
-    case DragLaw::DiFelice: {    // the single-sphere curve; hindrance is applied per sphere
-      // Cd = (0.63 + 4.8 / sqrt(Re))^2  =>  Cd Re = (0.63 sqrt(Re) + 4.8)^2
-      const double root = std::sqrt(re);
-      const double inner = 0.63 * root + 4.8;
-      return {inner * inner, re > 0.0 ? inner * 0.63 / root : 0.0};
-    }
-    case DragLaw::ZhangLi:
-      if (re < zhang_li_low) return {24.0, 0.0};
-      if (re <= zhang_li_high) return {29.12 + 0.195 * re, 0.195};
-      return {0.4 * re, 0.4};
-    case DragLaw::ZhangLiSmooth:
-      // Continuous variant: a linear ramp of Cd Re from 24 to 29.315 over Re' < 1, then
-      // Cd = max(29.12 / Re' + 0.195, 0.4). Same static force and same law for 1 <= Re' <= 142.
-      if (re < zhang_li_low) return {24.0 + 5.315 * re, 5.315};
-      if (29.12 + 0.195 * re >= 0.4 * re) return {29.12 + 0.195 * re, 0.195};
-      return {0.4 * re, 0.4};
-  }
-  return {24.0, 0.0};
-}
-
 double drag_coefficient(DragLaw law, double re) { return drag_curve(law, re).g / re; }
 
-Exponent di_felice_exponent(double re)
-{
-  if (!(re > 0.0)) return {3.7, 0.0};
-  const double t = 1.5 - std::log10(re);
-  const double bump = 0.65 * std::exp(-0.5 * t * t);
-  // d/dRe of -bump = -bump * t / (Re ln 10)
-  return {3.7 - bump, -bump * t / (re * std::log(10.0))};
-}
-
 DragModel::DragModel(DragLaw law, const Fluid &fluid, HindranceBuoyancy buoyancy) :
-    law_(law), hindrance_offset_(buoyancy == HindranceBuoyancy::Plain ? 1.0 : 0.0), fluid_(fluid), smooth_(false)
+    law_(law), hindrance_offset_(buoyancy == HindranceBuoyancy::Plain ? 1.0 : 0.0), fluid_(fluid),
+    density_per_viscosity_(fluid.viscosity > 0.0 ? fluid.density / fluid.viscosity : 0.0), smooth_(false)
 {
   std::array<ForceJump, max_jumps> unused;
   smooth_ = fluid_.yield_stress <= 0.0 && jumps(1.0, unused) == 0;
-}
-
-DragCurve DragModel::curve(double re, double voidage) const
-{
-  const DragCurve single = drag_curve(law_, re);
-  if (law_ != DragLaw::DiFelice || voidage >= 1.0) return single;
-  // G eps^-(chi(Re) + offset): the exponent depends on Re, so the slope has a second term.
-  const Exponent chi = di_felice_exponent(re);
-  const double log_eps = std::log(voidage);
-  const double factor = std::exp(-(chi.value + hindrance_offset_) * log_eps);
-  return {single.g * factor, (single.dg - single.g * log_eps * chi.slope) * factor};
 }
 
 double DragModel::viscous_scale(double d, double speed) const
@@ -156,14 +100,8 @@ double DragModel::static_force(double d, DragScale scale) const
 double DragModel::slope_at(double d, double speed, DragCurve g, DragScale scale) const
 {
   double dforce = fluid_.viscosity / d * g.g;
-  if (speed > 0.0) {
-    // dRe'/ds = rho s (2 tau_y + eta s / d) / (tau_y + eta s / d)^2
-    const double visc = viscous_scale(d, speed);
-    const double dre =
-        fluid_.density * speed * (2.0 * fluid_.yield_stress + fluid_.viscosity * speed / d) /
-        (visc * visc);
-    dforce += visc * g.dg * dre;
-  }
+  // (tau_y + eta s / d) G' dRe'/ds with dRe'/ds = Re' (2 tau_y + eta s / d) / (s (tau_y + eta s / d))
+  if (speed > 0.0) dforce += g.re_dg * (2.0 * fluid_.yield_stress + fluid_.viscosity * speed / d) / speed;
   return scale.area * 0.5 * sphere_area(d) * dforce;
 }
 

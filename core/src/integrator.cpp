@@ -45,9 +45,13 @@ Phi phis(double z)
   }
   // Beyond z = 745.13 e^-z rounds to 0, which libm reaches through its slow underflow path (an
   // eighth of a sedimentation test's step, where dt is 1e5 relaxation times of the fine grains).
-  if (z > 745.2) return {0.0, 1.0 / z, (z - 1.0) / (z * z)};
+  if (z > 745.2) {
+    const double inverse = 1.0 / z;
+    return {0.0, inverse, (z - 1.0) * inverse * inverse};
+  }
   const double decay = std::exp(-z);
-  return {decay, (1.0 - decay) / z, (z - 1.0 + decay) / (z * z)};
+  const double inverse = 1.0 / z;
+  return {decay, (1.0 - decay) * inverse, (z - 1.0 + decay) * inverse * inverse};
 }
 
 double phi1(double z) { return phis(z).phi1; }
@@ -55,17 +59,6 @@ double phi1(double z) { return phis(z).phi1; }
 double phi2(double z) { return phis(z).phi2; }
 
 namespace {
-
-// Exact solution of ds/dt = c - k s over a time t, from s0.
-struct Segment {
-  double speed;
-  double distance;
-};
-
-Segment advance(const Phi &p, double s0, double c, double t)
-{
-  return {s0 * p.decay + c * t * p.phi1, s0 * t * p.phi1 + c * t * t * p.phi2};
-}
 
 Segment advance(double s0, double c, double k, double t) { return advance(phis(k * t), s0, c, t); }
 
@@ -161,8 +154,15 @@ double dot(const double a[3], const double b[3]) { return a[0] * b[0] + a[1] * b
 
 }    // namespace
 
-StepCorrection nonlinear_step_initial(const SphereDrag &drag, double mass, const double a[3],
-                                      const double u[3], double dt, double v[3], double dx[3])
+StepCorrection smooth_step_initial(const SphereDrag &drag, double mass, const double a[3], const double u[3],
+                                   double dt, double v[3], double dx[3])
+{
+  const SmoothLinearisation lin = smooth_linearise(drag, 1.0 / mass, a, u, dt, v);
+  return smooth_advance(lin, phis(lin.z_along), phis(lin.z_across), a, u, dt, v, dx);
+}
+
+StepCorrection set_valued_step_initial(const SphereDrag &drag, double mass, const double a[3],
+                                       const double u[3], double dt, double v[3], double dx[3])
 {
   StepCorrection corr;
   const double w[3] = {v[0] - u[0], v[1] - u[1], v[2] - u[2]};
@@ -177,36 +177,23 @@ StepCorrection nonlinear_step_initial(const SphereDrag &drag, double mass, const
   const double a_par = dot(a, dir);
   const double a_perp[3] = {a[0] - a_par * dir[0], a[1] - a_par * dir[1], a[2] - a_par * dir[2]};
 
-  double rate_across;
-  AlongSlip along;
-  if (drag.model->smooth()) {
-    // No set-valued point to stop at: one evaluation of the law gives the Newton step along the
-    // slip (the piecewise advance below, in one piece) and the secant rate across it.
-    const Linearised lin = linearise(drag, mass, s, s, a_par);
-    const Phi p = phis(lin.rate * dt);
-    const Segment full = advance(p, s, lin.c, dt);
-    along = {full.speed, full.distance, lin.rate, SlipState::Free};
-    rate_across = s > 0.0 ? lin.force / (s * mass) : lin.rate;
-    corr.along = dt * p.phi2;
-  } else {
-    const double static_force = drag.model->static_force(drag.diameter, drag.scale);
-    const bool stays_at_rest = s == 0.0 && static_force > 0.0 && mass * a_norm <= static_force;
-    along = stays_at_rest ? AlongSlip{0.0, 0.0, 0.0, SlipState::Stuck}
-                          : advance_along(drag, mass, s, a_par, dt, static_force);
-    corr.state = along.state;
-    if (along.state == SlipState::Stuck) {
-      for (int k = 0; k < 3; ++k) {
-        v[k] = u[k];
-        dx[k] = u[k] * dt + along.distance * dir[k];
-      }
-      corr.along = corr.across = 0.0;
-      return corr;
+  const double static_force = drag.model->static_force(drag.diameter, drag.scale);
+  const bool stays_at_rest = s == 0.0 && static_force > 0.0 && mass * a_norm <= static_force;
+  const AlongSlip along = stays_at_rest ? AlongSlip{0.0, 0.0, 0.0, SlipState::Stuck}
+                                        : advance_along(drag, mass, s, a_par, dt, static_force);
+  corr.state = along.state;
+  if (along.state == SlipState::Stuck) {
+    for (int k = 0; k < 3; ++k) {
+      v[k] = u[k];
+      dx[k] = u[k] * dt + along.distance * dir[k];
     }
-    // Across the slip the force turns with the slip: secant rate F(s) / s.
-    rate_across = s > 0.0 ? drag.model->force(drag.diameter, s, drag.scale) / (s * mass)
-                          : drag.model->tangent(drag.diameter, 0.0, drag.scale) / mass;
-    corr.along = along.state == SlipState::Free ? dt * phi2(along.rate * dt) : 0.0;
+    corr.along = corr.across = 0.0;
+    return corr;
   }
+  // Across the slip the force turns with the slip: secant rate F(s) / s.
+  const double rate_across = s > 0.0 ? drag.model->force(drag.diameter, s, drag.scale) / (s * mass)
+                                     : drag.model->tangent(drag.diameter, 0.0, drag.scale) / mass;
+  corr.along = along.state == SlipState::Free ? dt * phi2(along.rate * dt) : 0.0;
   const Phi across = phis(rate_across * dt);
   const double p1 = across.phi1;
   const double p2 = across.phi2;

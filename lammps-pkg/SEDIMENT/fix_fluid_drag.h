@@ -46,6 +46,8 @@ class FixFluidDrag : public Fix {
   // has no rotational drag: then immersed_drag(i) is sphere_drag(i) for the atoms of the group, and
   // an integrator may skip the per-atom region, surface and rotation look-ups.
   bool uniform() const;
+  // True when the law is smooth (no yield stress, no Cd jump) and not linear in the slip.
+  bool smooth_nonlinear() const { return model->smooth() && !(model->linear_coefficient(1.0) > 0.0); }
   // The drag on local atom i of the group when uniform(): its diameter and local fraction only.
   sediment::SphereDrag immersed_drag(int i) const;
 

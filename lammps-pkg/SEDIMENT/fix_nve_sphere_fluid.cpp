@@ -20,6 +20,7 @@
 #include "modify.h"
 #include "update.h"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstring>
@@ -73,7 +74,7 @@ static inline double nve_sphere_kick_drift(double *x, double *v, double *omega, 
 }
 
 FixNVESphereFluid::FixNVESphereFluid(LAMMPS *lmp, int narg, char **arg) :
-    Fix(lmp, narg, arg), weights(nullptr), nmax_weights(0), uniform(nullptr), floor_axis(-1), floor_level(0.0)
+    Fix(lmp, narg, arg), weights(nullptr), nmax_weights(0), uniform(nullptr), smooth_drag(false), floor_axis(-1), floor_level(0.0)
 {
   StyleArgs args(lmp, FLERR, "Fix nve/sphere/fluid", narg, arg, 3);
   while (args.more()) {
@@ -131,17 +132,72 @@ void FixNVESphereFluid::setup(int /*vflag*/)
 {
   // After every fix's init(): the drag fixes know their fluid only then.
   uniform = drags.size() == 1 && drags.front()->uniform() ? drags.front() : nullptr;
+  smooth_drag = false;
+  for (FixFluidDrag *drag : drags) smooth_drag |= drag->smooth_nonlinear();
 }
 
-template <class Lookup> void FixNVESphereFluid::first_half(Lookup lookup)
+template <bool blocked, class Lookup> void FixNVESphereFluid::first_half(Lookup lookup)
 {
   const auto [x, v, f, omega, torque, radius, rmass, mask, nlocal] = sphere_arrays(atom);
   const double dt = update->dt;
   const double ftm2v = force->ftm2v;
   const double dtf = 0.5 * dt * ftm2v;
   static const double no_flow[3] = {0.0, 0.0, 0.0};
-
   bool finite = true;
+
+  // What follows the drag step of atom i: position, rotation, the weights for the second half
+  // (taken per unit mass and moment of inertia, so the second half divides by neither).
+  auto finish = [&](int i, const sediment::StepCorrection &corr, const double dx[3], double spin_rate,
+                    double per_mass) {
+    double *w = weights[i];
+    x[i][0] += dx[0];
+    x[i][1] += dx[1];
+    x[i][2] += dx[2];
+    if (corr.state == sediment::SlipState::Stuck) counts[STUCK] += 1.0;
+    if (corr.state == sediment::SlipState::HeldAtJump) counts[AT_JUMP] += 1.0;
+
+    const double per_inertia = ftm2v / sediment::sphere_inertia(rmass[i], radius[i]);
+    const double alpha[3] = {torque[i][0] * per_inertia, torque[i][1] * per_inertia, torque[i][2] * per_inertia};
+    w[SPIN] = sediment::rotation_step_initial(spin_rate, alpha, dt, omega[i], &w[SPIN_MEMO]) * per_inertia;
+    w[ALONG] = corr.along * per_mass;
+    w[ACROSS] = corr.across * per_mass;
+    if (corr.along != corr.across) {    // the direction matters to the second half only then
+      w[DIRX] = corr.dir[0];
+      w[DIRY] = corr.dir[1];
+      w[DIRZ] = corr.dir[2];
+    }
+    finite &= std::isfinite(state_sum(x[i], v[i]));
+  };
+
+  // Atoms under a smooth nonlinear law wait in a block: linearised one by one, then the block's
+  // exponentials, then advanced; each stage's atoms are independent, so the processor overlaps
+  // them instead of waiting on one atom's chain of square roots, divisions and exponentials.
+  struct Waiting {
+    int i;
+    sediment::SmoothLinearisation lin;
+    double a[3];
+    const double *flow;
+    double spin_rate;
+    double per_mass;
+    sediment::Phi along, across;
+  };
+  constexpr int block_size = 32;
+  Waiting block[block_size];
+  int waiting = 0;
+  auto step_block = [&]() {
+    for (int n = 0; n < waiting; ++n) {
+      block[n].along = sediment::phis(block[n].lin.z_along);
+      block[n].across = sediment::phis(block[n].lin.z_across);
+    }
+    for (int n = 0; n < waiting; ++n) {
+      const Waiting &b = block[n];
+      double dx[3];
+      finish(b.i, sediment::smooth_advance(b.lin, b.along, b.across, b.a, b.flow, dt, v[b.i], dx), dx, b.spin_rate,
+             b.per_mass);
+    }
+    waiting = 0;
+  };
+
   for (int i = 0; i < nlocal; ++i) {
     if (!(mask[i] & groupbit)) continue;
     sediment::SphereDrag sphere;
@@ -161,29 +217,31 @@ template <class Lookup> void FixNVESphereFluid::first_half(Lookup lookup)
     // Divisions dominate a cheap step: one for the forces and one for the torques, as fix nve/sphere.
     const double per_mass = ftm2v / mass;
     const double a[3] = {f[i][0] * per_mass, f[i][1] * per_mass, f[i][2] * per_mass};
-    double dx[3];
-    const sediment::StepCorrection corr =
-        sediment::drag_step_initial(sphere, mass, a, flow, dt, v[i], dx, &w[DRAG_MEMO]);
-    x[i][0] += dx[0];
-    x[i][1] += dx[1];
-    x[i][2] += dx[2];
-    if (corr.state == sediment::SlipState::Stuck) counts[STUCK] += 1.0;
-    if (corr.state == sediment::SlipState::HeldAtJump) counts[AT_JUMP] += 1.0;
-
-    const double per_inertia = ftm2v / sediment::sphere_inertia(mass, radius[i]);
-    const double alpha[3] = {torque[i][0] * per_inertia, torque[i][1] * per_inertia, torque[i][2] * per_inertia};
-    w[SPIN] = sediment::rotation_step_initial(spin_rate, alpha, dt, omega[i], &w[SPIN_MEMO]);
-    w[ALONG] = corr.along;
-    w[ACROSS] = corr.across;
-    if (corr.along != corr.across) {    // the direction matters to the second half only then
-      w[DIRX] = corr.dir[0];
-      w[DIRY] = corr.dir[1];
-      w[DIRZ] = corr.dir[2];
+    if (blocked && sediment::step_kind(sphere) == sediment::StepKind::Smooth) {
+      Waiting &b = block[waiting++];
+      b.i = i;
+      b.lin = sediment::smooth_linearise(sphere, per_mass, a, flow, dt, v[i]);    // coherent units: ftm2v = 1
+      std::copy(a, a + 3, b.a);
+      b.flow = flow;
+      b.spin_rate = spin_rate;
+      b.per_mass = per_mass;
+      if (waiting == block_size) step_block();
+      continue;
     }
-    finite &= std::isfinite(state_sum(x[i], v[i]));
+    double dx[3];
+    finish(i, sediment::drag_step_initial(sphere, mass, a, flow, dt, v[i], dx, &w[DRAG_MEMO]), dx, spin_rate, per_mass);
   }
+  if (blocked) step_block();
   if (!finite) find_non_finite();
   settle_on_floor();
+}
+
+template <class Lookup> void FixNVESphereFluid::step_first_half(Lookup lookup)
+{
+  if (smooth_drag)
+    first_half<true>(lookup);
+  else
+    first_half<false>(lookup);
 }
 
 void FixNVESphereFluid::initial_integrate(int /*vflag*/)
@@ -212,7 +270,7 @@ void FixNVESphereFluid::initial_integrate(int /*vflag*/)
     const int *mask = atom->mask;
     const int drag_bit = drag->groupbit;
     const double *flow = drag->fluid_fix()->velocity();
-    first_half([&](int i, sediment::SphereDrag &sphere, const double *&u, double &) {
+    step_first_half([&](int i, sediment::SphereDrag &sphere, const double *&u, double &) {
       if (!(mask[i] & drag_bit)) return;
       sphere = drag->immersed_drag(i);
       u = flow;
@@ -220,7 +278,7 @@ void FixNVESphereFluid::initial_integrate(int /*vflag*/)
     });
     return;
   }
-  first_half([&](int i, sediment::SphereDrag &sphere, const double *&u, double &spin_rate) {
+  step_first_half([&](int i, sediment::SphereDrag &sphere, const double *&u, double &spin_rate) {
     for (FixFluidDrag *drag : drags) {
       const sediment::SphereDrag candidate = drag->sphere_drag(i);
       if (!candidate.model) continue;
@@ -254,9 +312,7 @@ void FixNVESphereFluid::final_integrate()
       nve_sphere_kick(v[i], omega[i], f[i], torque[i], radius[i], rmass[i], dtf);
       continue;
     }
-    const double mass = rmass[i];
-    const double per_mass = ftm2v / mass;
-    const double a[3] = {f[i][0] * per_mass, f[i][1] * per_mass, f[i][2] * per_mass};
+    // The weights are per unit mass: the step is linear in the force, so f takes the place of a = f / m.
     sediment::StepCorrection corr;
     corr.along = w[ALONG];
     corr.across = w[ACROSS];
@@ -265,12 +321,10 @@ void FixNVESphereFluid::final_integrate()
       corr.dir[1] = w[DIRY];
       corr.dir[2] = w[DIRZ];
     }
-    sediment::drag_step_final(corr, a, v[i]);
-
-    const double spin = w[SPIN] * ftm2v / sediment::sphere_inertia(mass, radius[i]);
-    omega[i][0] += spin * torque[i][0];
-    omega[i][1] += spin * torque[i][1];
-    omega[i][2] += spin * torque[i][2];
+    sediment::drag_step_final(corr, f[i], v[i]);
+    omega[i][0] += w[SPIN] * torque[i][0];
+    omega[i][1] += w[SPIN] * torque[i][1];
+    omega[i][2] += w[SPIN] * torque[i][2];
   }
   settle_on_floor();
 }

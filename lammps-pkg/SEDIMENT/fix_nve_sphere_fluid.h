@@ -41,7 +41,7 @@ class FixNVESphereFluid : public Fix {
 
  private:
   // Per atom, from the first half of the step to the second: weights of the new force along
-  // and across the slip, the weight of the new torque, whether the atom was in a fluid (outside,
+  // and across the slip (per unit mass), the weight of the new torque (per moment of inertia), whether the atom was in a fluid (outside,
   // the step is fix nve/sphere's, operation for operation), the exponentials of the last step's
   // translational drag (sediment::phis memo); then the slip direction (needed only when the
   // weights differ) and the memo of the rotational drag. 16 columns: in rows aligned to 64 bytes,
@@ -53,9 +53,14 @@ class FixNVESphereFluid : public Fix {
   // Set in setup() when there is one fluid/drag and it is uniform() (every atom of its group wholly
   // immersed, no rotational drag): the step then skips the per-atom region and surface look-ups.
   class FixFluidDrag *uniform;
+  // Set in setup() when some fluid/drag has a smooth nonlinear law: its atoms are then stepped in
+  // blocks (sediment::smooth_linearise); without one the loop keeps no block.
+  bool smooth_drag;
   // The first half of the step for every atom of the group, with the drag found by lookup(i, sphere,
-  // flow, spin_rate) (one loop for the general and the uniform look-up, compiled for each).
-  template <class Lookup> void first_half(Lookup lookup);
+  // flow, spin_rate) (one loop for the general and the uniform look-up, compiled for each, with and
+  // without blocks; step_first_half picks by smooth_drag).
+  template <bool blocked, class Lookup> void first_half(Lookup lookup);
+  template <class Lookup> void step_first_half(Lookup lookup);
 
   int floor_axis;         // -1: no floor
   double floor_level;     // spheres stop with their lowest point here

@@ -12,6 +12,7 @@
 #include "sediment/geometry.hpp"
 
 #include <array>
+#include <cmath>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -35,12 +36,51 @@ struct Fluid {
   double yield_stress = 0.0;    // tau_y; 0 for a Newtonian fluid
 };
 
-// Cd * Re and its derivative with respect to Re.
+// Cd * Re and Re times its derivative with respect to Re (in this form no law divides by Re).
 struct DragCurve {
   double g;
-  double dg;
+  double re_dg;
 };
-DragCurve drag_curve(DragLaw law, double re);
+
+constexpr double ln10 = 2.30258509299404568402;
+
+// Reynolds numbers where the faithful laws switch branch.
+constexpr double schiller_naumann_switch = 1000.0;
+constexpr double zhang_li_low = 1.0;
+constexpr double zhang_li_high = 150.0;
+
+// Inline: the integrator's per-atom loops evaluate it with the law fixed for the whole run.
+inline DragCurve drag_curve(DragLaw law, double re)
+{
+  switch (law) {
+    case DragLaw::Stokes:
+      return {24.0, 0.0};
+    case DragLaw::SchillerNaumann:
+      if (re <= schiller_naumann_switch) {
+        const double p = 0.15 * std::pow(re, 0.687);
+        return {24.0 * (1.0 + p), 24.0 * 0.687 * p};
+      }
+      return {0.44 * re, 0.44 * re};
+    case DragLaw::Dallavalle:
+    case DragLaw::DiFelice: {    // the single-sphere curve; hindrance is applied per sphere
+      // Cd = (0.63 + 4.8 / sqrt(Re))^2  =>  Cd Re = (0.63 sqrt(Re) + 4.8)^2
+      const double root = std::sqrt(re);
+      const double inner = 0.63 * root + 4.8;
+      return {inner * inner, 0.63 * inner * root};
+    }
+    case DragLaw::ZhangLi:
+      if (re < zhang_li_low) return {24.0, 0.0};
+      if (re <= zhang_li_high) return {29.12 + 0.195 * re, 0.195 * re};
+      return {0.4 * re, 0.4 * re};
+    case DragLaw::ZhangLiSmooth:
+      // Continuous variant: a linear ramp of Cd Re from 24 to 29.315 over Re' < 1, then
+      // Cd = max(29.12 / Re' + 0.195, 0.4). Same static force and same law for 1 <= Re' <= 142.
+      if (re < zhang_li_low) return {24.0 + 5.315 * re, 5.315 * re};
+      if (29.12 + 0.195 * re >= 0.4 * re) return {29.12 + 0.195 * re, 0.195 * re};
+      return {0.4 * re, 0.4 * re};
+  }
+  return {24.0, 0.0};
+}
 double drag_coefficient(DragLaw law, double re);
 
 // A speed at which the force curve jumps (Cd discontinuity), with the one-sided forces.
@@ -58,12 +98,18 @@ struct DragScale {
   double voidage = 1.0;
 };
 
-// Di Felice (1994) exponent chi(Re) = 3.7 - 0.65 exp(-(1.5 - log10 Re)^2 / 2) and d chi / d Re.
+// Di Felice (1994) exponent chi(Re) = 3.7 - 0.65 exp(-(1.5 - log10 Re)^2 / 2) and Re d chi / d Re.
 struct Exponent {
   double value;
-  double slope;
+  double re_slope;
 };
-Exponent di_felice_exponent(double re);
+inline Exponent di_felice_exponent(double re)
+{
+  if (!(re > 0.0)) return {3.7, 0.0};
+  const double t = 1.5 - std::log10(re);
+  const double bump = 0.65 * std::exp(-0.5 * t * t);
+  return {3.7 - bump, -bump * t / ln10};    // Re d/dRe of -bump = -bump t / ln 10
+}
 
 class DragModel {
  public:
@@ -89,6 +135,21 @@ class DragModel {
   // True when F(s) is single-valued and continuous: no yield stress and no Cd jump, so a step
   // needs no event handling (Stokes, Dallavalle, Di Felice, zhang-li/smooth in a Newtonian fluid).
   bool smooth() const { return smooth_; }
+  // A smooth law is F(s) = k s G(K s) with k = s_A pi eta d / 8 and Re = K s, K = rho d / eta:
+  // the step takes its rates from k G and k (G + Re G') without dividing by the slip.
+  double smooth_drag_per_speed(double d, DragScale scale) const { return scale.area * pi / 8.0 * fluid_.viscosity * d; }
+  double smooth_reynolds_per_speed(double d) const { return density_per_viscosity_ * d; }
+  // Cd Re' of the law at this sphere, with the Di Felice hindrance when it applies.
+  DragCurve curve(double re, double voidage) const
+  {
+    const DragCurve single = drag_curve(law_, re);
+    if (law_ != DragLaw::DiFelice || voidage >= 1.0) return single;
+    // G eps^-(chi(Re) + offset): the exponent depends on Re, so the slope has a second term.
+    const Exponent chi = di_felice_exponent(re);
+    const double log_eps = std::log(voidage);
+    const double factor = std::exp(-(chi.value + hindrance_offset_) * log_eps);
+    return {single.g * factor, (single.re_dg - single.g * log_eps * chi.re_slope) * factor};
+  }
   // F(0+): the largest force a sphere at rest resists (zero for a Newtonian fluid).
   double static_force(double d, DragScale scale = {}) const;
   // c when F(s) = c s exactly (Stokes in a Newtonian fluid), else 0.
@@ -106,12 +167,11 @@ class DragModel {
   double force_at(double d, double speed, double g, DragScale scale) const;
   // dF/ds from the law's curve evaluated at this speed.
   double slope_at(double d, double speed, DragCurve g, DragScale scale) const;
-  // Cd Re' of the law at this sphere, with the Di Felice hindrance when it applies.
-  DragCurve curve(double re, double voidage) const;
 
   DragLaw law_;
   double hindrance_offset_;    // 1: eps^-(chi+1), 0: eps^-chi
   Fluid fluid_;
+  double density_per_viscosity_;    // rho / eta (0 without viscosity)
   bool smooth_;
 };
 

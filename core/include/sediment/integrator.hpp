@@ -18,6 +18,8 @@
 
 #include "sediment/drag.hpp"
 
+#include <cmath>
+
 namespace sediment {
 
 double phi1(double z);
@@ -64,10 +66,91 @@ struct StepCorrection {
   SlipState state = SlipState::Free;
 };
 
-// drag_step_initial for a drag that is not linear in the slip (out of line: Newton linearisation,
-// set-valued points).
-StepCorrection nonlinear_step_initial(const SphereDrag &drag, double mass, const double a[3],
-                                      const double u[3], double dt, double v[3], double dx[3]);
+// The slip's exact advance over t under ds/dt = c - k s from s0, given p = phis(k t).
+struct Segment {
+  double speed;
+  double distance;
+};
+inline Segment advance(const Phi &p, double s0, double c, double t)
+{
+  return {s0 * p.decay + c * t * p.phi1, s0 * t * p.phi1 + c * t * t * p.phi2};
+}
+
+// The step of a smooth law (DragModel::smooth(): no yield, no Cd jump) in two parts, so that an
+// integrator can take the exponentials of a block of spheres together (independent work instead
+// of one long chain of dependent operations per sphere). One evaluation of the law gives the
+// Newton rate along the slip, k (G + Re G') / m, and the secant rate across it, k G / m
+// (F = k s G(Re), Re = K s); z_along and z_across are those rates times dt.
+struct SmoothLinearisation {
+  double dir[3];
+  double s;
+  double a_par;
+  double c;    // ds/dt = c - rate_along s, c = a_par - (F(s) - F'(s) s) / m
+  double z_along;
+  double z_across;
+};
+
+inline SmoothLinearisation smooth_linearise(const SphereDrag &drag, double inverse_mass, const double a[3],
+                                            const double u[3], double dt, const double v[3])
+{
+  const DragModel &model = *drag.model;
+  SmoothLinearisation lin{{0.0, 0.0, 1.0}, 0.0, 0.0, 0.0, 0.0, 0.0};
+  const double w[3] = {v[0] - u[0], v[1] - u[1], v[2] - u[2]};
+  const double s = std::sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]);
+  if (s > 0.0) {
+    const double inv_s = 1.0 / s;
+    for (int k = 0; k < 3; ++k) lin.dir[k] = w[k] * inv_s;
+  } else if (const double a_norm = std::sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]); a_norm > 0.0) {
+    for (int k = 0; k < 3; ++k) lin.dir[k] = a[k] / a_norm;    // at rest: along the drive
+  }
+  lin.s = s;
+  lin.a_par = a[0] * lin.dir[0] + a[1] * lin.dir[1] + a[2] * lin.dir[2];
+  const double re = model.smooth_reynolds_per_speed(drag.diameter) * s;
+  const DragCurve g = model.curve(re, drag.scale.voidage);
+  const double k = model.smooth_drag_per_speed(drag.diameter, drag.scale) * inverse_mass;
+  lin.c = lin.a_par + s * k * g.re_dg;
+  lin.z_along = k * (g.g + g.re_dg) * dt;
+  lin.z_across = k * g.g * dt;
+  return lin;
+}
+
+// The second part, given along = phis(z_along) and across = phis(z_across).
+inline StepCorrection smooth_advance(const SmoothLinearisation &lin, const Phi &along, const Phi &across,
+                                     const double a[3], const double u[3], double dt, double v[3], double dx[3])
+{
+  StepCorrection corr;
+  const double *dir = lin.dir;
+  const Segment full = advance(along, lin.s, lin.c, dt);
+  corr.along = dt * along.phi2;
+  corr.across = dt * across.phi2;
+  for (int n = 0; n < 3; ++n) {
+    corr.dir[n] = dir[n];
+    const double a_perp = a[n] - lin.a_par * dir[n];
+    // The share of a_n in the ETD2 weights; drag_step_final adds the same share of a_{n+1}.
+    v[n] = u[n] + full.speed * dir[n] + a_perp * dt * across.phi1 - corr.along * lin.a_par * dir[n] -
+        corr.across * a_perp;
+    dx[n] = u[n] * dt + full.distance * dir[n] + a_perp * dt * dt * across.phi2;
+  }
+  return corr;
+}
+
+// Both parts for one sphere (out of line, like the next).
+StepCorrection smooth_step_initial(const SphereDrag &drag, double mass, const double a[3], const double u[3],
+                                   double dt, double v[3], double dx[3]);
+
+// drag_step_initial for a law with set-valued points (a yield stress or a Cd jump): Newton
+// linearisation, advanced piecewise between the points (out of line).
+StepCorrection set_valued_step_initial(const SphereDrag &drag, double mass, const double a[3],
+                                       const double u[3], double dt, double v[3], double dx[3]);
+
+// Which step a sphere's drag takes.
+enum class StepKind { Free, Linear, Smooth, SetValued };
+inline StepKind step_kind(const SphereDrag &drag)
+{
+  if (drag.model == nullptr || (drag.scale.area <= 0.0 && drag.scale.wetted <= 0.0)) return StepKind::Free;
+  if (drag.model->linear_coefficient(drag.diameter, drag.scale) > 0.0) return StepKind::Linear;
+  return drag.model->smooth() ? StepKind::Smooth : StepKind::SetValued;
+}
 
 // First half: advances x by dx and replaces v with the mid-step velocity, given the non-drag
 // acceleration a_n = f_n / m and the uniform fluid velocity u. A memo (see phis) saves the
@@ -78,18 +161,24 @@ inline StepCorrection drag_step_initial(const SphereDrag &drag, double mass, con
                                         double *memo = nullptr)
 {
   StepCorrection corr;
-  if (drag.model == nullptr || (drag.scale.area <= 0.0 && drag.scale.wetted <= 0.0)) {
-    for (int k = 0; k < 3; ++k) {
-      v[k] += 0.5 * dt * a[k];
-      dx[k] = dt * v[k];
-    }
-    corr.along = corr.across = 0.5 * dt;
-    return corr;
+  switch (step_kind(drag)) {
+    case StepKind::Free:
+      for (int k = 0; k < 3; ++k) {
+        v[k] += 0.5 * dt * a[k];
+        dx[k] = dt * v[k];
+      }
+      corr.along = corr.across = 0.5 * dt;
+      return corr;
+    case StepKind::Smooth:
+      return smooth_step_initial(drag, mass, a, u, dt, v, dx);
+    case StepKind::SetValued:
+      return set_valued_step_initial(drag, mass, a, u, dt, v, dx);
+    case StepKind::Linear:
+      break;
   }
   // Drag linear in the slip: the same step with equal rates along and across the slip and no
   // set-valued points, in closed form.
   const double linear = drag.model->linear_coefficient(drag.diameter, drag.scale);
-  if (!(linear > 0.0)) return nonlinear_step_initial(drag, mass, a, u, dt, v, dx);
   const double z = linear / mass * dt;
   const Phi p = memo ? phis(z, memo) : phis(z);
   // Copies first: the stores into v could alias u or a, which would then be read anew each time.
