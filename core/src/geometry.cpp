@@ -50,4 +50,14 @@ double hertz_modulus_for_load(double pressure, double overlap, double poisson_ra
   return 2.0 * (1.0 - poisson_ratio * poisson_ratio) * reduced_modulus;
 }
 
+double hertz_contact_frequency(Impact impact, double d, double density, double youngs_modulus, double poisson_ratio,
+                               double overlap)
+{
+  const double reduced_modulus = youngs_modulus / (2.0 * (1.0 - poisson_ratio * poisson_ratio));
+  const bool wall = impact == Impact::Wall;
+  const double stiffness = 2.0 * reduced_modulus * std::sqrt((wall ? 0.5 : 0.25) * d * overlap * d);
+  const double mass = density * sphere_volume(d) * (wall ? 1.0 : 0.5);
+  return std::sqrt(stiffness / mass);
+}
+
 }    // namespace sediment

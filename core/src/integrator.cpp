@@ -207,4 +207,32 @@ StepCorrection set_valued_step_initial(const SphereDrag &drag, double mass, cons
   return corr;
 }
 
+namespace {
+
+bool spring_step_stable(double omega, double rate, double dt)
+{
+  const Phi p = phis(rate * dt);
+  const double h2 = omega * omega * dt * dt;
+  const double trace = 1.0 - h2 * p.phi2 + p.decay - h2 * p.phi1 * p.phi2;
+  const double det = p.decay + h2 * (p.phi1 * p.phi1 - p.phi1 * p.phi2 - p.phi2 * p.decay);
+  return det <= 1.0 && std::abs(trace) <= 1.0 + det;
+}
+
+}    // namespace
+
+double spring_step_limit(double omega, double rate)
+{
+  // Stable from 0 up to the limit: bracket it by doubling from the undamped limit, then bisect.
+  double stable = 0.0, unstable = 2.0 / omega;
+  while (spring_step_stable(omega, rate, unstable)) {
+    stable = unstable;
+    unstable *= 2.0;
+  }
+  for (int n = 0; n < 200 && unstable - stable > 1e-15 * unstable; ++n) {
+    const double mid = 0.5 * (stable + unstable);
+    (spring_step_stable(omega, rate, mid) ? stable : unstable) = mid;
+  }
+  return stable;
+}
+
 }    // namespace sediment

@@ -202,6 +202,15 @@ PYBIND11_MODULE(_core, m)
         py::arg("poisson_ratio"),
         "Young's modulus [Pa] at which a sphere pressed on a wall by pressure * d^2 overlaps by `overlap` of d.");
 
+  m.def("hertz_contact_frequency", [impact_of](const std::string &impact, double d, double density, double youngs,
+                                               double poisson, double overlap) {
+    return hertz_contact_frequency(impact_of(impact), d, density, youngs, poisson, overlap);
+  }, py::arg("impact"), py::arg("diameter"), py::arg("density"), py::arg("youngs_modulus"), py::arg("poisson_ratio"),
+     py::arg("overlap"), "Angular frequency [1/s] of a Hertz contact linearised at `overlap` ('wall' or 'pair').");
+  m.def("spring_step_limit", &spring_step_limit, py::arg("omega"), py::arg("rate"),
+        "Largest stable time step [s] of the drag-implicit step for a linear spring of angular frequency omega "
+        "(explicit) under a linear drag of rate `rate` [1/s] (exact): 2/omega without drag, 2 rate/omega^2 overdamped.");
+
   m.def("submergence", [](double radius, double centre_height) {
     const Submergence sub = submergence(radius, centre_height);
     return py::dict(py::arg("volume") = sub.volume, py::arg("area") = sub.area, py::arg("wetted") = sub.wetted);

@@ -3,6 +3,7 @@
 #include "sediment/geometry.hpp"
 
 #include <cmath>
+#include <tuple>
 
 #include <gtest/gtest.h>
 
@@ -96,4 +97,20 @@ TEST(HertzLoad, OverlapUnderAPressedWeight)
   const double reduced = hertz_modulus_for_load(p, overlap, nu) / (2.0 * (1.0 - nu * nu));
   const double delta = overlap * d;
   EXPECT_NEAR(4.0 / 3.0 * reduced * std::sqrt(d / 2) * std::pow(delta, 1.5), p * d * d, 1e-12 * p * d * d);
+}
+
+TEST(HertzContact, FrequencyIsTheForceSlopeOverTheMass)
+{
+  // dF/d delta of F = (4/3) E* sqrt(R) delta^(3/2), by a central difference, over the effective mass.
+  const double d = 60e-6, rho = 2650.0, E = 1.9e4, nu = 0.3, overlap = 0.01;
+  const double reduced = E / (2.0 * (1.0 - nu * nu)), m = rho * sphere_volume(d);
+  for (auto [impact, R, m_eff] : {std::tuple{Impact::Wall, d / 2, m}, std::tuple{Impact::Pair, d / 4, m / 2}}) {
+    auto force = [&, R = R](double delta) { return 4.0 / 3.0 * reduced * std::sqrt(R) * std::pow(delta, 1.5); };
+    const double delta = overlap * d, h = 1e-4 * delta;
+    const double slope = (force(delta + h) - force(delta - h)) / (2 * h);
+    EXPECT_NEAR(hertz_contact_frequency(impact, d, rho, E, nu, overlap), std::sqrt(slope / m_eff),
+                1e-7 * std::sqrt(slope / m_eff));
+  }
+  EXPECT_NEAR(hertz_contact_frequency(Impact::Pair, d, rho, E, nu, overlap) /
+                  hertz_contact_frequency(Impact::Wall, d, rho, E, nu, overlap), std::pow(2.0, 0.25), 1e-14);
 }

@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <functional>
 
@@ -297,3 +298,40 @@ TEST(Integrator, PhiMemoGivesTheSameStepAndFollowsTheRate)
   EXPECT_EQ(phis(next, memo).decay, phis(next).decay);
   EXPECT_EQ(memo[0], next);
 }
+
+// A sphere on a linear spring under Stokes drag, advanced by the drag step with the spring force
+// explicit (as LAMMPS computes contact forces between the halves): largest |x| over many steps.
+static double spring_amplitude(double omega, double rate, double dt, int steps)
+{
+  const double d = 1e-4, mass = 2650.0 * sphere_volume(d);
+  const double viscosity = rate * mass / (3.0 * pi * d);
+  const DragModel model(DragLaw::Stokes, Fluid{1000.0, viscosity, 0.0});
+  const SphereDrag drag{&model, d, {}};
+  const double u[3] = {0.0, 0.0, 0.0};
+  double x = 1.0, v[3] = {0.0, 0.0, 0.0}, largest = 0.0;
+  for (int n = 0; n < steps; ++n) {
+    double a[3] = {-omega * omega * x, 0.0, 0.0}, dx[3];
+    const StepCorrection corr = drag_step_initial(drag, mass, a, u, dt, v, dx);
+    x += dx[0];
+    a[0] = -omega * omega * x;
+    drag_step_final(corr, a, v);
+    largest = std::max(largest, std::abs(x));
+  }
+  return largest;
+}
+
+TEST(Integrator, SpringStepLimitSeparatesBoundedFromGrowingMotion)
+{
+  const double omega = 1e4;
+  // From no drag through critical damping (rate = 2 omega) to a drag 1000 times overdamping.
+  for (double rate : {0.0, 0.3 * omega, 2.0 * omega, 30.0 * omega, 1e3 * omega}) {
+    const double limit = spring_step_limit(omega, rate);
+    EXPECT_LT(spring_amplitude(omega, rate, 0.98 * limit, 20000), 10.0) << rate;    // Verlet: 5 at 0.98
+    EXPECT_GT(spring_amplitude(omega, rate, 1.02 * limit, 20000), 1e3) << rate;
+  }
+  EXPECT_NEAR(spring_step_limit(omega, 0.0), 2.0 / omega, 1e-12 / omega);    // velocity Verlet
+  // Overdamped: the spring relaxes at omega^2 / rate, and the step is bounded by twice its inverse.
+  const double rate = 1e4 * omega;
+  EXPECT_NEAR(spring_step_limit(omega, rate), 2.0 * rate / (omega * omega), 1e-3 * 2.0 * rate / (omega * omega));
+}
+

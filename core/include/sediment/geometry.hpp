@@ -58,4 +58,10 @@ double hertz_modulus_for_overlap(Impact impact, double density, double speed, do
 // by `overlap` of its diameter: F = (4/3) E* sqrt(d/2) delta^(3/2) gives E* = 3 sqrt(2) p / (4 (delta/d)^(3/2)).
 double hertz_modulus_for_load(double pressure, double overlap, double poisson_ratio);
 
+// Angular frequency sqrt(k / m_eff) of a Hertz contact linearised at `overlap` (relative to the
+// diameter d): k = dF/d delta = 2 E* sqrt(R delta); on a wall (R = d/2, m_eff = m) or between two
+// equal spheres (R = d/4, m_eff = m/2, the stiffer per unit mass by 2^(1/4)).
+double hertz_contact_frequency(Impact impact, double d, double density, double youngs_modulus, double poisson_ratio,
+                               double overlap);
+
 }    // namespace sediment

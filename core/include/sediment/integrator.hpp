@@ -205,6 +205,15 @@ inline void drag_step_final(const StepCorrection &corr, const double a[3], doubl
     v[k] += corr.along * a_par * corr.dir[k] + corr.across * (a[k] - a_par * corr.dir[k]);
 }
 
+// Largest time step at which this step is stable for a sphere on a linear spring of angular
+// frequency omega (the spring force taken explicitly, as LAMMPS's contacts are) under a linear drag
+// of rate `rate` (taken exactly). Over (x, dt v) the step is the matrix
+//   [[1 - h^2 phi2, phi1], [-h^2 (phi1 - phi2) - h^2 phi2 (1 - h^2 phi2), e^-z - h^2 phi1 phi2]],
+// h = omega dt, z = rate dt; it is stable while |trace| <= 1 + det and det <= 1. The limit is 2 / omega
+// without drag (velocity Verlet) and tends to 2 rate / omega^2 when the drag overdamps the spring:
+// then the spring's own relaxation, not its oscillation, sets the step.
+double spring_step_limit(double omega, double rate);
+
 // Rotation with a linear drag torque -k I omega: same ETD2 weights, isotropic.
 // Returns the weight of alpha_{n+1} for the second half (dt / 2 when k = 0).
 inline double rotation_step_initial(double rate, const double alpha[3], double dt, double omega[3],
