@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 
 namespace sediment {
 
@@ -222,6 +223,7 @@ bool spring_step_stable(double omega, double rate, double dt)
 
 double spring_step_limit(double omega, double rate)
 {
+  if (omega == 0.0) return std::numeric_limits<double>::infinity();    // no spring, no limit
   // Stable from 0 up to the limit: bracket it by doubling from the undamped limit, then bisect.
   double stable = 0.0, unstable = 2.0 / omega;
   while (spring_step_stable(omega, rate, unstable)) {

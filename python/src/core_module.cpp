@@ -11,6 +11,7 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include <cmath>
 #include <stdexcept>
 
 namespace py = pybind11;
@@ -207,7 +208,11 @@ PYBIND11_MODULE(_core, m)
     return hertz_contact_frequency(impact_of(impact), d, density, youngs, poisson, overlap);
   }, py::arg("impact"), py::arg("diameter"), py::arg("density"), py::arg("youngs_modulus"), py::arg("poisson_ratio"),
      py::arg("overlap"), "Angular frequency [1/s] of a Hertz contact linearised at `overlap` ('wall' or 'pair').");
-  m.def("spring_step_limit", &spring_step_limit, py::arg("omega"), py::arg("rate"),
+  m.def("spring_step_limit", [](double omega, double rate) {
+    if (!(omega >= 0.0 && rate >= 0.0 && std::isfinite(omega) && std::isfinite(rate)))
+      throw py::value_error("omega and rate must be finite and >= 0");
+    return spring_step_limit(omega, rate);
+  }, py::arg("omega"), py::arg("rate"),
         "Largest stable time step [s] of the drag-implicit step for a linear spring of angular frequency omega "
         "(explicit) under a linear drag of rate `rate` [1/s] (exact): 2/omega without drag, 2 rate/omega^2 overdamped.");
 

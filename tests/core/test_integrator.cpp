@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cmath>
 #include <functional>
+#include <limits>
 
 using namespace sediment;
 
@@ -333,5 +334,6 @@ TEST(Integrator, SpringStepLimitSeparatesBoundedFromGrowingMotion)
   // Overdamped: the spring relaxes at omega^2 / rate, and the step is bounded by twice its inverse.
   const double rate = 1e4 * omega;
   EXPECT_NEAR(spring_step_limit(omega, rate), 2.0 * rate / (omega * omega), 1e-3 * 2.0 * rate / (omega * omega));
+  EXPECT_EQ(spring_step_limit(0.0, rate), std::numeric_limits<double>::infinity());    // no spring
 }
 

@@ -5,6 +5,7 @@ import math
 import pytest
 
 import sediment
+from sediment import _core
 
 
 def test_case_a_terminal_velocity_and_tau():
@@ -48,6 +49,9 @@ def test_rayleigh_time_example():
     (lambda: sediment.DragModel("stokes", 1000, 0), "viscosity must be > 0"),
     (lambda: sediment.terminal_velocity("stokes", 1000, 1e-3, 0, -1e-4, 2700), "diameter must be > 0"),
     (lambda: sediment.time_to_fraction("stokes", 1000, 1e-3, 0, 1e-4, 2700, 9.81, 1.5), "fraction must be in"),
+    (lambda: _core.spring_step_limit(-1.0, 0.0), "omega and rate must be finite and >= 0"),
+    (lambda: _core.spring_step_limit(1e4, float("nan")), "omega and rate must be finite and >= 0"),
+    (lambda: _core.hertz_contact_frequency("floor", 1e-4, 2650, 1e6, 0.3, 0.01), "impact must be 'wall' or 'pair'"),
 ])
 def test_bad_input_raises_clear_errors(call, message):
     with pytest.raises(ValueError, match=message):

@@ -211,7 +211,8 @@ inline void drag_step_final(const StepCorrection &corr, const double a[3], doubl
 //   [[1 - h^2 phi2, phi1], [-h^2 (phi1 - phi2) - h^2 phi2 (1 - h^2 phi2), e^-z - h^2 phi1 phi2]],
 // h = omega dt, z = rate dt; it is stable while |trace| <= 1 + det and det <= 1. The limit is 2 / omega
 // without drag (velocity Verlet) and tends to 2 rate / omega^2 when the drag overdamps the spring:
-// then the spring's own relaxation, not its oscillation, sets the step.
+// then the spring's own relaxation, not its oscillation, sets the step. Infinite for omega = 0;
+// omega and rate finite and >= 0.
 double spring_step_limit(double omega, double rate);
 
 // Rotation with a linear drag torque -k I omega: same ETD2 weights, isotropic.
