@@ -31,28 +31,27 @@ sys.path.insert(0, str(HERE.parent / "python"))
 from sediment import _core  # noqa: E402
 from sediment.cli.types import count  # noqa: E402
 from sediment.sim.run import run_batch  # noqa: E402
+from sediment.sim.scene import OVERLAP_TOLERANCE, POISSON_RATIO, contact_modulus  # noqa: E402
 
 DECK = HERE.parent / "tests" / "decks" / "soft_bed.lmp"
-RHO_P, RHO_F, MU, NU, G, TOLERANCE = 2650.0, 1000.0, 1e-3, 0.3, 9.81, 0.01
+RHO_P, RHO_F, MU, G = 2650.0, 1000.0, 1e-3, 9.81
 BEDS = {"coarse": (1.0, 0.5), "fine": (0.1, 5.0)}    # length scale, simulated time [s] (settling takes 1/scale)
 STEPS = ("rayleigh/10", "rayleigh/5", "0.5 bound", "bound")
 
 
 def modulus(scale: float) -> float:
-    """The contact modulus of sediment sample's rule: 1 % overlap for the largest grain landing at its
-    terminal speed, and under the buoyant weight of the bed on one grain's cross-section."""
+    """The contact modulus `sediment sample --contacts` would choose for this bed."""
     d_max, d_mean = 100e-6 * scale, 80e-6 * scale
     v = float(_core.terminal_velocity("dallavalle", RHO_F, MU, 0.0, d_max, RHO_P, G)[0])
-    impact = _core.hertz_modulus_for_overlap("wall", RHO_P, v, TOLERANCE, NU)
     solid_height = 320 * math.pi / 6 * d_mean ** 3 / (1e-3 * scale) ** 2
-    return max(impact, _core.hertz_modulus_for_load(solid_height * (RHO_P - RHO_F) * G, TOLERANCE, NU))
+    return contact_modulus(RHO_P, v, solid_height * (RHO_P - RHO_F) * G)
 
 
 def time_step(step: str, scale: float, youngs: float) -> float:
     d = 60e-6 * scale
     if step.startswith("rayleigh"):
-        return _core.rayleigh_time(d / 2, RHO_P, youngs, NU) / int(step.split("/")[1])
-    omega = math.sqrt(12) * _core.hertz_contact_frequency("pair", d, RHO_P, youngs, NU, TOLERANCE)
+        return _core.rayleigh_time(d / 2, RHO_P, youngs, POISSON_RATIO) / int(step.split("/")[1])
+    omega = math.sqrt(12) * _core.hertz_contact_frequency("pair", d, RHO_P, youngs, POISSON_RATIO, OVERLAP_TOLERANCE)
     rate = _core.DragModel("dallavalle", RHO_F, MU).tangent(d, 0.0) / (RHO_P * math.pi / 6 * d ** 3)
     return (0.5 if step == "0.5 bound" else 1.0) * _core.spring_step_limit(omega, rate)
 

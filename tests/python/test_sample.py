@@ -84,14 +84,17 @@ def test_contacts_need_real_grains_and_set_the_step(tmp_path):
                  t_end=2e-5, effects=Effects(lubrication=True))
     dt, steps = scene.stages()[0]
     assert steps == math.ceil(2e-5 / dt) and len(scene.diameter) > 1000
-    # The contacts: the softest modulus keeping a 1 % overlap for the fastest grain's impact on the floor
-    # (here it is the bound: the 3 mm deposit weighs little), and a fifth of the smallest grain's Rayleigh time.
+    # The contacts: the softest modulus keeping a 1 % overlap both for the fastest grain's impact on the floor
+    # and under three times the deposit's buoyant weight on one grain's cross-section (here the load decides),
+    # and a fifth of the smallest grain's Rayleigh time.
     f, sizes = scene.suspension, scene.classes.diameter[scene.classes.count > 0]
     v_max = terminal_speed(f, sizes.max(), scene.effects.drag)
-    youngs = _core.hertz_modulus_for_overlap("wall", f.particle_density, v_max, 0.01, 0.3)
-    assert scene.contact_modulus() == pytest.approx(youngs, rel=1e-12)
-    assert _core.hertz_impact_overlap("wall", f.particle_density, v_max, scene.contact_modulus(), 0.3) == \
-        pytest.approx(0.01, rel=1e-9)
+    impact = _core.hertz_modulus_for_overlap("wall", f.particle_density, v_max, 0.01, 0.3)
+    pressure = scene.initial_concentration * scene.height * (1 - f.fluid_density / f.particle_density) * f.gravity
+    load = _core.hertz_modulus_for_load(3 * pressure, 0.01, 0.3)
+    youngs = max(impact, load)
+    assert load > impact and scene.contact_modulus() == pytest.approx(youngs, rel=1e-12)
+    assert _core.hertz_impact_overlap("wall", f.particle_density, v_max, scene.contact_modulus(), 0.3) < 0.01
     assert dt == pytest.approx(0.2 * _core.rayleigh_time(sizes.min() / 2, f.particle_density, youngs, 0.3), rel=1e-12)
     # no two grains overlap (periodic across, not along the height)
     p, r = scene.position, scene.diameter / 2
