@@ -1,15 +1,19 @@
 # SPDX-License-Identifier: GPL-2.0-or-later
 """Cost per particle-step of the SEDIMENT effects, as ratios measured in one run on this machine.
 
-    /usr/bin/python3 benchmarks/cost.py [--particles 20000] [--steps 2000] [--repeats 3]
+    /usr/bin/python3 benchmarks/cost.py [--particles 20000] [--steps 2000] [--repeats 3] [--baseline LMP]
 
 Each scene runs `repeats` times, the scenes taking turns (so that a drift of the machine's speed
 during the run touches every scene alike); the best loop time is kept. LAMMPS reports the loop
-time, which excludes start-up.
+time, which excludes start-up. With --baseline (another lmp_sediment, e.g. a build of an earlier
+commit) every scene also runs with it, the two taking turns scene by scene, and the table gains
+the ratio this build / baseline: on a machine whose speed drifts by 10 % between runs, the way to
+measure one change.
 """
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 from pathlib import Path
 
@@ -29,8 +33,25 @@ SCENES = {"plain": "nve/sphere + gravity (reference)",
           "lubricated": "as drag + pair lubricate/fluid"}
 
 
-def loop_time(scene: str, particles: int, steps: int) -> float:
-    return run_batch(HERE / "in.cost", {"scene": scene, "n": particles, "steps": steps}).loops[0][0]
+def loop_time(scene: str, particles: int, steps: int, lmp: Path | None = None) -> float:
+    """Loop time of the scene, with `lmp` instead of the lmp_sediment in use when given."""
+    previous = os.environ.get("SEDIMENT_LMP")
+    if lmp is not None:
+        os.environ["SEDIMENT_LMP"] = str(lmp)
+    try:
+        return run_batch(HERE / "in.cost", {"scene": scene, "n": particles, "steps": steps}).loops[0][0]
+    finally:
+        if previous is None:
+            os.environ.pop("SEDIMENT_LMP", None)
+        else:
+            os.environ["SEDIMENT_LMP"] = previous
+
+
+def existing_file(text: str) -> Path:
+    path = Path(text)
+    if not path.is_file():
+        raise argparse.ArgumentTypeError(f"no such file: {text}")
+    return path.resolve()
 
 
 def main() -> None:
@@ -38,16 +59,26 @@ def main() -> None:
     parser.add_argument("--particles", type=count, default=20000)
     parser.add_argument("--steps", type=count, default=2000)
     parser.add_argument("--repeats", type=count, default=3)
+    parser.add_argument("--baseline", type=existing_file, help="another lmp_sediment to take turns with")
     args = parser.parse_args()
     times = {s: float("inf") for s in SCENES}
+    baseline = {s: float("inf") for s in SCENES}
     for _ in range(args.repeats):
         for s in SCENES:
             times[s] = min(times[s], loop_time(s, args.particles, args.steps))
+            if args.baseline:
+                baseline[s] = min(baseline[s], loop_time(s, args.particles, args.steps, args.baseline))
     per = {s: t / (args.particles * args.steps) * 1e9 for s, t in times.items()}
     print(f"{args.particles} particles x {args.steps} steps, best of {args.repeats}, 1 rank")
-    print(f"{'scene':10s} {'ns/particle-step':>17s} {'ratio to plain':>15s}  what")
+    against = f" {'baseline ns':>12s} {'this/baseline':>14s}" if args.baseline else ""
+    print(f"{'scene':10s} {'ns/particle-step':>17s} {'ratio to plain':>15s}{against}  what")
     for s, what in SCENES.items():
-        print(f"{s:10s} {per[s]:17.2f} {per[s] / per['plain']:15.2f}  {what}")
+        other = baseline[s] / (args.particles * args.steps) * 1e9
+        against = f" {other:12.2f} {times[s] / baseline[s]:14.3f}" if args.baseline else ""
+        print(f"{s:10s} {per[s]:17.2f} {per[s] / per['plain']:15.2f}{against}  {what}")
+    if args.baseline:
+        print(f"baseline: {args.baseline}; the peer and plain scenes run the same code in both builds, so "
+              "their ratios show this machine's noise")
     print(f"every effect off: {100 * (per['bare'] / per['plain'] - 1):+.1f} % against fix nve/sphere")
     print(f"against the peer (LAMMPS's own fixes): explicit stokes + buoyancy {per['explicit'] / per['peer']:.2f}x, "
           f"implicit {per['drag'] / per['peer']:.2f}x, nonlinear implicit {per['nonlinear'] / per['peer']:.2f}x")
