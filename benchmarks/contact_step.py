@@ -12,7 +12,8 @@ a grain pressed by a Hertz spring (sediment._core.spring_step_limit) whose stiff
 contact between two smallest grains at the tolerated overlap, times 12 (Gershgorin's bound on the
 stiffness of a grain with 12 neighbours, each contact counted on both grains). Each bed is
 compared with the one at a tenth of the Rayleigh time: mean height (volume-weighted centre height
-over the mean diameter) and packing fraction below twice it, and the largest overlap during the run.
+over the mean diameter) and packing fraction below twice it, the largest overlap during the run and
+at its end (the settled bed).
 """
 from __future__ import annotations
 
@@ -71,7 +72,8 @@ def settle(bed: str, step: str, folder: Path) -> dict:
     grains = np.loadtxt(final, skiprows=9)
     volume = np.pi / 6 * grains[:, 4] ** 3
     height = float(np.sum(volume * grains[:, 3]) / volume.sum())
-    return {**row, "overlap": float(out.samples[:, 1].max()), "height": height / (80e-6 * scale),
+    return {**row, "overlap": float(out.samples[:, 1].max()), "settled": float(out.samples[-1, 1]),
+            "height": height / (80e-6 * scale),
             "packing": float(volume.sum() / ((1e-3 * scale) ** 2 * 2 * height))}
 
 
@@ -82,7 +84,7 @@ def main() -> None:
     runs = [(bed, step) for bed in BEDS for step in STEPS]
     with tempfile.TemporaryDirectory() as tmp, ThreadPoolExecutor(max_workers=args.jobs) as pool:
         rows = list(pool.map(lambda run: settle(*run, Path(tmp)), runs))
-    print(f"{'bed':7s} {'step':12s} {'dt [s]':>9s} {'steps':>8s} {'wall [s]':>8s} {'overlap':>8s} "
+    print(f"{'bed':7s} {'step':12s} {'dt [s]':>9s} {'steps':>8s} {'wall [s]':>8s} {'overlap':>8s} {'settled':>8s} "
           f"{'height/d':>9s} {'packing':>8s}  against rayleigh/10")
     for row in rows:
         reference = next(r for r in rows if r["bed"] == row["bed"] and r["step"] == "rayleigh/10")
@@ -92,7 +94,7 @@ def main() -> None:
             continue
         change = (f"height {row['height'] / reference['height'] - 1:+.1%}, packing "
                   f"{row['packing'] / reference['packing'] - 1:+.1%}") if "height" in reference else ""
-        print(f"{head} {row['overlap']:8.2%} {row['height']:9.4f} {row['packing']:8.4f}  {change}")
+        print(f"{head} {row['overlap']:8.2%} {row['settled']:8.2%} {row['height']:9.4f} {row['packing']:8.4f}  {change}")
 
 
 if __name__ == "__main__":
