@@ -53,7 +53,7 @@ def time_step(step: str, scale: float, youngs: float) -> float:
     if step.startswith("rayleigh"):
         return _core.rayleigh_time(d / 2, RHO_P, youngs, POISSON_RATIO) / int(step.split("/")[1])
     omega = math.sqrt(12) * _core.hertz_contact_frequency("pair", d, RHO_P, youngs, POISSON_RATIO, OVERLAP_TOLERANCE)
-    rate = _core.DragModel("dallavalle", RHO_F, MU).tangent(d, 0.0) / (RHO_P * math.pi / 6 * d ** 3)
+    rate = 1.0 / _core.relaxation_time("dallavalle", RHO_F, MU, d, RHO_P)
     return (0.5 if step == "0.5 bound" else 1.0) * _core.spring_step_limit(omega, rate)
 
 

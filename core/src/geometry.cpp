@@ -23,6 +23,9 @@ double rayleigh_time(double radius, double density, double youngs_modulus, doubl
 }
 
 namespace {
+// E / E* of two spheres of one material (or a sphere and a wall of it): 2 (1 - nu^2).
+double youngs_per_reduced(double poisson_ratio) { return 2.0 * (1.0 - poisson_ratio * poisson_ratio); }
+
 // (delta/d)^(5/2) E* / (rho v^2) of the impact.
 double impact_factor(Impact impact)
 {
@@ -33,7 +36,7 @@ double impact_factor(Impact impact)
 double hertz_impact_overlap(Impact impact, double density, double speed, double youngs_modulus,
                             double poisson_ratio)
 {
-  const double reduced_modulus = youngs_modulus / (2.0 * (1.0 - poisson_ratio * poisson_ratio));
+  const double reduced_modulus = youngs_modulus / youngs_per_reduced(poisson_ratio);
   return std::pow(impact_factor(impact) * density * speed * speed / reduced_modulus, 0.4);
 }
 
@@ -41,19 +44,19 @@ double hertz_modulus_for_overlap(Impact impact, double density, double speed, do
                                  double poisson_ratio)
 {
   const double reduced_modulus = impact_factor(impact) * density * speed * speed / std::pow(overlap, 2.5);
-  return 2.0 * (1.0 - poisson_ratio * poisson_ratio) * reduced_modulus;
+  return youngs_per_reduced(poisson_ratio) * reduced_modulus;
 }
 
 double hertz_modulus_for_load(double pressure, double overlap, double poisson_ratio)
 {
   const double reduced_modulus = 3.0 * std::sqrt(2.0) * pressure / (4.0 * std::pow(overlap, 1.5));
-  return 2.0 * (1.0 - poisson_ratio * poisson_ratio) * reduced_modulus;
+  return youngs_per_reduced(poisson_ratio) * reduced_modulus;
 }
 
 double hertz_contact_frequency(Impact impact, double d, double density, double youngs_modulus, double poisson_ratio,
                                double overlap)
 {
-  const double reduced_modulus = youngs_modulus / (2.0 * (1.0 - poisson_ratio * poisson_ratio));
+  const double reduced_modulus = youngs_modulus / youngs_per_reduced(poisson_ratio);
   const bool wall = impact == Impact::Wall;
   const double stiffness = 2.0 * reduced_modulus * std::sqrt((wall ? 0.5 : 0.25) * d * overlap * d);
   const double mass = density * sphere_volume(d) * (wall ? 1.0 : 0.5);

@@ -151,8 +151,6 @@ AlongSlip advance_along(const SphereDrag &drag, double mass, double s, double a_
   return {s, distance + s * left, rate, SlipState::Free};
 }
 
-double dot(const double a[3], const double b[3]) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
-
 }    // namespace
 
 StepCorrection smooth_step_initial(const SphereDrag &drag, double mass, const double a[3], const double u[3],

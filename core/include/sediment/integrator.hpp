@@ -66,6 +66,8 @@ struct StepCorrection {
   SlipState state = SlipState::Free;
 };
 
+inline double dot(const double a[3], const double b[3]) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+
 // The slip's exact advance over t under ds/dt = c - k s from s0, given p = phis(k t).
 struct Segment {
   double speed;
@@ -96,15 +98,15 @@ inline SmoothLinearisation smooth_linearise(const SphereDrag &drag, double inver
   const DragModel &model = *drag.model;
   SmoothLinearisation lin{{0.0, 0.0, 1.0}, 0.0, 0.0, 0.0, 0.0, 0.0};
   const double w[3] = {v[0] - u[0], v[1] - u[1], v[2] - u[2]};
-  const double s = std::sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]);
+  const double s = std::sqrt(dot(w, w));
   if (s > 0.0) {
     const double inv_s = 1.0 / s;
     for (int k = 0; k < 3; ++k) lin.dir[k] = w[k] * inv_s;
-  } else if (const double a_norm = std::sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]); a_norm > 0.0) {
+  } else if (const double a_norm = std::sqrt(dot(a, a)); a_norm > 0.0) {
     for (int k = 0; k < 3; ++k) lin.dir[k] = a[k] / a_norm;    // at rest: along the drive
   }
   lin.s = s;
-  lin.a_par = a[0] * lin.dir[0] + a[1] * lin.dir[1] + a[2] * lin.dir[2];
+  lin.a_par = dot(a, lin.dir);
   const double re = model.smooth_reynolds_per_speed(drag.diameter) * s;
   const DragCurve g = model.curve(re, drag.scale.voidage);
   const double k = model.smooth_drag_per_speed(drag.diameter, drag.scale) * inverse_mass;
@@ -200,7 +202,7 @@ inline void drag_step_final(const StepCorrection &corr, const double a[3], doubl
     for (int k = 0; k < 3; ++k) v[k] += corr.along * a[k];
     return;
   }
-  const double a_par = a[0] * corr.dir[0] + a[1] * corr.dir[1] + a[2] * corr.dir[2];
+  const double a_par = dot(a, corr.dir);
   for (int k = 0; k < 3; ++k)
     v[k] += corr.along * a_par * corr.dir[k] + corr.across * (a[k] - a_par * corr.dir[k]);
 }
