@@ -2,6 +2,7 @@
 """Cost per particle-step of the SEDIMENT effects, as ratios measured in one run on this machine.
 
     /usr/bin/python3 benchmarks/cost.py [--particles 20000] [--steps 2000] [--repeats 3] [--baseline LMP]
+                                        [--scenes plain,drag,...]
 
 Each scene runs `repeats` times, the scenes taking turns (so that a drift of the machine's speed
 during the run touches every scene alike); the best loop time is kept. LAMMPS reports the loop
@@ -54,17 +55,29 @@ def existing_file(text: str) -> Path:
     return path.resolve()
 
 
+def scene_list(text: str) -> list[str]:
+    names = [name.strip() for name in text.split(",") if name.strip()]
+    unknown = [name for name in names if name not in SCENES]
+    if unknown or not names:
+        raise argparse.ArgumentTypeError(f"unknown scene(s) {', '.join(unknown) or text!r}; expected some of "
+                                         f"{', '.join(SCENES)}")
+    return names
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--particles", type=count, default=20000)
     parser.add_argument("--steps", type=count, default=2000)
     parser.add_argument("--repeats", type=count, default=3)
     parser.add_argument("--baseline", type=existing_file, help="another lmp_sediment to take turns with")
+    parser.add_argument("--scenes", type=scene_list, default=list(SCENES),
+                        help="comma-separated scenes to run (default: all; plain and peer always run, the ratios need them)")
     args = parser.parse_args()
-    times = {s: float("inf") for s in SCENES}
-    baseline = {s: float("inf") for s in SCENES}
+    scenes = {s: SCENES[s] for s in SCENES if s in args.scenes or s in ("plain", "peer")}
+    times = {s: float("inf") for s in scenes}
+    baseline = {s: float("inf") for s in scenes}
     for _ in range(args.repeats):
-        for s in SCENES:
+        for s in scenes:
             times[s] = min(times[s], loop_time(s, args.particles, args.steps))
             if args.baseline:
                 baseline[s] = min(baseline[s], loop_time(s, args.particles, args.steps, args.baseline))
@@ -72,22 +85,29 @@ def main() -> None:
     print(f"{args.particles} particles x {args.steps} steps, best of {args.repeats}, 1 rank")
     against = f" {'baseline ns':>12s} {'this/baseline':>14s}" if args.baseline else ""
     print(f"{'scene':10s} {'ns/particle-step':>17s} {'ratio to plain':>15s}{against}  what")
-    for s, what in SCENES.items():
+    for s, what in scenes.items():
         other = baseline[s] / (args.particles * args.steps) * 1e9
         against = f" {other:12.2f} {times[s] / baseline[s]:14.3f}" if args.baseline else ""
         print(f"{s:10s} {per[s]:17.2f} {per[s] / per['plain']:15.2f}{against}  {what}")
     if args.baseline:
         print(f"baseline: {args.baseline}; the peer and plain scenes run the same code in both builds, so "
               "their ratios show this machine's noise")
-    print(f"every effect off: {100 * (per['bare'] / per['plain'] - 1):+.1f} % against fix nve/sphere")
-    print(f"against the peer (LAMMPS's own fixes): explicit stokes + buoyancy {per['explicit'] / per['peer']:.2f}x, "
-          f"implicit {per['drag'] / per['peer']:.2f}x, nonlinear implicit {per['nonlinear'] / per['peer']:.2f}x")
-    grid = per["hindered"] - per["nonlinear"]
-    print(f"grid + Di Felice hindrance on top of the nonlinear step: {grid:.1f} ns/particle-step "
-          f"({grid / per['plain']:.2f}x the plain step); with 3d cells "
-          f"{per['cells'] - per['nonlinear']:.1f} ns ({(per['cells'] - per['nonlinear']) / per['plain']:.2f}x)")
-    film = per["lubricated"] - per["drag"]
-    print(f"lubrication on top of the Stokes step: {film:.1f} ns/particle-step ({film / per['plain']:.2f}x the plain step)")
+    if "bare" in per:
+        print(f"every effect off: {100 * (per['bare'] / per['plain'] - 1):+.1f} % against fix nve/sphere")
+    against_peer = [f"{label} {per[s] / per['peer']:.2f}x" for s, label in
+                    (("explicit", "explicit stokes + buoyancy"), ("drag", "implicit"), ("nonlinear", "nonlinear implicit"))
+                    if s in per]
+    if against_peer:
+        print("against the peer (LAMMPS's own fixes): " + ", ".join(against_peer))
+    if "nonlinear" in per and "hindered" in per:
+        grid = per["hindered"] - per["nonlinear"]
+        cells = f"; with 3d cells {per['cells'] - per['nonlinear']:.1f} ns ({(per['cells'] - per['nonlinear']) / per['plain']:.2f}x)" \
+            if "cells" in per else ""
+        print(f"grid + Di Felice hindrance on top of the nonlinear step: {grid:.1f} ns/particle-step "
+              f"({grid / per['plain']:.2f}x the plain step){cells}")
+    if "drag" in per and "lubricated" in per:
+        film = per["lubricated"] - per["drag"]
+        print(f"lubrication on top of the Stokes step: {film:.1f} ns/particle-step ({film / per['plain']:.2f}x the plain step)")
 
 
 if __name__ == "__main__":

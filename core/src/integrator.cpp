@@ -153,10 +153,10 @@ AlongSlip advance_along(const SphereDrag &drag, double mass, double s, double a_
 
 }    // namespace
 
-StepCorrection smooth_step_initial(const SphereDrag &drag, double mass, const double a[3], const double u[3],
-                                   double dt, double v[3], double dx[3])
+StepCorrection smooth_step_initial(const SphereDrag &drag, double inverse_mass, const double a[3],
+                                   const double u[3], double dt, double v[3], double dx[3])
 {
-  const SmoothLinearisation lin = smooth_linearise(drag, 1.0 / mass, a, u, dt, v);
+  const SmoothLinearisation lin = smooth_linearise(drag, inverse_mass, a, u, dt, v);
   return smooth_advance(lin, phis(lin.z_along), phis(lin.z_across), a, u, dt, v, dx);
 }
 

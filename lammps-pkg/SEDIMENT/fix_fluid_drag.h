@@ -47,7 +47,9 @@ class FixFluidDrag : public Fix {
   // an integrator may skip the per-atom region, surface and rotation look-ups.
   bool uniform() const;
   // True when the law is smooth (no yield stress, no Cd jump) and not linear in the slip.
-  bool smooth_nonlinear() const { return model->smooth() && !(model->linear_coefficient(1.0) > 0.0); }
+  bool smooth_nonlinear() const { return model->smooth() && !(linear_per_diameter() > 0.0); }
+  // c when the drag of a wholly immersed sphere of diameter d is F = c d w, else 0.
+  double linear_per_diameter() const { return model->linear_coefficient(1.0); }
   // The drag on local atom i of the group when uniform(): its diameter and local fraction only.
   sediment::SphereDrag immersed_drag(int i) const;
 

@@ -74,7 +74,8 @@ static inline double nve_sphere_kick_drift(double *x, double *v, double *omega, 
 }
 
 FixNVESphereFluid::FixNVESphereFluid(LAMMPS *lmp, int narg, char **arg) :
-    Fix(lmp, narg, arg), weights(nullptr), nmax_weights(0), uniform(nullptr), smooth_drag(false), floor_axis(-1), floor_level(0.0)
+    Fix(lmp, narg, arg), weights(nullptr), nmax_weights(0), uniform(nullptr), half_step(HalfStep::General),
+    linear_per_diameter(0.0), floor_axis(-1), floor_level(0.0)
 {
   StyleArgs args(lmp, FLERR, "Fix nve/sphere/fluid", narg, arg, 3);
   while (args.more()) {
@@ -132,21 +133,27 @@ void FixNVESphereFluid::setup(int /*vflag*/)
 {
   // After every fix's init(): the drag fixes know their fluid only then.
   uniform = drags.size() == 1 && drags.front()->uniform() ? drags.front() : nullptr;
-  smooth_drag = false;
-  for (FixFluidDrag *drag : drags) smooth_drag |= drag->smooth_nonlinear();
+  // Linear only with the uniform look-up: its sphere has the whole area, so F = c d w.
+  linear_per_diameter = uniform ? uniform->linear_per_diameter() : 0.0;
+  half_step = linear_per_diameter > 0.0 ? HalfStep::Linear : HalfStep::General;
+  for (FixFluidDrag *drag : drags)
+    if (drag->smooth_nonlinear()) half_step = HalfStep::Blocked;
 }
 
-template <bool blocked, class Lookup> void FixNVESphereFluid::first_half(Lookup lookup)
+template <FixNVESphereFluid::HalfStep path, class Lookup> void FixNVESphereFluid::first_half(Lookup lookup)
 {
   const auto [x, v, f, omega, torque, radius, rmass, mask, nlocal] = sphere_arrays(atom);
   const double dt = update->dt;
   const double ftm2v = force->ftm2v;
   const double dtf = 0.5 * dt * ftm2v;
   static const double no_flow[3] = {0.0, 0.0, 0.0};
+  // Whether every state sum is finite: a local that no lambda captures, so that it stays in a
+  // register (captured by reference, it was read and written in memory for every atom).
   bool finite = true;
 
   // What follows the drag step of atom i: position, rotation, the weights for the second half
-  // (taken per unit mass and moment of inertia, so the second half divides by neither).
+  // (taken per unit mass and moment of inertia, so the second half divides by neither). Returns
+  // the sum of the new position and velocity.
   auto finish = [&](int i, const sediment::StepCorrection &corr, const double dx[3], double spin_rate,
                     double per_mass) {
     double *w = weights[i];
@@ -162,11 +169,9 @@ template <bool blocked, class Lookup> void FixNVESphereFluid::first_half(Lookup 
     w[ALONG] = corr.along * per_mass;
     w[ACROSS] = corr.across * per_mass;
     if (corr.along != corr.across) {    // the direction matters to the second half only then
-      w[DIRX] = corr.dir[0];
-      w[DIRY] = corr.dir[1];
-      w[DIRZ] = corr.dir[2];
+      std::copy(corr.dir, corr.dir + 3, &w[DIRX]);
     }
-    finite &= std::isfinite(state_sum(x[i], v[i]));
+    return state_sum(x[i], v[i]);
   };
 
   // Atoms under a smooth nonlinear law wait in a block: linearised one by one, then the block's
@@ -189,13 +194,15 @@ template <bool blocked, class Lookup> void FixNVESphereFluid::first_half(Lookup 
       block[n].along = sediment::phis(block[n].lin.z_along);
       block[n].across = sediment::phis(block[n].lin.z_across);
     }
+    bool block_finite = true;
     for (int n = 0; n < waiting; ++n) {
       const Waiting &b = block[n];
       double dx[3];
-      finish(b.i, sediment::smooth_advance(b.lin, b.along, b.across, b.a, b.flow, dt, v[b.i], dx), dx, b.spin_rate,
-             b.per_mass);
+      block_finite &= std::isfinite(finish(b.i, sediment::smooth_advance(b.lin, b.along, b.across, b.a, b.flow, dt,
+                                                                         v[b.i], dx), dx, b.spin_rate, b.per_mass));
     }
     waiting = 0;
+    return block_finite;
   };
 
   for (int i = 0; i < nlocal; ++i) {
@@ -205,7 +212,6 @@ template <bool blocked, class Lookup> void FixNVESphereFluid::first_half(Lookup 
     double spin_rate = 0.0;
     lookup(i, sphere, flow, spin_rate);
 
-    const double mass = rmass[i];
     double *w = weights[i];
     w[IN_FLUID] = sphere.model ? 1.0 : 0.0;
     if (!sphere.model) {
@@ -214,34 +220,46 @@ template <bool blocked, class Lookup> void FixNVESphereFluid::first_half(Lookup 
       continue;
     }
 
-    // Divisions dominate a cheap step: one for the forces and one for the torques, as fix nve/sphere.
-    const double per_mass = ftm2v / mass;
+    // Divisions dominate a cheap step: one for the forces and one for the torques, as fix nve/sphere
+    // (fix fluid requires coherent units: ftm2v = 1, so per_mass is also the drag step's 1 / m).
+    const double per_mass = ftm2v / rmass[i];
     const double a[3] = {f[i][0] * per_mass, f[i][1] * per_mass, f[i][2] * per_mass};
-    if (blocked && sediment::step_kind(sphere) == sediment::StepKind::Smooth) {
+    double dx[3];
+    if constexpr (path == HalfStep::Linear) {    // sphere.diameter * c, as the law's linear_coefficient
+      const double z = linear_per_diameter * sphere.diameter * per_mass * dt;
+      finite &= std::isfinite(finish(i, sediment::linear_step_initial(sediment::phis(z, &w[DRAG_MEMO]), a, flow, dt,
+                                                                      v[i], dx), dx, spin_rate, per_mass));
+      continue;
+    }
+    if (path == HalfStep::Blocked && sediment::step_kind(sphere) == sediment::StepKind::Smooth) {
       Waiting &b = block[waiting++];
       b.i = i;
-      b.lin = sediment::smooth_linearise(sphere, per_mass, a, flow, dt, v[i]);    // coherent units: ftm2v = 1
+      b.lin = sediment::smooth_linearise(sphere, per_mass, a, flow, dt, v[i]);
       std::copy(a, a + 3, b.a);
       b.flow = flow;
       b.spin_rate = spin_rate;
       b.per_mass = per_mass;
-      if (waiting == block_size) step_block();
+      if (waiting == block_size) finite &= step_block();
       continue;
     }
-    double dx[3];
-    finish(i, sediment::drag_step_initial(sphere, mass, a, flow, dt, v[i], dx, &w[DRAG_MEMO]), dx, spin_rate, per_mass);
+    finite &= std::isfinite(finish(i, sediment::drag_step_initial(sphere, per_mass, a, flow, dt, v[i], dx,
+                                                                  &w[DRAG_MEMO]), dx, spin_rate, per_mass));
   }
-  if (blocked) step_block();
+  if (path == HalfStep::Blocked) finite &= step_block();
   if (!finite) find_non_finite();
   settle_on_floor();
 }
 
 template <class Lookup> void FixNVESphereFluid::step_first_half(Lookup lookup)
 {
-  if (smooth_drag)
-    first_half<true>(lookup);
-  else
-    first_half<false>(lookup);
+  switch (half_step) {
+    case HalfStep::Blocked:
+      return first_half<HalfStep::Blocked>(lookup);
+    case HalfStep::Linear:
+      return first_half<HalfStep::Linear>(lookup);
+    case HalfStep::General:
+      return first_half<HalfStep::General>(lookup);
+  }
 }
 
 void FixNVESphereFluid::initial_integrate(int /*vflag*/)
@@ -317,9 +335,7 @@ void FixNVESphereFluid::final_integrate()
     corr.along = w[ALONG];
     corr.across = w[ACROSS];
     if (corr.along != corr.across) {    // written by the first half only then
-      corr.dir[0] = w[DIRX];
-      corr.dir[1] = w[DIRY];
-      corr.dir[2] = w[DIRZ];
+      std::copy(&w[DIRX], &w[DIRX] + 3, corr.dir);
     }
     sediment::drag_step_final(corr, f[i], v[i]);
     omega[i][0] += w[SPIN] * torque[i][0];

@@ -53,13 +53,18 @@ class FixNVESphereFluid : public Fix {
   // Set in setup() when there is one fluid/drag and it is uniform() (every atom of its group wholly
   // immersed, no rotational drag): the step then skips the per-atom region and surface look-ups.
   class FixFluidDrag *uniform;
-  // Set in setup() when some fluid/drag has a smooth nonlinear law: its atoms are then stepped in
-  // blocks (sediment::smooth_linearise); without one the loop keeps no block.
-  bool smooth_drag;
+  // How the first half steps the spheres in a fluid, decided in setup(): General (any law, one
+  // sphere at a time), Blocked (some fluid/drag has a smooth nonlinear law: its spheres are stepped
+  // in blocks, sediment::smooth_linearise) or Linear (the uniform drag is linear in the slip, F = c d w:
+  // c is taken once per run, and the step is sediment::linear_step_initial with no per-sphere
+  // choice of law).
+  enum class HalfStep { General, Blocked, Linear };
+  HalfStep half_step;
+  double linear_per_diameter;    // c of the Linear step
   // The first half of the step for every atom of the group, with the drag found by lookup(i, sphere,
-  // flow, spin_rate) (one loop for the general and the uniform look-up, compiled for each, with and
-  // without blocks; step_first_half picks by smooth_drag).
-  template <bool blocked, class Lookup> void first_half(Lookup lookup);
+  // flow, spin_rate) (one loop for the general and the uniform look-up, compiled for each way of
+  // stepping; step_first_half picks by half_step).
+  template <HalfStep path, class Lookup> void first_half(Lookup lookup);
   template <class Lookup> void step_first_half(Lookup lookup);
 
   int floor_axis;         // -1: no floor

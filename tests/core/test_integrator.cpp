@@ -30,7 +30,7 @@ void run(const SphereDrag &drag, double mass, const std::function<void(const dou
   accel(s.x, a);
   for (int n = 0; n < steps; ++n) {
     double dx[3];
-    const StepCorrection corr = drag_step_initial(drag, mass, a, flow, dt, s.v, dx);
+    const StepCorrection corr = drag_step_initial(drag, 1.0 / mass, a, flow, dt, s.v, dx);
     for (int k = 0; k < 3; ++k) s.x[k] += dx[k];
     accel(s.x, a);
     drag_step_final(corr, a, s.v);
@@ -312,7 +312,7 @@ static double spring_amplitude(double omega, double rate, double dt, int steps)
   double x = 1.0, v[3] = {0.0, 0.0, 0.0}, largest = 0.0;
   for (int n = 0; n < steps; ++n) {
     double a[3] = {-omega * omega * x, 0.0, 0.0}, dx[3];
-    const StepCorrection corr = drag_step_initial(drag, mass, a, u, dt, v, dx);
+    const StepCorrection corr = drag_step_initial(drag, 1.0 / mass, a, u, dt, v, dx);
     x += dx[0];
     a[0] = -omega * omega * x;
     drag_step_final(corr, a, v);

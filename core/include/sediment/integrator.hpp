@@ -137,8 +137,8 @@ inline StepCorrection smooth_advance(const SmoothLinearisation &lin, const Phi &
 }
 
 // Both parts for one sphere (out of line, like the next).
-StepCorrection smooth_step_initial(const SphereDrag &drag, double mass, const double a[3], const double u[3],
-                                   double dt, double v[3], double dx[3]);
+StepCorrection smooth_step_initial(const SphereDrag &drag, double inverse_mass, const double a[3],
+                                   const double u[3], double dt, double v[3], double dx[3]);
 
 // drag_step_initial for a law with set-valued points (a yield stress or a Cd jump): Newton
 // linearisation, advanced piecewise between the points (out of line).
@@ -147,42 +147,22 @@ StepCorrection set_valued_step_initial(const SphereDrag &drag, double mass, cons
 
 // Which step a sphere's drag takes.
 enum class StepKind { Free, Linear, Smooth, SetValued };
+inline bool drag_acts(const SphereDrag &drag)
+{
+  return drag.model != nullptr && (drag.scale.area > 0.0 || drag.scale.wetted > 0.0);
+}
 inline StepKind step_kind(const SphereDrag &drag)
 {
-  if (drag.model == nullptr || (drag.scale.area <= 0.0 && drag.scale.wetted <= 0.0)) return StepKind::Free;
+  if (!drag_acts(drag)) return StepKind::Free;
   if (drag.model->linear_coefficient(drag.diameter, drag.scale) > 0.0) return StepKind::Linear;
   return drag.model->smooth() ? StepKind::Smooth : StepKind::SetValued;
 }
 
-// First half: advances x by dx and replaces v with the mid-step velocity, given the non-drag
-// acceleration a_n = f_n / m and the uniform fluid velocity u. A memo (see phis) saves the
-// exponential of a linear drag from step to step. Inline: the per-atom loops of the integrator
-// take the linear and no-drag cases without a call.
-inline StepCorrection drag_step_initial(const SphereDrag &drag, double mass, const double a[3],
-                                        const double u[3], double dt, double v[3], double dx[3],
-                                        double *memo = nullptr)
+// Drag linear in the slip, F = c w: the step with equal rates along and across the slip and no
+// set-valued points, in closed form, given p = phis(c dt / m).
+inline StepCorrection linear_step_initial(const Phi &p, const double a[3], const double u[3], double dt, double v[3],
+                                          double dx[3])
 {
-  StepCorrection corr;
-  switch (step_kind(drag)) {
-    case StepKind::Free:
-      for (int k = 0; k < 3; ++k) {
-        v[k] += 0.5 * dt * a[k];
-        dx[k] = dt * v[k];
-      }
-      corr.along = corr.across = 0.5 * dt;
-      return corr;
-    case StepKind::Smooth:
-      return smooth_step_initial(drag, mass, a, u, dt, v, dx);
-    case StepKind::SetValued:
-      return set_valued_step_initial(drag, mass, a, u, dt, v, dx);
-    case StepKind::Linear:
-      break;
-  }
-  // Drag linear in the slip: the same step with equal rates along and across the slip and no
-  // set-valued points, in closed form.
-  const double linear = drag.model->linear_coefficient(drag.diameter, drag.scale);
-  const double z = linear / mass * dt;
-  const Phi p = memo ? phis(z, memo) : phis(z);
   // Copies first: the stores into v could alias u or a, which would then be read anew each time.
   const double flow[3] = {u[0], u[1], u[2]}, accel[3] = {a[0], a[1], a[2]};
   const double slip[3] = {v[0] - flow[0], v[1] - flow[1], v[2] - flow[2]};
@@ -191,8 +171,37 @@ inline StepCorrection drag_step_initial(const SphereDrag &drag, double mass, con
     v[k] = flow[k] + slip[k] * p.decay + weight_now * accel[k];
     dx[k] = dt * (flow[k] + p.phi1 * slip[k] + weight_drift * accel[k]);
   }
+  StepCorrection corr;
   corr.along = corr.across = weight_drift;
   return corr;
+}
+
+// First half: advances x by dx and replaces v with the mid-step velocity, given the non-drag
+// acceleration a_n = f_n / m, 1 / m and the uniform fluid velocity u. A memo (see phis) saves the
+// exponential of a linear drag from step to step. Inline: the per-atom loops of the integrator
+// take the linear and no-drag cases without a call, and without a division (1 / m is shared with
+// the caller's a_n).
+inline StepCorrection drag_step_initial(const SphereDrag &drag, double inverse_mass, const double a[3],
+                                        const double u[3], double dt, double v[3], double dx[3],
+                                        double *memo = nullptr)
+{
+  if (!drag_acts(drag)) {
+    for (int k = 0; k < 3; ++k) {
+      v[k] += 0.5 * dt * a[k];
+      dx[k] = dt * v[k];
+    }
+    StepCorrection corr;
+    corr.along = corr.across = 0.5 * dt;
+    return corr;
+  }
+  // The law's linear coefficient taken once: it also tells the kind of step (step_kind).
+  const double linear = drag.model->linear_coefficient(drag.diameter, drag.scale);
+  if (!(linear > 0.0)) {
+    if (drag.model->smooth()) return smooth_step_initial(drag, inverse_mass, a, u, dt, v, dx);
+    return set_valued_step_initial(drag, 1.0 / inverse_mass, a, u, dt, v, dx);
+  }
+  const double z = linear * inverse_mass * dt;
+  return linear_step_initial(memo ? phis(z, memo) : phis(z), a, u, dt, v, dx);
 }
 
 // Second half: adds the weighted acceleration a_{n+1} = f_{n+1} / m.
