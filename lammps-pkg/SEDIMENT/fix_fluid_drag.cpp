@@ -189,6 +189,29 @@ void FixFluidDrag::post_force(int /*vflag*/)
   if (all_implicit) return;    // fix nve/sphere/fluid takes the drag of every atom into its step
   // Local sums: a store into the fix inside the loop would alias the force array.
   double sum[3] = {0.0, 0.0, 0.0};
+  auto pull = [&](int i, double coeff, const double *slip) {
+    for (int k = 0; k < 3; ++k) {
+      f[i][k] -= coeff * slip[k];
+      sum[k] -= coeff * slip[k];
+    }
+  };
+  if (const double per_diameter = linear_per_diameter(); per_diameter > 0.0 && uniform()) {
+    // Stokes drag on wholly immersed spheres: F = c d w with c taken once (bit for bit the law's
+    // linear_coefficient), without the per-sphere look-ups of the general loop.
+    prepare_step();
+    double **v = atom->v;
+    const double *radius = atom->radius;
+    const int *mask = atom->mask;
+    const double *flow = fluid->velocity();
+    const double u[3] = {flow[0], flow[1], flow[2]};
+    for (int i = 0; i < atom->nlocal; ++i) {
+      if (!(mask[i] & groupbit) || (mask[i] & implicit_groupbit)) continue;
+      const double slip[3] = {v[i][0] - u[0], v[i][1] - u[1], v[i][2] - u[2]};
+      pull(i, per_diameter * (2.0 * radius[i]), slip);
+    }
+    for (int k = 0; k < 3; ++k) totals[k] = sum[k];
+    return;
+  }
   for_each_explicit([&](int i, const sediment::SphereDrag &drag, const double *slip) {
     if (!drag.model) {
       totals[OUTSIDE] += 1.0;
@@ -197,14 +220,9 @@ void FixFluidDrag::post_force(int /*vflag*/)
     if (fraction_capped(i)) totals[CAPPED] += 1.0;
     const double linear = model->linear_coefficient(drag.diameter, drag.scale);
     const double speed = linear > 0.0 ? 0.0 : norm(slip);
-    if (linear > 0.0 || speed > 0.0) {
-      // Explicit: the yield part acts only while moving, so a yield-stress fluid chatters here.
-      const double coeff = linear > 0.0 ? linear : model->force(drag.diameter, speed, drag.scale) / speed;
-      for (int k = 0; k < 3; ++k) {
-        f[i][k] -= coeff * slip[k];
-        sum[k] -= coeff * slip[k];
-      }
-    }
+    // Explicit: the yield part acts only while moving, so a yield-stress fluid chatters here.
+    if (linear > 0.0 || speed > 0.0)
+      pull(i, linear > 0.0 ? linear : model->force(drag.diameter, speed, drag.scale) / speed, slip);
     const double rate = rotation_rate(i, drag);
     if (rate > 0.0) {
       const double inertia = sediment::sphere_inertia(atom->rmass[i], atom->radius[i]);

@@ -50,6 +50,7 @@ class FixFluidDrag : public Fix {
   bool smooth_nonlinear() const { return model->smooth() && !(linear_per_diameter() > 0.0); }
   // c when the drag of a wholly immersed sphere of diameter d is F = c d w, else 0.
   double linear_per_diameter() const { return model->linear_coefficient(1.0); }
+  const sediment::DragModel *drag_model() const { return model.get(); }
   // The drag on local atom i of the group when uniform(): its diameter and local fraction only.
   sediment::SphereDrag immersed_drag(int i) const;
 

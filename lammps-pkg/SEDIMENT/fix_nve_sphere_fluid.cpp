@@ -60,9 +60,8 @@ static inline SphereArrays sphere_arrays(const Atom *atom)
   return {atom->x, atom->v, atom->f, atom->omega, atom->torque, atom->radius, atom->rmass, atom->mask, atom->nlocal};
 }
 
-// The first half of fix nve/sphere's step: kick, then drift over the whole step. Returns the sum
-// of the new position and velocity (the finite-state check), taken from registers.
-static inline double nve_sphere_kick_drift(double *x, double *v, double *omega, const double *f,
+// The first half of fix nve/sphere's step: kick, then drift over the whole step.
+static inline void nve_sphere_kick_drift(double *x, double *v, double *omega, const double *f,
                                            const double *torque, double radius, double rmass, double dtf, double dt)
 {
   const auto [v0, v1, v2] = nve_sphere_kick(v, omega, f, torque, radius, rmass, dtf);
@@ -70,7 +69,6 @@ static inline double nve_sphere_kick_drift(double *x, double *v, double *omega, 
   x[0] = x0;
   x[1] = x1;
   x[2] = x2;
-  return x0 + x1 + x2 + v0 + v1 + v2;
 }
 
 FixNVESphereFluid::FixNVESphereFluid(LAMMPS *lmp, int narg, char **arg) :
@@ -133,7 +131,7 @@ void FixNVESphereFluid::setup(int /*vflag*/)
 {
   // After every fix's init(): the drag fixes know their fluid only then.
   uniform = drags.size() == 1 && drags.front()->uniform() ? drags.front() : nullptr;
-  // Linear only with the uniform look-up: its sphere has the whole area, so F = c d w.
+  // Linear only with a uniform drag: its spheres are wholly immersed, so F = c d w.
   linear_per_diameter = uniform ? uniform->linear_per_diameter() : 0.0;
   half_step = linear_per_diameter > 0.0 ? HalfStep::Linear : HalfStep::General;
   for (FixFluidDrag *drag : drags)
@@ -147,13 +145,8 @@ template <FixNVESphereFluid::HalfStep path, class Lookup> void FixNVESphereFluid
   const double ftm2v = force->ftm2v;
   const double dtf = 0.5 * dt * ftm2v;
   static const double no_flow[3] = {0.0, 0.0, 0.0};
-  // Whether every state sum is finite: a local that no lambda captures, so that it stays in a
-  // register (captured by reference, it was read and written in memory for every atom).
-  bool finite = true;
-
   // What follows the drag step of atom i: position, rotation, the weights for the second half
-  // (taken per unit mass and moment of inertia, so the second half divides by neither). Returns
-  // the sum of the new position and velocity.
+  // (taken per unit mass and moment of inertia, so the second half divides by neither).
   auto finish = [&](int i, const sediment::StepCorrection &corr, const double dx[3], double spin_rate,
                     double per_mass) {
     double *w = weights[i];
@@ -171,7 +164,6 @@ template <FixNVESphereFluid::HalfStep path, class Lookup> void FixNVESphereFluid
     if (corr.along != corr.across) {    // the direction matters to the second half only then
       std::copy(corr.dir, corr.dir + 3, &w[DIRX]);
     }
-    return state_sum(x[i], v[i]);
   };
 
   // Atoms under a smooth nonlinear law wait in a block: linearised one by one, then the block's
@@ -194,15 +186,13 @@ template <FixNVESphereFluid::HalfStep path, class Lookup> void FixNVESphereFluid
       block[n].along = sediment::phis(block[n].lin.z_along);
       block[n].across = sediment::phis(block[n].lin.z_across);
     }
-    bool block_finite = true;
     for (int n = 0; n < waiting; ++n) {
       const Waiting &b = block[n];
       double dx[3];
-      block_finite &= std::isfinite(finish(b.i, sediment::smooth_advance(b.lin, b.along, b.across, b.a, b.flow, dt,
-                                                                         v[b.i], dx), dx, b.spin_rate, b.per_mass));
+      finish(b.i, sediment::smooth_advance(b.lin, b.along, b.across, b.a, b.flow, dt, v[b.i], dx), dx, b.spin_rate,
+             b.per_mass);
     }
     waiting = 0;
-    return block_finite;
   };
 
   for (int i = 0; i < nlocal; ++i) {
@@ -216,7 +206,7 @@ template <FixNVESphereFluid::HalfStep path, class Lookup> void FixNVESphereFluid
     w[IN_FLUID] = sphere.model ? 1.0 : 0.0;
     if (!sphere.model) {
       counts[OUTSIDE] += 1.0;
-      finite &= std::isfinite(nve_sphere_kick_drift(x[i], v[i], omega[i], f[i], torque[i], radius[i], rmass[i], dtf, dt));
+      nve_sphere_kick_drift(x[i], v[i], omega[i], f[i], torque[i], radius[i], rmass[i], dtf, dt);
       continue;
     }
 
@@ -227,8 +217,8 @@ template <FixNVESphereFluid::HalfStep path, class Lookup> void FixNVESphereFluid
     double dx[3];
     if constexpr (path == HalfStep::Linear) {    // sphere.diameter * c, as the law's linear_coefficient
       const double z = linear_per_diameter * sphere.diameter * per_mass * dt;
-      finite &= std::isfinite(finish(i, sediment::linear_step_initial(sediment::phis(z, &w[DRAG_MEMO]), a, flow, dt,
-                                                                      v[i], dx), dx, spin_rate, per_mass));
+      finish(i, sediment::linear_step_initial(sediment::phis(z, &w[DRAG_MEMO]), a, flow, dt, v[i], dx), dx,
+             spin_rate, per_mass);
       continue;
     }
     if (path == HalfStep::Blocked && sediment::step_kind(sphere) == sediment::StepKind::Smooth) {
@@ -239,27 +229,24 @@ template <FixNVESphereFluid::HalfStep path, class Lookup> void FixNVESphereFluid
       b.flow = flow;
       b.spin_rate = spin_rate;
       b.per_mass = per_mass;
-      if (waiting == block_size) finite &= step_block();
+      if (waiting == block_size) step_block();
       continue;
     }
-    finite &= std::isfinite(finish(i, sediment::drag_step_initial(sphere, per_mass, a, flow, dt, v[i], dx,
-                                                                  &w[DRAG_MEMO]), dx, spin_rate, per_mass));
+    finish(i, sediment::drag_step_initial(sphere, per_mass, a, flow, dt, v[i], dx, &w[DRAG_MEMO]), dx, spin_rate,
+           per_mass);
   }
-  if (path == HalfStep::Blocked) finite &= step_block();
-  if (!finite) find_non_finite();
+  if (path == HalfStep::Blocked) step_block();
+  check_finite();
   settle_on_floor();
 }
 
 template <class Lookup> void FixNVESphereFluid::step_first_half(Lookup lookup)
 {
-  switch (half_step) {
-    case HalfStep::Blocked:
-      return first_half<HalfStep::Blocked>(lookup);
-    case HalfStep::Linear:
-      return first_half<HalfStep::Linear>(lookup);
-    case HalfStep::General:
-      return first_half<HalfStep::General>(lookup);
-  }
+  // Linear is taken by initial_integrate with its own look-up.
+  if (half_step == HalfStep::Blocked)
+    first_half<HalfStep::Blocked>(lookup);
+  else
+    first_half<HalfStep::General>(lookup);
 }
 
 void FixNVESphereFluid::initial_integrate(int /*vflag*/)
@@ -272,14 +259,13 @@ void FixNVESphereFluid::initial_integrate(int /*vflag*/)
     const double dt = update->dt;
     const double dtf = 0.5 * dt * force->ftm2v;
     int outside = 0;    // a local count: a store into the fix would alias the atom arrays
-    bool finite = true;    // a flag, not a running sum: no chain of dependent additions
     for (int i = 0; i < nlocal; ++i)
       if (mask[i] & groupbit) {
-        finite &= std::isfinite(nve_sphere_kick_drift(x[i], v[i], omega[i], f[i], torque[i], radius[i], rmass[i], dtf, dt));
+        nve_sphere_kick_drift(x[i], v[i], omega[i], f[i], torque[i], radius[i], rmass[i], dtf, dt);
         ++outside;
       }
     counts[OUTSIDE] = outside;
-    if (!finite) find_non_finite();
+    check_finite();
     settle_on_floor();
     return;
   }
@@ -288,6 +274,17 @@ void FixNVESphereFluid::initial_integrate(int /*vflag*/)
     const int *mask = atom->mask;
     const int drag_bit = drag->groupbit;
     const double *flow = drag->fluid_fix()->velocity();
+    if (half_step == HalfStep::Linear) {    // a linear law has no local fraction: the diameter is all it needs
+      const double *radius = atom->radius;
+      const sediment::DragModel *model = drag->drag_model();
+      first_half<HalfStep::Linear>([&](int i, sediment::SphereDrag &sphere, const double *&u, double &) {
+        if (!(mask[i] & drag_bit)) return;
+        sphere.model = model;
+        sphere.diameter = 2.0 * radius[i];
+        u = flow;
+      });
+      return;
+    }
     step_first_half([&](int i, sediment::SphereDrag &sphere, const double *&u, double &) {
       if (!(mask[i] & drag_bit)) return;
       sphere = drag->immersed_drag(i);
@@ -337,18 +334,37 @@ void FixNVESphereFluid::final_integrate()
     if (corr.along != corr.across) {    // written by the first half only then
       std::copy(&w[DIRX], &w[DIRX] + 3, corr.dir);
     }
+    const double spin = w[SPIN];    // read once: the stores into v and omega could alias w
     sediment::drag_step_final(corr, f[i], v[i]);
-    omega[i][0] += w[SPIN] * torque[i][0];
-    omega[i][1] += w[SPIN] * torque[i][1];
-    omega[i][2] += w[SPIN] * torque[i][2];
+    omega[i][0] += spin * torque[i][0];
+    omega[i][1] += spin * torque[i][1];
+    omega[i][2] += spin * torque[i][2];
   }
   settle_on_floor();
 }
 
+void FixNVESphereFluid::check_finite() const
+{
+  // One pass over the positions and velocities of all local atoms, which LAMMPS keeps in two
+  // contiguous blocks of 3 nlocal values, with four independent partial sums (NaN and inf
+  // survive a sum): a few additions per atom, instead of a chain of them at the end of each
+  // atom's step.
+  const int n = 3 * atom->nlocal;
+  if (n == 0) return;
+  const double *x = atom->x[0], *v = atom->v[0];
+  double sums[4] = {0.0, 0.0, 0.0, 0.0};
+  int j = 0;
+  for (; j + 4 <= n; j += 4)
+    for (int k = 0; k < 4; ++k) sums[k] += x[j + k] + v[j + k];
+  for (; j < n; ++j) sums[0] += x[j] + v[j];
+  if (!std::isfinite((sums[0] + sums[1]) + (sums[2] + sums[3]))) find_non_finite();
+}
+
 void FixNVESphereFluid::find_non_finite() const
 {
-  // Some atom's state sum is not finite: name the first such atom (a sum of finite values can
-  // overflow; then none is named and the run goes on).
+  // Some state sum is not finite: name the first atom of the group whose own sum is not (a sum
+  // of finite values can overflow, and an atom outside the group is not this fix's to name;
+  // then none is named and the run goes on).
   const int *mask = atom->mask;
   for (int i = 0; i < atom->nlocal; ++i) {
     if (!(mask[i] & groupbit) || std::isfinite(state_sum(atom->x[i], atom->v[i]))) continue;

@@ -79,7 +79,8 @@ class FixNVESphereFluid : public Fix {
   // the sum of each atom's position and velocity (NaN and inf survive a sum) and stops at the
   // first bad atom, before the forces and grids of the step see it.
   static double state_sum(const double *x, const double *v) { return x[0] + x[1] + x[2] + v[0] + v[1] + v[2]; }
-  void find_non_finite() const;
+  void check_finite() const;       // after the first half: stops at a NaN or inf state
+  void find_non_finite() const;    // names the atom
 };
 
 }    // namespace LAMMPS_NS
