@@ -8,13 +8,15 @@ Each scene runs `repeats` times, the scenes taking turns (so that a drift of the
 during the run touches every scene alike); the best loop time is kept. LAMMPS reports the loop
 time, which excludes start-up. With --baseline (another lmp_sediment, e.g. a build of an earlier
 commit) every scene also runs with it, the two taking turns scene by scene, and the table gains
-the ratio this build / baseline: on a machine whose speed drifts by 10 % between runs, the way to
-measure one change.
+the ratio this build / baseline, as the ratio of the best times and as the median of the ratios of
+back-to-back pairs (robust to the machine's drift during the run): on a machine whose speed drifts
+by 10 % between runs, the way to measure one change.
 """
 from __future__ import annotations
 
 import argparse
 import os
+import statistics
 import sys
 from pathlib import Path
 
@@ -76,18 +78,23 @@ def main() -> None:
     scenes = {s: SCENES[s] for s in SCENES if s in args.scenes or s in ("plain", "peer")}
     times = {s: float("inf") for s in scenes}
     baseline = {s: float("inf") for s in scenes}
+    pair_ratios: dict[str, list[float]] = {s: [] for s in scenes}
     for _ in range(args.repeats):
         for s in scenes:
-            times[s] = min(times[s], loop_time(s, args.particles, args.steps))
+            mine = loop_time(s, args.particles, args.steps)
+            times[s] = min(times[s], mine)
             if args.baseline:
-                baseline[s] = min(baseline[s], loop_time(s, args.particles, args.steps, args.baseline))
+                theirs = loop_time(s, args.particles, args.steps, args.baseline)
+                baseline[s] = min(baseline[s], theirs)
+                pair_ratios[s].append(mine / theirs)
     per = {s: t / (args.particles * args.steps) * 1e9 for s, t in times.items()}
     print(f"{args.particles} particles x {args.steps} steps, best of {args.repeats}, 1 rank")
-    against = f" {'baseline ns':>12s} {'this/baseline':>14s}" if args.baseline else ""
+    against = f" {'baseline ns':>12s} {'this/baseline':>14s} {'median of pairs':>16s}" if args.baseline else ""
     print(f"{'scene':10s} {'ns/particle-step':>17s} {'ratio to plain':>15s}{against}  what")
     for s, what in scenes.items():
         other = baseline[s] / (args.particles * args.steps) * 1e9
-        against = f" {other:12.2f} {times[s] / baseline[s]:14.3f}" if args.baseline else ""
+        against = (f" {other:12.2f} {times[s] / baseline[s]:14.3f} {statistics.median(pair_ratios[s]):16.3f}"
+                   if args.baseline else "")
         print(f"{s:10s} {per[s]:17.2f} {per[s] / per['plain']:15.2f}{against}  {what}")
     if args.baseline:
         print(f"baseline: {args.baseline}; the peer and plain scenes run the same code in both builds, so "
