@@ -32,7 +32,7 @@ constexpr bigint max_grid_values = 200000000;
 
 ComputeConcentrationGrid::ComputeConcentrationGrid(LAMMPS *lmp, int narg, char **arg) :
     Compute(lmp, narg, arg), axis(-1), counts{0, 0, 0}, has_bounds(0), bounds{}, ncentres(0), by_type(0),
-    thickness(0.0), smooth_width(0.0), weight_index(-1), ncols(1), grid{}, cell_volume(1.0), profiled_step(-1),
+    thickness(0.0), smooth_width(0.0), weight_index(-1), every(1), ncols(1), grid{}, cell_volume(1.0), profiled_step(-1),
     nmax(0)
 {
   const int dimension = domain->dimension;
@@ -81,8 +81,11 @@ ComputeConcentrationGrid::ComputeConcentrationGrid(LAMMPS *lmp, int narg, char *
       if (!args.has(1) || strncmp(args.text(1), "d_", 2) != 0 || !args.text(1)[2])
         args.fail("'weight' needs a per-atom property d_NAME (fix property/atom d_NAME)");
       weight_name = args.text(1) + 2;
+    } else if (args.is("every")) {
+      args.need(1, "a number of steps");
+      every = args.count(1, MAXSMALLINT);
     } else {
-      args.unknown("layers, cells, bounds, classes, types, thickness, smooth or weight");
+      args.unknown("layers, cells, bounds, classes, types, thickness, smooth, weight or every");
     }
     args.next(nvalues);
   }
@@ -245,7 +248,10 @@ void ComputeConcentrationGrid::compute_array()
 void ComputeConcentrationGrid::compute_peratom()
 {
   invoked_peratom = update->ntimestep;
-  profile();
+  // The field the per-atom values are read from is refreshed every `every` steps (and at the start
+  // of a run, or when the step number went back); the values themselves follow the atoms each step.
+  const bigint step = update->ntimestep;
+  if (profiled_step < 0 || step < profiled_step || step - profiled_step >= every) profile();
   if (atom->nmax > nmax) {
     memory->destroy(vector_atom);
     nmax = atom->nmax;

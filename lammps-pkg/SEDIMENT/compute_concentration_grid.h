@@ -58,6 +58,7 @@ class ComputeConcentrationGrid : public Compute {
   double smooth_width;                // 0: no smoothing
   std::string weight_name;            // per-atom property: real spheres each atom stands for
   int weight_index;
+  int every;                          // steps between refreshes of the field behind the per-atom values
   int ncols;                          // fraction columns: total, classes, types
 
   sediment::Grid grid;

@@ -643,6 +643,66 @@ def hindered_settling(np_ranks: int):
         assert rel < 1e-10
 
 
+@check
+def concentration_every(np_ranks: int):
+    # With 'every N' the per-atom fractions follow the atoms every step but read the field of the
+    # last refresh: on refresh steps they equal a run refreshing every step, in between they are the
+    # last refresh's profile interpolated at the atoms' current heights.
+    with tempfile.TemporaryDirectory() as tmp:
+        files = {n: {k: Path(tmp) / f"{k}{n}.txt" for k in ("profile", "peratom")} for n in (1, 5)}
+        for every, paths in files.items():
+            run_deck("concentration_every.lmp", {"every": every, **paths}, np_ranks)
+        frames = {n: read_dump_frames(files[n]["peratom"]) for n in files}
+        profiles = read_profile_blocks(files[5]["profile"])
+    stale = 0.0
+    for step, atoms in frames[5].items():
+        fresh = frames[1][step]
+        if step % 5 == 0:
+            assert np.array_equal(atoms[:, 2], fresh[:, 2]), f"step {step}: a refresh step differs from every 1"
+            continue
+        z, total = profiles[step - step % 5]
+        # the field is periodic along z: interpolate across the ends as the compute does
+        period = 0.02
+        zz = np.concatenate([z - period, z, z + period])
+        expected = np.interp(atoms[:, 1], zz, np.tile(total, 3))
+        assert np.allclose(atoms[:, 2], expected, rtol=1e-12, atol=1e-15), f"step {step}: not the step {step - step % 5} field"
+        stale = max(stale, float(np.max(np.abs(atoms[:, 2] - fresh[:, 2]))))
+    report(f"concentration grid every 5: refresh steps equal to every 1; in between the last field at the new "
+           f"heights, differing from a fresh field by up to {stale:.2e}")
+    assert stale > 0.0    # the spheres move: a field refreshed every step would differ
+
+
+def read_dump_frames(path: Path) -> dict[int, np.ndarray]:
+    """The frames of a LAMMPS text dump (columns after the header) by step."""
+    lines = path.read_text().splitlines()
+    frames, k = {}, 0
+    while k < len(lines):
+        step = int(lines[k + 1])
+        count = int(lines[k + 3])
+        start = k + 9
+        frames[step] = np.array([[float(v) for v in line.split()] for line in lines[start:start + count]])
+        k = start + count
+    return frames
+
+
+def read_profile_blocks(path: Path) -> dict[int, tuple[np.ndarray, np.ndarray]]:
+    """Layer centres and total fraction of each block of a fix ave/time vector file, by step."""
+    blocks, rows, step, left = {}, [], None, 0
+    for line in path.read_text().splitlines():
+        if line.startswith("#") or not line.strip():
+            continue
+        values = line.split()
+        if left == 0:
+            step, left, rows = int(values[0]), int(values[1]), []
+            continue
+        rows.append([float(v) for v in values[1:3]])
+        left -= 1
+        if left == 0:
+            table = np.array(rows)
+            blocks[step] = (table[:, 0], table[:, 1])
+    return blocks
+
+
 # ---- layer files -------------------------------------------------------------------------------
 EXAMPLES = HERE.parents[1] / "examples"
 
@@ -863,6 +923,8 @@ BAD_INPUT = [
     ("compute c all concentration/grid layers z 10 thickness 1", "'thickness' is for 2d simulations only"),
     ("compute c all concentration/grid layers z 10 smooth -1", "smooth width must be finite and > 0"),
     ("compute c all concentration/grid layers z 10 sieve 3", "unknown keyword 'sieve'"),
+    ("compute c all concentration/grid layers z 10 every 0", "every count 0 must be from 1 to"),
+    ("compute c all concentration/grid layers z 10 every 2.5", "Expected integer"),
     ("compute c all concentration/grid layers z 10 weight w", "'weight' needs a per-atom property d_NAME"),
     ("compute c all concentration/grid layers z 10 weight d_w\nrun 0", "weight d_w is not a per-atom floating-point vector"),
     ("fix l all layers/hdf5 0 a.h5 c_c", "N must be > 0"),

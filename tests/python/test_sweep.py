@@ -115,3 +115,13 @@ def test_readout_curves_of_a_scene_barely_move_with_the_step(tmp_path):
     assert planned.error == 0.0 and len(planned.observations["hydrometer"].x) >= 5
     assert 0 < coarse.error < 0.02     # two percentage points
     assert coarse.loop_seconds < planned.loop_seconds
+
+
+def test_whole_values_reach_the_deck_as_integers():
+    # A deck variable read as an integer (compute concentration/grid every ${field_every}) must get
+    # "10", not "10.0"; other values go exactly.
+    assert sweep.deck_number(10.0) == "10"
+    assert sweep.deck_number(1.0) == "1"
+    assert sweep.deck_number(0.001) == "0.001"
+    assert sweep.deck_number(2.5) == "2.5"
+    assert float(sweep.deck_number(1e300)) == 1e300

@@ -438,6 +438,7 @@ def _deck(scene: Scene, data: str, layer_file: str) -> str:
         "variable        overwrite index no    # yes: replace a layer file of another run (sediment run --force)",
         f"variable        t_end equal {scene.t_end:.12g}",
         "variable        dt_scale index 1    # multiplies every stage's time step (sediment sweep ... --parameter dt_scale)",
+        "variable        field_every index 1    # steps between refreshes of the concentration field the hindered drag reads",
         "variable        resume index no     # yes: start from ${restart_file} (sediment run --resume)",
         "variable        restart_file index restart.a.bin",
         "",
@@ -460,7 +461,7 @@ def _deck(scene: Scene, data: str, layer_file: str) -> str:
         f"fix             water all fluid density {f.fluid_density:.12g} viscosity {f.viscosity:.12g}",
         "fix             buoy all fluid/buoyancy water",
         f"compute         conc all concentration/grid layers {up} {scene.layers} bounds 0 {scene.height:.12g}"
-        f"{f' thickness {scene.thickness:.12g}' if slab else ''} weight d_weight",
+        f"{f' thickness {scene.thickness:.12g}' if slab else ''} weight d_weight every ${{field_every}}",
     ]
     if e.hindered:
         lines.append("fix             drag all fluid/drag water law difelice concentration c_conc")

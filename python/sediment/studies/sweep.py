@@ -217,6 +217,12 @@ def relative_error(run: Observation, ref: Observation, log_x: bool = False) -> f
     return float(np.max(np.abs(run.y[inside] - expected)) / (scale if scale > 0 else 1.0))
 
 
+def deck_number(value: float) -> str:
+    """The value as a LAMMPS -var: whole numbers without a decimal point, so that a variable a style
+    reads as an integer (a refresh interval, a count) takes them; others exactly (repr)."""
+    return str(int(value)) if float(value).is_integer() and abs(value) < 2**53 else repr(value)
+
+
 def run_sweep(deck: Path, values: list[float], observables: list[str], integrators: list[str] | None = None,
               parameter: str = "dt", references: dict[str, str] | None = None,
               variables: dict[str, object] | None = None, ranks: int = 1, work_dir: Path | None = None,
@@ -278,7 +284,7 @@ def run_sweep(deck: Path, values: list[float], observables: list[str], integrato
         plan_iter = plan
     runs = []
     for integrator, value in plan_iter:
-        run_vars = dict(variables or {}, **{parameter: repr(value)})
+        run_vars = dict(variables or {}, **{parameter: deck_number(value)})
         if integrator:
             run_vars["integrator"] = INTEGRATORS[integrator]
         layers_file = None
