@@ -145,6 +145,7 @@ template <FixNVESphereFluid::HalfStep path, class Lookup> void FixNVESphereFluid
   const double ftm2v = force->ftm2v;
   const double dtf = 0.5 * dt * ftm2v;
   static const double no_flow[3] = {0.0, 0.0, 0.0};
+
   // What follows the drag step of atom i: position, rotation, the weights for the second half
   // (taken per unit mass and moment of inertia, so the second half divides by neither).
   auto finish = [&](int i, const sediment::StepCorrection &corr, const double dx[3], double spin_rate,

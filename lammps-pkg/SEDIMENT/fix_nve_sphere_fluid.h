@@ -62,8 +62,8 @@ class FixNVESphereFluid : public Fix {
   HalfStep half_step;
   double linear_per_diameter;    // c of the Linear step
   // The first half of the step for every atom of the group, with the drag found by lookup(i, sphere,
-  // flow, spin_rate) (one loop for the general and the uniform look-up, compiled for each way of
-  // stepping; step_first_half picks by half_step).
+  // flow, spin_rate) (one loop, compiled for each look-up and way of stepping: step_first_half picks
+  // General or Blocked, initial_integrate takes Linear with a look-up of the diameter only).
   template <HalfStep path, class Lookup> void first_half(Lookup lookup);
   template <class Lookup> void step_first_half(Lookup lookup);
 
@@ -75,9 +75,9 @@ class FixNVESphereFluid : public Fix {
   // Cd jump, outside every fluid, and with their local solid fraction capped (hindered drag).
   enum { STUCK, AT_JUMP, OUTSIDE, CAPPED, NCOUNTS };
   RankSums<NCOUNTS> counts;
-  // A NaN or inf spreads through contacts and grids without a trace: the first half-step checks
-  // the sum of each atom's position and velocity (NaN and inf survive a sum) and stops at the
-  // first bad atom, before the forces and grids of the step see it.
+  // A NaN or inf spreads through contacts and grids without a trace: after the first half-step
+  // the sum of all positions and velocities is checked (NaN and inf survive a sum), and the run
+  // stops at the first atom whose own sum is not finite, before the forces and grids see it.
   static double state_sum(const double *x, const double *v) { return x[0] + x[1] + x[2] + v[0] + v[1] + v[2]; }
   void check_finite() const;       // after the first half: stops at a NaN or inf state
   void find_non_finite() const;    // names the atom
