@@ -62,7 +62,7 @@ static inline SphereArrays sphere_arrays(const Atom *atom)
 
 // The first half of fix nve/sphere's step: kick, then drift over the whole step.
 static inline void nve_sphere_kick_drift(double *x, double *v, double *omega, const double *f,
-                                           const double *torque, double radius, double rmass, double dtf, double dt)
+                                         const double *torque, double radius, double rmass, double dtf, double dt)
 {
   const auto [v0, v1, v2] = nve_sphere_kick(v, omega, f, torque, radius, rmass, dtf);
   const double x0 = x[0] + dt * v0, x1 = x[1] + dt * v1, x2 = x[2] + dt * v2;
