@@ -7,10 +7,12 @@ import json
 import math
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from sediment import cli
 from sediment.lab.psd import read_psd
+from sediment.planner.contacts import ReducedScene, coarse_part, measure_contacts
 from sediment.planner.plan import plan_effects
 from sediment.planner.scenes import DeckScene, SampleScene
 from sediment.planner.screening import INCLUDE, OMIT, SedimentationTest, screen
@@ -182,3 +184,59 @@ def test_an_interrupted_plan_stops_every_run_and_says_so(tmp_path):
     assert plan.returncode == 130 and "Traceback" not in err and "interrupted" in err
     wait_for(lambda: not busy(), seconds=10)
     assert not (out / "report.json").exists()
+
+
+def _narrow_psd(tmp_path: Path) -> Path:
+    """Grains of 40 to 40.4 um: speeds within 2 % of each other."""
+    path = tmp_path / "narrow.csv"
+    path.write_text("diameter_um,percent_finer\n40,0\n40.4,100\n")
+    return path
+
+
+def test_grains_of_one_size_lose_nothing_to_contacts(tmp_path):
+    """Grains settling at (nearly) one speed seldom meet: each class keeps its terminal speed to within
+    its sampling error, and the readings do not move."""
+    test = SedimentationTest(read_psd(_narrow_psd(tmp_path)))
+    m = measure_contacts(test, ReducedScene(40e-6, 0.3e-3, 3e-3, fall=0.5, classes=2), tmp_path / "run")
+    assert m.grains.sum() > 50
+    assert abs(m.speed_ratio - 1).max() < 5e-4    # measured: 4e-5
+    assert m.change < 1e-3
+
+
+def test_contacts_slow_the_coarse_grains_and_carry_the_fine_ones(tmp_path):
+    """Sample 5 above 20 um, a small box: the coarsest class is held back by the slower grains it runs
+    into and the finest carried along, by a few percent at most (what the screening's ballistic estimate
+    predicts in sign, within a factor 4); the soft contacts stay within their overlap tolerance; and
+    the measurement is the same for the same seed."""
+    test = SedimentationTest(read_psd(SAMPLE5))
+    setup = ReducedScene(20e-6, 0.3e-3, 3e-3, fall=0.2)
+    m = measure_contacts(test, setup, tmp_path / "a")
+    assert m.speed_ratio[-1] < 1 < m.speed_ratio[0]
+    assert abs(m.speed_ratio - 1).max() < 0.05
+    assert np.all(np.sign(m.speed_ratio - 1)[[0, -1]] == np.sign(m.estimated_ratio - 1)[[0, -1]])
+    assert np.all(np.abs(m.estimated_ratio - 1)[[0, -1]] < 4 * np.abs(m.speed_ratio - 1)[[0, -1]])
+    assert 0 < m.largest_overlap < 0.01
+    assert 0 < m.change < 1
+    again = measure_contacts(test, setup, tmp_path / "b")
+    assert np.array_equal(again.speed_ratio, m.speed_ratio)
+
+
+def test_a_reduced_scene_outside_the_psd_is_refused(tmp_path, capsys):
+    with pytest.raises(ValueError, match="cut diameter 80 um must lie within the PSD's span"):
+        coarse_part(read_psd(SAMPLE5), 80e-6)
+    with pytest.raises(ValueError, match="must be > 0"):
+        ReducedScene(20e-6, width=0.0)
+    assert cli.main(["plan", str(SAMPLE5), "--screen-only", "--measure-contacts", "--contact-cut", "100",
+                     "--out", str(tmp_path / "o")]) == 2
+    assert "cut diameter 100 um must lie within" in capsys.readouterr().err
+    assert cli.main(["plan", "--deck", str(SUSPENSION), "--observe", "speed", "--measure-contacts"]) == 2
+    assert "--measure-contacts is an option of a sedimentation test" in capsys.readouterr().err
+
+
+def test_the_coarse_part_of_a_psd_keeps_its_shape():
+    psd = read_psd(SAMPLE5)
+    coarse, share = coarse_part(psd, 20e-6)
+    assert share == pytest.approx(1 - psd.at([20e-6])[0] / 100)
+    assert coarse.percent_finer[0] == 0 and coarse.percent_finer[-1] == pytest.approx(100)
+    d = np.array([25e-6, 40e-6])
+    assert coarse.at(d) == pytest.approx((psd.at(d) - psd.at([20e-6])[0]) / share)

@@ -49,6 +49,13 @@ def add_parser(commands) -> argparse.ArgumentParser:
                       help="parcel ladder, comma-separated (default 40000,20000,10000,5000; the largest is the reference)")
     test.add_argument("--courant", type=positive_list, default=[1.0, 2.0, 4.0, 8.0],
                       help="Courant ladder, comma-separated (default 1,2,4,8; the smallest is the reference)")
+    test.add_argument("--measure-contacts", action="store_true",
+                      help="also measure what contacts, and contacts with lubrication, change: a reduced real-grain "
+                      "scene (the grains above --contact-cut in a periodic box) run both ways, written to "
+                      "OUT/contacts.csv and contacts.json (minutes; docs/effects.md section 5)")
+    test.add_argument("--contact-cut", type=positive, metavar="UM",
+                      help="smallest grain of the reduced scene [um] (default a third of the largest: smaller "
+                      "grains meet larger ones with an interception efficiency below 9 %%)")
     deck = parser.add_argument_group("deck")
     deck.add_argument("--observe", nargs="+", metavar="NAME", help="RESULT or SERIES names the deck prints")
     deck.add_argument("--ladder", type=_ladder, action="append", metavar="NAME=V1,V2",
@@ -95,13 +102,62 @@ def run(args: argparse.Namespace) -> int:
         name = args.psd.stem
         if args.screen_only:
             _print_screens(scene.screens)
+            if args.measure_contacts:
+                _measure_contacts(test, args, tolerance)
             return 0
     pin(scene, dict(args.set or []))
     plan = plan_effects(scene, args.out, tolerance, args.jobs, args.seed if args.deck is None else 1,
                         args.measure_all, name=name)
     print(plan.text(), end="")
     print(f"wrote {args.out}/effects.csv, trials.csv, report.json, plan.png; the chosen scene: {args.out / 'decision'}")
+    if args.deck is None and args.measure_contacts:
+        _measure_contacts(test, args, tolerance)
     return 0
+
+
+def _measure_contacts(test, args: argparse.Namespace, tolerance: float) -> None:
+    """Runs the reduced real-grain scene with contacts, and with contacts and lubrication, at once."""
+    import json
+    from concurrent.futures import ThreadPoolExecutor
+
+    from ..planner.contacts import ReducedScene, measure_contacts
+    from ..results import write_text
+    from ..sim.run import stop_all
+
+    largest = test.psd.span()[1]
+    cut = largest / 3 if args.contact_cut is None else args.contact_cut * 1e-6
+    setups = [ReducedScene(cut, 7.5 * largest, 75 * largest, lubrication=lub, seed=args.seed) for lub in (False, True)]
+    print(f"measuring contacts: grains above {cut * 1e6:.3g} um in a periodic box of {setups[0].width * 1e3:.3g} x "
+          f"{setups[0].width * 1e3:.3g} x {setups[0].height * 1e3:.3g} mm, without and with lubrication "
+          f"({min(args.jobs, 2)} at once) ...", flush=True)
+    running: set = set()
+    with ThreadPoolExecutor(max_workers=min(args.jobs, 2)) as pool:
+        runs = [pool.submit(measure_contacts, test, setup, args.out / ("contacts_lubricated" if setup.lubrication
+                                                                      else "contacts"), running=running)
+                for setup in setups]
+        try:
+            measured = [run.result() for run in runs]
+        except BaseException:    # Ctrl-C or a failed run: stop the other one too
+            stop_all(running)
+            raise
+    rows, summary = [], {}
+    for m in measured:
+        print(m.table().text(), end="")
+        kind = "contacts_lubrication" if m.setup.lubrication else "contacts"
+        verdict = ("within the tolerance: omit" if m.change <= tolerance else
+                   "beyond the tolerance, as an upper bound (DEM contacts are ballistic, and Di Felice's "
+                   "correlation holds the real encounters): not simulable at real grain counts, left out")
+        summary[kind] = {"cut_um": cut * 1e6, "grains": int(m.grains.sum()), "steps": m.steps, "time_step": m.time_step,
+                         "loop_seconds": m.loop_seconds, "largest_overlap": m.largest_overlap,
+                         "reading_change_pp": m.change, "verdict": verdict}
+        print(f"{kind}: readings move by up to {m.change:.3g} pp (tolerance {tolerance:g}): {verdict}")
+        rows += [f"{kind},{d * 1e6:.6g},{n},{r:.6g},{e:.3g},{b:.6g}\n" for d, n, r, e, b in
+                 zip(m.diameter, m.grains, m.speed_ratio, m.standard_error, m.estimated_ratio)]
+    args.out.mkdir(parents=True, exist_ok=True)
+    write_text(args.out / "contacts.csv",
+               "scene,diameter_um,grains,speed_over_terminal,standard_error,ballistic_estimate\n" + "".join(rows))
+    write_text(args.out / "contacts.json", json.dumps(summary, indent=2) + "\n")
+    print(f"wrote {args.out}/contacts.csv, contacts.json")
 
 
 def _print_screens(screens) -> None:

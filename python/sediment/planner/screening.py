@@ -110,11 +110,13 @@ class ReadingModel:
         return max(float(np.max(np.abs(r.percent_finer - self.reference[r.instrument]))) for r in found)
 
 
-def encounters(test: SedimentationTest, classes: int = 120) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+def encounters(test: SedimentationTest, classes: int = 120,
+               interception: bool = True) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """The grain-grain contacts of grains settling through the column, per size class, counted with
     the initial real grain numbers. Class j grains lie in the tube pi (r_i + r_j)^2 |v_i - v_j| / v_i
     swept per metre of fall; of these the fraction E = 1 - 3 / (2 (1 + q)) + 1 / (2 (1 + q)^3)
-    (Stokes-flow interception, q = small / large radius) touches instead of being carried round. In
+    (Stokes-flow interception, q = small / large radius) touches instead of being carried round
+    (without `interception` every one touches, as DEM contacts without the flow do). In
     contact the pair settles at (xi_i v_i + xi_j v_j) / (xi_i + xi_j) (Stokes resistances xi ~ r)
     until it has slid past, a time (r_i + r_j) / |v_i - v_j|, which costs grain i a distance r_j
     (gains it, when j is the faster).
@@ -129,7 +131,8 @@ def encounters(test: SedimentationTest, classes: int = 120) -> tuple[np.ndarray,
     number = share * t.initial_concentration / (t.suspension.particle_density * math.pi / 6 * diameter ** 3)
     r = 0.5 * diameter
     q = np.minimum(r[:, None], r[None, :]) / np.maximum(r[:, None], r[None, :])
-    touching = (1 - 1.5 / (1 + q) + 0.5 / (1 + q) ** 3) * math.pi * (r[:, None] + r[None, :]) ** 2 * number[None, :]
+    efficiency = 1 - 1.5 / (1 + q) + 0.5 / (1 + q) ** 3 if interception else 1.0
+    touching = efficiency * math.pi * (r[:, None] + r[None, :]) ** 2 * number[None, :]
     closing = (speed[:, None] - speed[None, :]) / speed[:, None]
     contacts = t.cylinder.height * (touching * np.abs(closing)).sum(axis=1)
     delay = (touching * closing * r[None, :]).sum(axis=1)

@@ -372,7 +372,7 @@ def write(scene: Scene, out: Path, layer_file: str = "layers.h5") -> list[Path]:
     out.mkdir(parents=True, exist_ok=True)
     paths = [out / "sample.data", out / "in.sedimentation", out / "input_psd.csv", out / "simulated_psd.csv",
              out / "classes.csv"]
-    _write_data(scene, paths[0])
+    write_data(scene, paths[0])
     write_text(paths[1], _deck(scene, paths[0].name, layer_file))
     _write_psd(scene.psd, paths[2])
     _write_psd(scene.simulated_psd(), paths[3])
@@ -388,7 +388,8 @@ def _write_psd(psd: PSD, path: Path) -> None:
         f"{d * 1e6:.8g},{p:.8g}\n" for d, p in zip(psd.diameter, psd.percent_finer)))
 
 
-def _write_data(scene: Scene, path: Path) -> None:
+def write_data(scene: Scene, path: Path) -> None:
+    """The scene's LAMMPS data file: one atom type, diameters, density, positions and the Weights section."""
     lo, hi = scene_box(scene)
     n = len(scene.diameter)
     lines = [f"SEDIMENT sedimentation test: {n} grains ({scene.geometry})", "",
