@@ -231,6 +231,12 @@ def test_a_reduced_scene_outside_the_psd_is_refused(tmp_path, capsys):
     assert "cut diameter 100 um must lie within" in capsys.readouterr().err
     assert cli.main(["plan", "--deck", str(SUSPENSION), "--observe", "speed", "--measure-contacts"]) == 2
     assert "--measure-contacts is an option of a sedimentation test" in capsys.readouterr().err
+    mine = tmp_path / "mine" / "contacts"
+    mine.mkdir(parents=True)
+    (mine / "notes.txt").write_text("kept")
+    assert cli.main(["plan", str(SAMPLE5), "--screen-only", "--measure-contacts", "--out", str(mine.parent)]) == 2
+    assert "was not written by sediment plan" in capsys.readouterr().err
+    assert (mine / "notes.txt").read_text() == "kept"
 
 
 def test_the_coarse_part_of_a_psd_keeps_its_shape():

@@ -121,6 +121,7 @@ def _measure_contacts(test, args: argparse.Namespace, tolerance: float) -> None:
     from concurrent.futures import ThreadPoolExecutor
 
     from ..planner.contacts import ReducedScene, measure_contacts
+    from ..planner.scenes import prepare
     from ..results import write_text
     from ..sim.run import stop_all
 
@@ -130,11 +131,13 @@ def _measure_contacts(test, args: argparse.Namespace, tolerance: float) -> None:
     print(f"measuring contacts: grains above {cut * 1e6:.3g} um in a periodic box of {setups[0].width * 1e3:.3g} x "
           f"{setups[0].width * 1e3:.3g} x {setups[0].height * 1e3:.3g} mm, without and with lubrication "
           f"({min(args.jobs, 2)} at once) ...", flush=True)
+    for stale in ("contacts.csv", "contacts.json"):    # a failed rerun must not leave the last one's answer
+        (args.out / stale).unlink(missing_ok=True)
     running: set = set()
     with ThreadPoolExecutor(max_workers=min(args.jobs, 2)) as pool:
-        runs = [pool.submit(measure_contacts, test, setup, args.out / ("contacts_lubricated" if setup.lubrication
-                                                                      else "contacts"), running=running)
-                for setup in setups]
+        folders = [prepare(args.out / ("contacts_lubricated" if setup.lubrication else "contacts")) for setup in setups]
+        runs = [pool.submit(measure_contacts, test, setup, folder, running=running)
+                for setup, folder in zip(setups, folders)]
         try:
             measured = [run.result() for run in runs]
         except BaseException:    # Ctrl-C or a failed run: stop the other one too
