@@ -231,6 +231,8 @@ def test_a_reduced_scene_outside_the_psd_is_refused(tmp_path, capsys):
     assert "cut diameter 100 um must lie within" in capsys.readouterr().err
     assert cli.main(["plan", "--deck", str(SUSPENSION), "--observe", "speed", "--measure-contacts"]) == 2
     assert "--measure-contacts is an option of a sedimentation test" in capsys.readouterr().err
+    assert cli.main(["plan", str(SAMPLE5), "--screen-only", "--contact-cut", "30"]) == 2
+    assert "--contact-cut sets the reduced scene of --measure-contacts" in capsys.readouterr().err
     mine = tmp_path / "mine" / "contacts"
     mine.mkdir(parents=True)
     (mine / "notes.txt").write_text("kept")

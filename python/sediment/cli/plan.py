@@ -100,6 +100,8 @@ def run(args: argparse.Namespace) -> int:
                        t_end=args.t_end)
         scene = SampleScene(test, options, args.particles, args.courant, tolerance)
         name = args.psd.stem
+        if args.contact_cut is not None and not args.measure_contacts:
+            raise ValueError("--contact-cut sets the reduced scene of --measure-contacts: give both")
         if args.screen_only:
             _print_screens(scene.screens)
             if args.measure_contacts:
@@ -143,7 +145,7 @@ def _measure_contacts(test, args: argparse.Namespace, tolerance: float) -> None:
         except BaseException:    # Ctrl-C or a failed run: stop the other one too
             stop_all(running)
             raise
-    rows, summary = [], {}
+    header, rows, summary = "", [], {}
     for m in measured:
         print(m.table().text(), end="")
         kind = "contacts_lubrication" if m.setup.lubrication else "contacts"
@@ -154,11 +156,10 @@ def _measure_contacts(test, args: argparse.Namespace, tolerance: float) -> None:
                          "loop_seconds": m.loop_seconds, "largest_overlap": m.largest_overlap,
                          "reading_change_pp": m.change, "verdict": verdict}
         print(f"{kind}: readings move by up to {m.change:.3g} pp (tolerance {tolerance:g}): {verdict}")
-        rows += [f"{kind},{d * 1e6:.6g},{n},{r:.6g},{e:.3g},{b:.6g}\n" for d, n, r, e, b in
-                 zip(m.diameter, m.grains, m.speed_ratio, m.standard_error, m.estimated_ratio)]
+        lines = m.table().csv().splitlines(keepends=True)
+        header, rows = lines[0], rows + [f"{kind},{line}" for line in lines[1:]]
     args.out.mkdir(parents=True, exist_ok=True)
-    write_text(args.out / "contacts.csv",
-               "scene,diameter_um,grains,speed_over_terminal,standard_error,ballistic_estimate\n" + "".join(rows))
+    write_text(args.out / "contacts.csv", "scene," + header + "".join(rows))
     write_text(args.out / "contacts.json", json.dumps(summary, indent=2) + "\n")
     print(f"wrote {args.out}/contacts.csv, contacts.json")
 

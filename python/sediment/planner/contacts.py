@@ -31,7 +31,7 @@ import numpy as np
 from ..lab.psd import PSD
 from ..results import Table, write_text
 from ..sim.run import run_batch
-from ..sim.scene import POISSON_RATIO, OVERLAP_TOLERANCE, Cylinder, Effects, plan, write_data
+from ..sim.scene import OVERLAP_TOLERANCE, Cylinder, Effects, pair_lines, plan, write_data
 from .screening import ReadingModel, SedimentationTest, encounters, terminal_speeds
 
 
@@ -157,13 +157,6 @@ def _thermo_column(text: str, name: str) -> list[str]:
 def _deck(scene, dt: float, steps: int) -> str:
     s = scene.suspension
     d_max = float(scene.diameter.max())
-    granular = (f"hertz/material {scene.contact_modulus():.6g} 0.3 {POISSON_RATIO:g} tangential mindlin NULL 1.0 0.5 "
-                "damping tsuji")
-    if scene.effects.lubrication:
-        pair = ["pair_style      hybrid/overlay granular lubricate/fluid water inner 0.01 outer 0.5 limit yes",
-                f"pair_coeff      * * granular {granular}", "pair_coeff      * * lubricate/fluid"]
-    else:
-        pair = ["pair_style      granular", f"pair_coeff      * * {granular}"]
     relax = max(10, steps // 50)    # grains start at rest: a few relaxation times of the largest, at least
     return "\n".join([
         "# Reduced real-grain scene of `sediment plan --measure-contacts` (sediment.planner.contacts)",
@@ -178,7 +171,7 @@ def _deck(scene, dt: float, steps: int) -> str:
         f"fix             water all fluid density {s.fluid_density:.12g} viscosity {s.viscosity:.12g}",
         "fix             buoy all fluid/buoyancy water",
         "fix             drag all fluid/drag water law dallavalle",
-        *pair,
+        *pair_lines(scene),
         "fix             step all nve/sphere/fluid",
         "compute         overlap all contact/overlap",
         "variable        overlap equal c_overlap",

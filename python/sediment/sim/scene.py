@@ -468,15 +468,9 @@ def _deck(scene: Scene, data: str, layer_file: str) -> str:
         lines.append("fix             drag all fluid/drag water law difelice concentration c_conc")
     else:
         lines.append(f"fix             drag all fluid/drag water law {e.drag}")
-    granular = (f"granular hertz/material {scene.contact_modulus():.6g} 0.3 {POISSON_RATIO:g} tangential mindlin "
-                "NULL 1.0 0.5 damping tsuji") if e.interacting else ""
     if e.interacting:
-        if e.lubrication:
-            lines += ["pair_style      hybrid/overlay granular lubricate/fluid water inner 0.01 outer 0.5 limit yes",
-                      f"pair_coeff      * * {granular}", "pair_coeff      * * lubricate/fluid"]
-        else:
-            lines += ["pair_style      granular", f"pair_coeff      * * {granular.split(' ', 1)[1]}"]
-        lines += [f"fix             floor all wall/gran {granular} {up}plane 0 NULL",
+        lines += pair_lines(scene)
+        lines += [f"fix             floor all wall/gran granular {contact_model(scene)} {up}plane 0 NULL",
                   "fix             step all nve/sphere/fluid",
                   "# Soft contacts, made for overlaps up to "
                   f"{OVERLAP_TOLERANCE:.0%} of a diameter: the largest is reported, and twice that stops the run.",
@@ -502,6 +496,20 @@ def _deck(scene: Scene, data: str, layer_file: str) -> str:
         lines += [f"variable        stage_end equal $(v_stage_end+ceil({steps}/v_dt_scale))",
                   f'if "$(step) < ${{stage_end}}" then "timestep $({dt:.17g}*v_dt_scale)" "run ${{stage_end}} upto post no"']
     return "\n".join(lines) + "\n"
+
+
+def contact_model(scene: Scene) -> str:
+    """The grains' contact model as pair_coeff granular takes it: Hertz at the scene's soft modulus."""
+    return (f"hertz/material {scene.contact_modulus():.6g} 0.3 {POISSON_RATIO:g} tangential mindlin NULL 1.0 0.5 "
+            "damping tsuji")
+
+
+def pair_lines(scene: Scene) -> list[str]:
+    """The deck's pair_style and pair_coeff lines: the contacts, with the squeeze films overlaid."""
+    if scene.effects.lubrication:
+        return ["pair_style      hybrid/overlay granular lubricate/fluid water inner 0.01 outer 0.5 limit yes",
+                f"pair_coeff      * * granular {contact_model(scene)}", "pair_coeff      * * lubricate/fluid"]
+    return ["pair_style      granular", f"pair_coeff      * * {contact_model(scene)}"]
 
 
 def describe(scene: Scene) -> str:
