@@ -147,7 +147,8 @@ def _measure_contacts(test, args: argparse.Namespace, tolerance: float) -> None:
             raise
     header, rows, summary = "", [], {}
     for m in measured:
-        print(m.table().text(), end="")
+        table = m.table()
+        print(table.text(), end="")
         kind = "contacts_lubrication" if m.setup.lubrication else "contacts"
         verdict = ("within the tolerance: omit" if m.change <= tolerance else
                    "beyond the tolerance, as an upper bound (DEM contacts are ballistic, and Di Felice's "
@@ -156,7 +157,7 @@ def _measure_contacts(test, args: argparse.Namespace, tolerance: float) -> None:
                          "loop_seconds": m.loop_seconds, "largest_overlap": m.largest_overlap,
                          "reading_change_pp": m.change, "verdict": verdict}
         print(f"{kind}: readings move by up to {m.change:.3g} pp (tolerance {tolerance:g}): {verdict}")
-        lines = m.table().csv().splitlines(keepends=True)
+        lines = table.csv().splitlines(keepends=True)
         header, rows = lines[0], rows + [f"{kind},{line}" for line in lines[1:]]
     args.out.mkdir(parents=True, exist_ok=True)
     write_text(args.out / "contacts.csv", "scene," + header + "".join(rows))
