@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: GPL-2.0-or-later
 #include "sediment/integrator.hpp"
 
+#include "sediment/batch_math.hpp"
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -28,6 +30,17 @@ struct SeriesCoefficients {
 };
 constexpr SeriesCoefficients series;
 
+// phis(z) from e^-z (0 beyond z = 745.2) for z outside the series' range.
+inline Phi phis_from_decay(double z, double decay)
+{
+  const double inverse = 1.0 / z;
+  return {decay, (1.0 - decay) * inverse, (z - 1.0 + decay) * inverse * inverse};
+}
+
+// Beyond z = 745.13 e^-z rounds to 0, which libm reaches through its slow underflow path (an
+// eighth of a sedimentation test's step, where dt is 1e5 relaxation times of the fine grains).
+constexpr double decay_limit = 745.2;
+
 }    // namespace
 
 Phi phis(double z)
@@ -44,15 +57,22 @@ Phi phis(double z)
     }
     return {1.0 - z * p1, p1, p2};
   }
-  // Beyond z = 745.13 e^-z rounds to 0, which libm reaches through its slow underflow path (an
-  // eighth of a sedimentation test's step, where dt is 1e5 relaxation times of the fine grains).
-  if (z > 745.2) {
-    const double inverse = 1.0 / z;
-    return {0.0, inverse, (z - 1.0) * inverse * inverse};
+  return phis_from_decay(z, z > decay_limit ? 0.0 : std::exp(-z));
+}
+
+void phis_many(const double *z, Phi *out, int n)
+{
+  constexpr int chunk = 64;
+  double decay[chunk];
+  for (int start = 0; start < n; start += chunk) {
+    const int m = std::min(chunk, n - start);
+    for (int k = 0; k < m; ++k) decay[k] = -std::min(z[start + k], decay_limit);
+    exp_many(decay, decay, m);
+    for (int k = 0; k < m; ++k) {
+      const double zk = z[start + k];
+      out[start + k] = std::abs(zk) < 0.5 || zk > decay_limit ? phis(zk) : phis_from_decay(zk, decay[k]);
+    }
   }
-  const double decay = std::exp(-z);
-  const double inverse = 1.0 / z;
-  return {decay, (1.0 - decay) * inverse, (z - 1.0 + decay) * inverse * inverse};
 }
 
 double phi1(double z) { return phis(z).phi1; }

@@ -103,12 +103,17 @@ struct Exponent {
   double value;
   double re_slope;
 };
+// chi from t = 1.5 - log10 Re and gauss = exp(-t^2 / 2).
+inline Exponent di_felice_exponent(double t, double gauss)
+{
+  const double bump = 0.65 * gauss;
+  return {3.7 - bump, -bump * t / ln10};    // Re d/dRe of -bump = -bump t / ln 10
+}
 inline Exponent di_felice_exponent(double re)
 {
   if (!(re > 0.0)) return {3.7, 0.0};
   const double t = 1.5 - std::log10(re);
-  const double bump = 0.65 * std::exp(-0.5 * t * t);
-  return {3.7 - bump, -bump * t / ln10};    // Re d/dRe of -bump = -bump t / ln 10
+  return di_felice_exponent(t, std::exp(-0.5 * t * t));
 }
 
 class DragModel {
@@ -143,13 +148,14 @@ class DragModel {
   DragCurve curve(double re, double voidage) const
   {
     const DragCurve single = drag_curve(law_, re);
-    if (law_ != DragLaw::DiFelice || voidage >= 1.0) return single;
-    // G eps^-(chi(Re) + offset): the exponent depends on Re, so the slope has a second term.
+    if (!hindered(voidage)) return single;
     const Exponent chi = di_felice_exponent(re);
     const double log_eps = std::log(voidage);
-    const double factor = std::exp(-(chi.value + hindrance_offset_) * log_eps);
-    return {single.g * factor, (single.re_dg - single.g * log_eps * chi.re_slope) * factor};
+    return hindered_curve(single, chi, log_eps, std::exp(-(chi.value + hindrance_offset_) * log_eps));
   }
+  // curve() of n spheres at once, the hindrance's logarithms and exponentials taken together
+  // (exp_many, log_many): within a few ulp of curve().
+  void curves(const double *re, const double *voidage, DragCurve *out, int n) const;
   // F(0+): the largest force a sphere at rest resists (zero for a Newtonian fluid).
   double static_force(double d, DragScale scale = {}) const;
   // c when F(s) = c s exactly (Stokes in a Newtonian fluid), else 0.
@@ -162,6 +168,13 @@ class DragModel {
   int jumps(double d, std::array<ForceJump, max_jumps> &out, DragScale scale = {}) const;
 
  private:
+  bool hindered(double voidage) const { return law_ == DragLaw::DiFelice && !(voidage >= 1.0); }
+  // G eps^-(chi(Re) + offset), factor = eps^-(chi + offset): the exponent depends on Re, so the
+  // slope has a second term.
+  static DragCurve hindered_curve(DragCurve single, Exponent chi, double log_eps, double factor)
+  {
+    return {single.g * factor, (single.re_dg - single.g * log_eps * chi.re_slope) * factor};
+  }
   double viscous_scale(double d, double speed) const;    // tau_y + eta s / d
   double speed_at_reynolds(double d, double re) const;  // inverse of reynolds()
   double force_at(double d, double speed, double g, DragScale scale) const;

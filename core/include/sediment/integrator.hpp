@@ -32,6 +32,8 @@ struct Phi {
   double phi2;
 };
 Phi phis(double z);
+// phis of n rates at once, their exponentials taken together (exp_many): within a few ulp of phis.
+void phis_many(const double *z, Phi *out, int n);
 
 // phis(z) remembered for the last z a sphere saw, in memo = {z, decay, phi1, phi2} (z NaN: empty).
 // With a fixed step and a linear drag z does not change, so the exponential is taken once.
@@ -92,10 +94,9 @@ struct SmoothLinearisation {
   double z_across;
 };
 
-inline SmoothLinearisation smooth_linearise(const SphereDrag &drag, double inverse_mass, const double a[3],
-                                            const double u[3], double dt, const double v[3])
+// The slip and its direction, the first stage of smooth_linearise (rates still zero).
+inline SmoothLinearisation smooth_slip(const double a[3], const double u[3], const double v[3])
 {
-  const DragModel &model = *drag.model;
   SmoothLinearisation lin{{0.0, 0.0, 1.0}, 0.0, 0.0, 0.0, 0.0, 0.0};
   const double w[3] = {v[0] - u[0], v[1] - u[1], v[2] - u[2]};
   const double s = std::sqrt(dot(w, w));
@@ -107,12 +108,30 @@ inline SmoothLinearisation smooth_linearise(const SphereDrag &drag, double inver
   }
   lin.s = s;
   lin.a_par = dot(a, lin.dir);
-  const double re = model.smooth_reynolds_per_speed(drag.diameter) * s;
-  const DragCurve g = model.curve(re, drag.scale.voidage);
-  const double k = model.smooth_drag_per_speed(drag.diameter, drag.scale) * inverse_mass;
-  lin.c = lin.a_par + s * k * g.re_dg;
+  return lin;
+}
+
+// The law's Reynolds number at the slip of smooth_slip.
+inline double smooth_reynolds(const SphereDrag &drag, const SmoothLinearisation &lin)
+{
+  return drag.model->smooth_reynolds_per_speed(drag.diameter) * lin.s;
+}
+
+// The rates, from the law's curve g at that Reynolds number.
+inline void smooth_rates(const SphereDrag &drag, double inverse_mass, const DragCurve &g, double dt,
+                         SmoothLinearisation &lin)
+{
+  const double k = drag.model->smooth_drag_per_speed(drag.diameter, drag.scale) * inverse_mass;
+  lin.c = lin.a_par + lin.s * k * g.re_dg;
   lin.z_along = k * (g.g + g.re_dg) * dt;
   lin.z_across = k * g.g * dt;
+}
+
+inline SmoothLinearisation smooth_linearise(const SphereDrag &drag, double inverse_mass, const double a[3],
+                                            const double u[3], double dt, const double v[3])
+{
+  SmoothLinearisation lin = smooth_slip(a, u, v);
+  smooth_rates(drag, inverse_mass, drag.model->curve(smooth_reynolds(drag, lin), drag.scale.voidage), dt, lin);
   return lin;
 }
 

@@ -1,0 +1,137 @@
+// SPDX-License-Identifier: GPL-2.0-or-later
+// Per-atom kernels of the physics core, timed on the scene of benchmarks/in.cost (20 000 spheres of
+// 30 um at random in a 4 x 4 x 20 mm box): the time per sphere of what compute concentration/grid
+// and the Di Felice law do each step. Ratios between kernels, or between two builds run back to back.
+//   build/bench_core_kernels [--benchmark_repetitions=5]
+#include "sediment/concentration.hpp"
+#include "sediment/drag.hpp"
+#include "sediment/integrator.hpp"
+
+#include <benchmark/benchmark.h>
+
+#include <algorithm>
+#include <array>
+#include <random>
+#include <vector>
+
+namespace {
+
+constexpr int spheres = 20000;
+constexpr double radius = 1.5e-5;
+constexpr double box[3] = {0.004, 0.004, 0.02};
+
+std::vector<std::array<double, 3>> centres()
+{
+  std::mt19937_64 random(11);
+  std::vector<std::array<double, 3>> out(spheres);
+  for (auto &c : out)
+    for (int d = 0; d < 3; ++d) c[d] = std::uniform_real_distribution<double>(0.0, box[d])(random);
+  return out;
+}
+
+sediment::Grid layer_grid()
+{
+  sediment::Grid grid{};
+  for (int d = 0; d < 3; ++d) grid.axes[d] = {0.0, box[d], 1, true};
+  grid.axes[2] = {0.0, box[2] / 400, 400, true};
+  grid.resolved[0] = grid.resolved[1] = false;
+  grid.resolved[2] = true;
+  return grid;
+}
+
+sediment::Grid cell_grid()
+{
+  const int counts[3] = {20, 20, 100};
+  sediment::Grid grid{};
+  for (int d = 0; d < 3; ++d) {
+    grid.axes[d] = {0.0, box[d] / counts[d], counts[d], true};
+    grid.resolved[d] = true;
+  }
+  return grid;
+}
+
+void deposit(benchmark::State &state, const sediment::Grid &grid)
+{
+  const auto at = centres();
+  std::vector<double> values(grid.cells());
+  for (auto _ : state) {
+    for (const auto &c : at) sediment::add_sphere_to_grid(grid, c.data(), radius, values.data());
+    benchmark::DoNotOptimize(values.data());
+  }
+  state.SetItemsProcessed(state.iterations() * spheres);
+}
+
+void interpolate(benchmark::State &state, const sediment::Grid &grid)
+{
+  const auto at = centres();
+  std::vector<double> values(grid.cells(), 0.01);
+  for (const auto &c : at) sediment::add_sphere_to_grid(grid, c.data(), radius, values.data());
+  double sum = 0.0;
+  for (auto _ : state) {
+    for (const auto &c : at) sum += sediment::grid_value_at(grid, values.data(), c.data());
+    benchmark::DoNotOptimize(sum);
+  }
+  state.SetItemsProcessed(state.iterations() * spheres);
+}
+
+void LayerDeposit(benchmark::State &state) { deposit(state, layer_grid()); }
+void LayerInterpolation(benchmark::State &state) { interpolate(state, layer_grid()); }
+void CellDeposit(benchmark::State &state) { deposit(state, cell_grid()); }
+void CellInterpolation(benchmark::State &state) { interpolate(state, cell_grid()); }
+
+// The Di Felice curve at the Reynolds numbers and voidages of a settling suspension, one sphere at a
+// time (DragModel::curve) or a block of 32 at a time (DragModel::curves, as the integrator does).
+void di_felice(benchmark::State &state, bool blocks)
+{
+  const sediment::DragModel model(sediment::DragLaw::DiFelice, {998.2, 1.002e-3, 0.0});
+  std::mt19937_64 random(5);
+  std::vector<double> re(spheres), voidage(spheres);
+  for (int i = 0; i < spheres; ++i) {
+    re[i] = std::uniform_real_distribution<double>(1e-3, 1.0)(random);
+    voidage[i] = std::uniform_real_distribution<double>(0.9, 1.0)(random);
+  }
+  std::vector<sediment::DragCurve> curves(spheres);
+  for (auto _ : state) {
+    if (blocks)
+      for (int i = 0; i < spheres; i += 32) model.curves(&re[i], &voidage[i], &curves[i], std::min(32, spheres - i));
+    else
+      for (int i = 0; i < spheres; ++i) curves[i] = model.curve(re[i], voidage[i]);
+    benchmark::DoNotOptimize(curves.data());
+  }
+  state.SetItemsProcessed(state.iterations() * spheres);
+}
+void DiFeliceCurve(benchmark::State &state) { di_felice(state, false); }
+void DiFeliceCurves(benchmark::State &state) { di_felice(state, true); }
+
+// e^-z, phi1 and phi2 over the rates of a step near the relaxation time: one by one (phis) or 64
+// at a time (phis_many, as the integrator takes a block's rates along and across the slip).
+void phi_functions(benchmark::State &state, bool blocks)
+{
+  std::mt19937_64 random(7);
+  std::vector<double> z(spheres);
+  for (double &value : z) value = std::uniform_real_distribution<double>(0.1, 3.0)(random);
+  std::vector<sediment::Phi> out(spheres);
+  for (auto _ : state) {
+    if (blocks)
+      for (int i = 0; i < spheres; i += 64) sediment::phis_many(&z[i], &out[i], std::min(64, spheres - i));
+    else
+      for (int i = 0; i < spheres; ++i) out[i] = sediment::phis(z[i]);
+    benchmark::DoNotOptimize(out.data());
+  }
+  state.SetItemsProcessed(state.iterations() * spheres);
+}
+void Phis(benchmark::State &state) { phi_functions(state, false); }
+void PhisMany(benchmark::State &state) { phi_functions(state, true); }
+
+BENCHMARK(LayerDeposit);
+BENCHMARK(LayerInterpolation);
+BENCHMARK(CellDeposit);
+BENCHMARK(CellInterpolation);
+BENCHMARK(DiFeliceCurve);
+BENCHMARK(DiFeliceCurves);
+BENCHMARK(Phis);
+BENCHMARK(PhisMany);
+
+}    // namespace
+
+BENCHMARK_MAIN();

@@ -1,0 +1,25 @@
+// SPDX-License-Identifier: GPL-2.0-or-later
+// e^x and ln x of many values at once, for the per-atom loops that need one or more of each per atom
+// and step (the drag step's exponentials, the Di Felice hindrance). On x86-64 with glibc they are the
+// vector functions of glibc's libmvec (4 values per call where the processor has AVX2, else 2 with
+// SSE2), within 4 ulp of std::exp and std::log; elsewhere std::exp and std::log one by one.
+// Every value goes through the same function wherever it sits in the batch, so a sphere's result
+// does not depend on which others share its batch (nor on how atoms are spread over MPI ranks).
+#pragma once
+
+namespace sediment {
+
+enum class BatchMath { Scalar, SSE2, AVX2 };
+
+// The fastest kind this build has on this processor (decided once per process), and whether a
+// kind runs here at all (Scalar always does).
+BatchMath batch_math_kind();
+bool batch_math_available(BatchMath kind);
+const char *batch_math_name(BatchMath kind);
+
+// out[k] = e^x[k] and ln x[k], k < n; out may be x. Special values as std::exp and std::log.
+// With a kind that is not available here, the scalar functions run.
+void exp_many(const double *x, double *out, int n, BatchMath kind = batch_math_kind());
+void log_many(const double *x, double *out, int n, BatchMath kind = batch_math_kind());
+
+}    // namespace sediment
