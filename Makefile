@@ -75,9 +75,11 @@ test-lammps-current: build
 
 test: test-cpp test-python check-sanitize test-lammps-current
 
-# Cost of each effect per particle-step, as ratios measured in one run (not part of make test).
+# Cost of each effect per particle-step, as ratios measured in one run, then the core's per-atom
+# kernels (grid deposit and interpolation, Di Felice curve, phi functions; not part of make test).
 bench: build
 	$(PYTHON) benchmarks/cost.py
+	$(BUILD)/bench_core_kernels --benchmark_min_time=0.2
 
 clean:
 	rm -rf $(BUILD) $(SANITIZE_BUILD) $(OUT) python/sediment/_core*.so

@@ -32,17 +32,27 @@ int cell_of(const Layers &axis, int k)
   return k >= 0 && k < axis.count ? k : -1;
 }
 
-// Unwrapped indices of the first and last layer that the interval [lo, hi] touches, clamped to
-// the axis unless it is periodic; first > last when it misses a bounded axis.
+// floor(s) as an int, without the libm call or its emulation on processors before SSE4.1.
+int floor_index(double s)
+{
+  const int t = static_cast<int>(s);
+  return t - (s < t);
+}
+
+// Unwrapped indices of the first and last layer that the interval [lo, hi] touches.
 void touched(const Layers &axis, double lo, double hi, int &first, int &last)
 {
   const double per_thickness = 1.0 / axis.thickness;    // one division: this runs per atom and step
-  first = static_cast<int>(std::floor((lo - axis.lo) * per_thickness));
-  last = static_cast<int>(std::floor((hi - axis.lo) * per_thickness));
-  if (!axis.periodic) {
-    first = std::max(first, 0);
-    last = std::min(last, axis.count - 1);
-  }
+  first = floor_index((lo - axis.lo) * per_thickness);
+  last = floor_index((hi - axis.lo) * per_thickness);
+}
+
+// The touched range clamped to the axis unless it is periodic; first > last when it misses.
+void clamp_to_axis(const Layers &axis, int &first, int &last)
+{
+  if (axis.periodic) return;
+  first = std::max(first, 0);
+  last = std::min(last, axis.count - 1);
 }
 
 struct Bracket {
@@ -55,9 +65,8 @@ Bracket bracket(const Layers &axis, double x)
 {
   const double s = (x - axis.lo) / axis.thickness - 0.5;    // in layers from the first centre
   if (axis.periodic) {
-    const double k = std::floor(s);
-    const int k0 = static_cast<int>(k);
-    return {wrap(k0, axis.count), wrap(k0 + 1, axis.count), s - k};
+    const int k0 = floor_index(s);
+    return {wrap(k0, axis.count), wrap(k0 + 1, axis.count), s - k0};
   }
   if (s <= 0.0) return {0, 0, 0.0};
   if (s >= axis.count - 1) return {axis.count - 1, axis.count - 1, 0.0};
@@ -125,9 +134,12 @@ class SphereCuts {
 double spread_over_cells(const Grid &grid, const double centre[3], double radius, const int first[3],
                          const int last[3], const bool crossing[3], double *values, int stride, double weight)
 {
-  std::vector<double> edges[3];
-  std::vector<int> cells[3];
+  // Scratch kept between calls: this runs for every sphere crossing faces along two axes, each step.
+  thread_local std::vector<double> edges[3], vertex;
+  thread_local std::vector<int> cells[3];
   for (int d = 0; d < 3; ++d) {
+    edges[d].clear();
+    cells[d].clear();
     if (!crossing[d]) {
       edges[d] = {-radius, radius};
       cells[d] = {grid.resolved[d] ? cell_of(grid.axes[d], first[d]) : 0};
@@ -140,7 +152,7 @@ double spread_over_cells(const Grid &grid, const double centre[3], double radius
   const int n[3] = {static_cast<int>(cells[0].size()), static_cast<int>(cells[1].size()),
                     static_cast<int>(cells[2].size())};
   const SphereCuts cuts(radius);
-  std::vector<double> vertex((n[0] + 1) * (n[1] + 1) * (n[2] + 1));
+  vertex.resize((n[0] + 1) * (n[1] + 1) * (n[2] + 1));
   auto at = [&](int i, int j, int k) -> double & { return vertex[i + (n[0] + 1) * (j + (n[1] + 1) * k)]; };
   for (int k = 0; k <= n[2]; ++k)
     for (int j = 0; j <= n[1]; ++j)
@@ -172,6 +184,7 @@ double add_sphere_to_layers(const Layers &layers, double centre, double radius, 
 {
   int first, last;
   touched(layers, centre - radius, centre + radius, first, last);
+  clamp_to_axis(layers, first, last);
   double lower = below(radius, layers.lo + first * layers.thickness - centre), inside = 0.0;
   for (int k = first; k <= last; ++k) {
     const double upper = below(radius, layers.lo + (k + 1) * layers.thickness - centre);
@@ -244,14 +257,14 @@ double add_sphere_to_grid(const Grid &grid, const double centre[3], double radiu
     first[d] = last[d] = 0;
     if (!grid.resolved[d]) continue;
     const Layers &axis = grid.axes[d];
+    touched(axis, centre[d] - radius, centre[d] + radius, first[d], last[d]);
     // A sphere crossing a face (an outer one too) is split along d; the range is clamped after.
-    if (std::floor((centre[d] - radius - axis.lo) / axis.thickness) !=
-        std::floor((centre[d] + radius - axis.lo) / axis.thickness)) {
+    if (first[d] != last[d]) {
       crosses[d] = true;
       along = d;
       ++ncrossing;
     }
-    touched(axis, centre[d] - radius, centre[d] + radius, first[d], last[d]);
+    clamp_to_axis(axis, first[d], last[d]);
     if (first[d] > last[d]) return total;
   }
   if (ncrossing > 1)
@@ -276,19 +289,15 @@ double grid_value_at(const Grid &grid, const double *values, const double point[
   if (const int axis = layer_axis(grid); axis >= 0) return profile_at(grid.axes[axis], values, point[axis], stride);
   Bracket at[3];
   for (int d = 0; d < 3; ++d) at[d] = grid.resolved[d] ? bracket(grid.axes[d], point[d]) : Bracket{0, 0, 0.0};
+  // Linear along x on the four edges around the point, then along y, then along z: no branch per
+  // corner (an axis not resolved has k0 = k1 = 0 and weight 0, so it reads its one cell twice).
   const int nx = grid.axes[0].count, ny = grid.axes[1].count;
-  double sum = 0.0;
-  for (int corner = 0; corner < 8; ++corner) {
-    double weight = 1.0;
-    int cell[3];
-    for (int d = 0; d < 3; ++d) {
-      const bool upper = corner >> d & 1;
-      weight *= upper ? at[d].w : 1.0 - at[d].w;
-      cell[d] = upper ? at[d].k1 : at[d].k0;
-    }
-    if (weight != 0.0) sum += weight * values[(cell[0] + nx * (cell[1] + ny * cell[2])) * stride];
-  }
-  return sum;
+  auto along_x = [&](int j, int k) {
+    const double *row = values + nx * (j + ny * k) * stride;
+    return (1.0 - at[0].w) * row[at[0].k0 * stride] + at[0].w * row[at[0].k1 * stride];
+  };
+  auto along_y = [&](int k) { return (1.0 - at[1].w) * along_x(at[1].k0, k) + at[1].w * along_x(at[1].k1, k); };
+  return (1.0 - at[2].w) * along_y(at[2].k0) + at[2].w * along_y(at[2].k1);
 }
 
 void smooth_grid(const Grid &grid, double *values, double width, double *scratch, int stride)

@@ -217,6 +217,22 @@ TEST(Grid, InterpolatesTrilinearlyAndSmoothsConservatively)
   for (double v : flat) EXPECT_NEAR(v, 0.25, 1e-15);
 }
 
+TEST(Grid, InterpolatesAcrossPeriodicFacesAndAlongUnresolvedAxes)
+{
+  // x not resolved (one cell), y bounded, z periodic: 1 x 3 x 3 cells of unit size.
+  const Layers one{0.0, 5.0, 1}, bounded{0.0, 1.0, 3}, ring{0.0, 1.0, 3, true};
+  const Grid grid{{one, bounded, ring}, {false, true, true}};
+  std::vector<double> values(9);
+  for (int j = 0; j < 3; ++j)
+    for (int k = 0; k < 3; ++k) values[j + 3 * k] = 10.0 * j + 100.0 * k;
+  // z = 0.25 lies a quarter layer below the first centre: 0.25 of the last layer, 0.75 of the first.
+  const double wrapped[3] = {4.0, 1.25, 0.25};
+  EXPECT_NEAR(grid_value_at(grid, values.data(), wrapped), 7.5 + 0.25 * 200.0, 1e-12);
+  // Beyond the outer centre of the bounded y axis the value is flat; x has no say.
+  const double flat[3] = {-7.0, 2.9, 1.5};
+  EXPECT_NEAR(grid_value_at(grid, values.data(), flat), 20.0 + 100.0, 1e-12);
+}
+
 TEST(Grid, ACornerCellMatchesDirectIntegrationOfChords)
 {
   // Independent of the closed form: integrate the x chord of the sphere inside the cell over a
