@@ -135,9 +135,11 @@ def _measure_contacts(test, args: argparse.Namespace, tolerance: float) -> None:
           f"({min(args.jobs, 2)} at once) ...", flush=True)
     for stale in ("contacts.csv", "contacts.json"):    # a failed rerun must not leave the last one's answer
         (args.out / stale).unlink(missing_ok=True)
+    # One name per measurement: its run folder and its rows in contacts.csv/json.
+    kinds = ["contacts_lubrication" if setup.lubrication else "contacts" for setup in setups]
     running: set = set()
     with ThreadPoolExecutor(max_workers=min(args.jobs, 2)) as pool:
-        folders = [prepare(args.out / ("contacts_lubricated" if setup.lubrication else "contacts")) for setup in setups]
+        folders = [prepare(args.out / kind) for kind in kinds]
         runs = [pool.submit(measure_contacts, test, setup, folder, running=running)
                 for setup, folder in zip(setups, folders)]
         try:
@@ -146,10 +148,9 @@ def _measure_contacts(test, args: argparse.Namespace, tolerance: float) -> None:
             stop_all(running)
             raise
     header, rows, summary = "", [], {}
-    for m in measured:
+    for kind, m in zip(kinds, measured):
         table = m.table()
         print(table.text(), end="")
-        kind = "contacts_lubrication" if m.setup.lubrication else "contacts"
         verdict = ("within the tolerance: omit" if m.change <= tolerance else
                    "beyond the tolerance, as an upper bound (DEM contacts are ballistic, and Di Felice's "
                    "correlation holds the real encounters): not simulable at real grain counts, left out")
