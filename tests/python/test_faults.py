@@ -15,6 +15,7 @@ import numpy as np
 import pytest
 
 from sediment.sim.layers import read_layers
+from sediment.sim.run import run_batch
 
 REPO = Path(__file__).resolve().parents[2]
 SEDIMENT = [str(REPO / "bin" / "sediment")]
@@ -132,6 +133,23 @@ def test_a_killed_run_keeps_the_earlier_result_and_resumes_to_the_same_frames(tm
     assert b.complete and not (cut.parent / "layers.h5.partial").exists()
     assert np.array_equal(a.step, b.step) and np.allclose(a.time, b.time, rtol=1e-12, atol=0)
     assert np.max(np.abs(a.fraction - b.fraction)) < 1e-12
+
+
+def test_a_batch_run_streams_its_lines_and_is_stopped_at_its_timeout(tmp_path):
+    """run_batch hands each line to a reader as LAMMPS prints it, and a run past its timeout is
+    stopped (no LAMMPS left behind) with TimeoutExpired, not taken for a result."""
+    deck = tmp_path / "in.loop"
+    deck.write_text("units lj\nregion box block 0 1 0 1 0 1\ncreate_box 1 box\ncreate_atoms 1 single 0.5 0.5 0.5\n"
+                    "mass 1 1\nfix step all nve\nthermo_style custom step\nthermo 20000\nthermo_modify flush yes\n"
+                    "run 2000000000\n")
+    seen = []
+    start = time.monotonic()
+    with pytest.raises(subprocess.TimeoutExpired):
+        run_batch(deck, timeout=3, on_line=lambda line: seen.append((time.monotonic() - start, line)))
+    assert time.monotonic() - start < 15
+    assert not processes_in(tmp_path)
+    ticks = [t for t, line in seen if line.split()[:1] and line.split()[0].isdigit()]
+    assert len(ticks) > 3 and ticks[0] < 2    # read as printed, not at the end of the run
 
 
 def test_resume_needs_a_restart_file(tmp_path):

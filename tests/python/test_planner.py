@@ -197,10 +197,17 @@ def test_grains_of_one_size_lose_nothing_to_contacts(tmp_path):
     """Grains settling at (nearly) one speed seldom meet: each class keeps its terminal speed to within
     its sampling error, and the readings do not move."""
     test = SedimentationTest(read_psd(_narrow_psd(tmp_path)))
-    m = measure_contacts(test, ReducedScene(40e-6, 0.3e-3, 3e-3, fall=0.5, classes=2), tmp_path / "run")
+    progress = []
+    m = measure_contacts(test, ReducedScene(40e-6, 0.3e-3, 3e-3, fall=0.5, classes=2), tmp_path / "run",
+                         on_progress=lambda done, total: progress.append((done, total)))
     assert m.grains.sum() > 50
     assert abs(m.speed_ratio - 1).max() < 5e-4    # measured: 4e-5
     assert m.change < 1e-3
+    # The progress bar's feed: a hundred rows over the window, never backwards, ending at the total
+    # of the relaxation and the window.
+    done, total = np.array(progress).T
+    assert len(progress) > 100 and np.all(np.diff(done) >= 0) and np.all(total == total[0])
+    assert done[-1] == total[0] and m.steps < total[0] < 1.1 * m.steps
 
 
 def test_contacts_slow_the_coarse_grains_and_carry_the_fine_ones(tmp_path):

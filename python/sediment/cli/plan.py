@@ -120,7 +120,10 @@ def run(args: argparse.Namespace) -> int:
 def _measure_contacts(test, args: argparse.Namespace, tolerance: float) -> None:
     """Runs the reduced real-grain scene with contacts, and with contacts and lubrication, at once."""
     import json
+    import sys
     from concurrent.futures import ThreadPoolExecutor
+
+    from tqdm import tqdm
 
     from ..planner.contacts import ReducedScene, measure_contacts
     from ..planner.scenes import prepare
@@ -138,15 +141,29 @@ def _measure_contacts(test, args: argparse.Namespace, tolerance: float) -> None:
     # One name per measurement: its run folder and its rows in contacts.csv/json.
     kinds = ["contacts_lubrication" if setup.lubrication else "contacts" for setup in setups]
     running: set = set()
-    with ThreadPoolExecutor(max_workers=min(args.jobs, 2)) as pool:
-        folders = [prepare(args.out / kind) for kind in kinds]
-        runs = [pool.submit(measure_contacts, test, setup, folder, running=running)
-                for setup, folder in zip(setups, folders)]
-        try:
-            measured = [run.result() for run in runs]
-        except BaseException:    # Ctrl-C or a failed run: stop the other one too
-            stop_all(running)
-            raise
+    # One bar per run in steps (the relaxation and the measured window), with tqdm's ETA.
+    bars = [tqdm(total=1, desc=kind, unit="step", position=k, file=sys.stderr, dynamic_ncols=True, mininterval=0.5)
+            for k, kind in enumerate(kinds)]
+
+    def follow(bar):
+        def update(done: int, total: int) -> None:
+            bar.total = total
+            bar.update(done - bar.n)
+        return update
+
+    try:
+        with ThreadPoolExecutor(max_workers=min(args.jobs, 2)) as pool:
+            folders = [prepare(args.out / kind) for kind in kinds]
+            runs = [pool.submit(measure_contacts, test, setup, folder, running=running, on_progress=follow(bar))
+                    for setup, folder, bar in zip(setups, folders, bars)]
+            try:
+                measured = [run.result() for run in runs]
+            except BaseException:    # Ctrl-C or a failed run: stop the other one too
+                stop_all(running)
+                raise
+    finally:
+        for bar in bars:
+            bar.close()
     header, rows, summary = "", [], {}
     for kind, m in zip(kinds, measured):
         table = m.table()

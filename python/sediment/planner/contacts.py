@@ -25,6 +25,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Callable
 
 import numpy as np
 
@@ -100,8 +101,12 @@ def coarse_part(psd: PSD, smallest: float) -> tuple[PSD, float]:
 
 
 def measure_contacts(test: SedimentationTest, setup: ReducedScene, folder: Path, ranks: int = 1,
-                     running: set | None = None) -> ContactMeasurement:
-    """Runs the reduced scene in `folder` and measures each class's speed (see the module)."""
+                     running: set | None = None,
+                     on_progress: Callable[[int, int], None] | None = None) -> ContactMeasurement:
+    """Runs the reduced scene in `folder` and measures each class's speed (see the module).
+
+    `on_progress(done, total)` is called with the steps run so far, of the relaxation and the
+    measured window together, as LAMMPS prints its thermo rows (a hundred per window)."""
     coarse, share = coarse_part(test.psd, setup.smallest)
     s = test.suspension
     mass = test.initial_concentration * share * setup.width ** 2 * setup.height
@@ -114,7 +119,9 @@ def measure_contacts(test: SedimentationTest, setup: ReducedScene, folder: Path,
     folder.mkdir(parents=True, exist_ok=True)
     write_data(scene, folder / "reduced.data")
     write_text(folder / "in.reduced", _deck(scene, dt, steps))
-    out = run_batch(folder / "in.reduced", ranks=ranks, running=running)
+    relax = _relaxation_steps(steps)
+    out = run_batch(folder / "in.reduced", ranks=ranks, running=running,
+                    on_line=None if on_progress is None else _step_counter(relax, steps, on_progress))
 
     frame = (folder / "displacements.txt").read_text().split("ITEM: ATOMS")[-1].split("\n", 1)[1]
     rows = np.loadtxt(frame.splitlines(), ndmin=2)
@@ -154,12 +161,34 @@ def _thermo_column(text: str, name: str) -> list[str]:
     return values
 
 
+def _relaxation_steps(steps: int) -> int:
+    """Grains start at rest: 2 % of the window before it opens, which for these scenes is some hundred
+    relaxation times of the largest grain (sample 5: 0.095 s against 7.5e-4 s)."""
+    return max(10, steps // 50)
+
+
+def _step_counter(relax: int, steps: int, report: Callable[[int, int], None]) -> Callable[[str], None]:
+    """A reader of the reduced deck's output that reports (steps done, relax + steps) at each thermo row.
+    The deck runs `relax` steps, resets the step to 0 and runs the window: a row's step counts from
+    the start of the run it belongs to; rows stand between a "Step" header and the "Loop time" line."""
+    done_before, in_rows = [0], [False]
+
+    def read(line: str) -> None:
+        words = line.split()
+        if line.startswith("Loop time"):
+            done_before[0], in_rows[0] = relax, False
+        elif words[:1] == ["Step"]:
+            in_rows[0] = True
+        elif in_rows[0] and words and words[0].isdigit():
+            report(min(done_before[0] + int(words[0]), relax + steps), relax + steps)
+
+    return read
+
+
 def _deck(scene, dt: float, steps: int) -> str:
     s = scene.suspension
     d_max = float(scene.diameter.max())
-    # Grains start at rest: 2 % of the window before it opens, which for these scenes is some hundred
-    # relaxation times of the largest grain (sample 5: 0.095 s against 7.5e-4 s).
-    relax = max(10, steps // 50)
+    relax = _relaxation_steps(steps)
     return "\n".join([
         "# Reduced real-grain scene of `sediment plan --measure-contacts` (sediment.planner.contacts)",
         "units           si",
@@ -180,7 +209,8 @@ def _deck(scene, dt: float, steps: int) -> str:
         f"fix             overlap_guard all halt 100 v_overlap > {2 * OVERLAP_TOLERANCE:g} error hard message yes",
         f"timestep        {dt:.17g}",
         "thermo_style    custom step time c_overlap",
-        f"thermo          {max(1, steps // 20)}",
+        "thermo_modify   flush yes    # each row at once: the progress bar follows them",
+        f"thermo          {max(1, steps // 100)}",
         f"run             {relax}",
         "reset_timestep  0",
         "compute         moved all displace/atom",

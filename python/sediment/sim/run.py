@@ -13,11 +13,13 @@ import re
 import signal
 import subprocess
 import sys
+import threading
 import time
 from collections import deque
 from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Callable
 
 import numpy as np
 
@@ -255,7 +257,8 @@ class DeckOutput:
 
 
 def run_batch(deck: Path, variables: dict[str, object] | None = None, ranks: int = 1, cwd: Path | None = None,
-              timeout: float | None = None, check: bool = True, running: set | None = None) -> DeckOutput:
+              timeout: float | None = None, check: bool = True, running: set | None = None,
+              on_line: Callable[[str], None] | None = None) -> DeckOutput:
     """Runs a deck quietly (no log file) and collects what it prints.
 
     Parameters
@@ -275,6 +278,8 @@ def run_batch(deck: Path, variables: dict[str, object] | None = None, ranks: int
     running : set, optional
         Holds the run's process while it runs, for a caller running several at once to stop them
         (`stop_all`).
+    on_line : callable, optional
+        Called with each line LAMMPS prints as it prints it (a progress bar follows the thermo rows).
 
     Returns
     -------
@@ -289,14 +294,40 @@ def run_batch(deck: Path, variables: dict[str, object] | None = None, ranks: int
     proc = _start(cmd, env, cwd or deck.parent, stdout=subprocess.PIPE, stderr=subprocess.PIPE)
     if running is not None:
         running.add(proc)
+    # Standard output is read line by line as it comes (standard error by a thread, so that neither
+    # pipe can fill and stall the run); a timer stops a run that overstays its timeout.
+    stderr_text: list[str] = []
+    reader = threading.Thread(target=lambda: stderr_text.append(proc.stderr.read()), daemon=True)
+    timed_out = threading.Event()
+
+    def overstayed() -> None:
+        timed_out.set()
+        _stop(proc)
+
+    timer = threading.Timer(timeout, overstayed) if timeout is not None else None
+    lines = []
     try:
-        stdout, stderr = proc.communicate(timeout=timeout)
+        reader.start()
+        if timer is not None:
+            timer.start()
+        assert proc.stdout is not None
+        for line in proc.stdout:
+            lines.append(line)
+            if on_line is not None:
+                on_line(line)
+        proc.wait()
+        reader.join()
     except BaseException:
         _stop(proc)
         raise
     finally:
+        if timer is not None:
+            timer.cancel()
         if running is not None:
             running.discard(proc)
+    if timed_out.is_set():
+        raise subprocess.TimeoutExpired(cmd, timeout)
+    stdout, stderr = "".join(lines), "".join(stderr_text)
     wall = time.monotonic() - start
     rows, results = [], {}
     for line in stdout.splitlines():

@@ -485,7 +485,7 @@ def _deck(scene: Scene, data: str, layer_file: str) -> str:
         "",
         "thermo_style    custom step time dt f_layers" + (" c_overlap" if e.interacting else ""),
         f"thermo          {frames_every * 5}",
-        "thermo_modify   norm no",
+        "thermo_modify   norm no flush yes    # each row at once: the progress bar follows them",
         f'print           "SEDIMENT plan steps $(ceil({total_steps}/v_dt_scale)) t_end {scene.t_end:.12g}"',
         "# Two restart files in turn (one is always complete); each stage runs up to its last step, so a",
         "# resumed run skips the stages it has done and finishes the one it was in.",
