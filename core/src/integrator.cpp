@@ -60,19 +60,24 @@ Phi phis(double z)
   return phis_from_decay(z, z > decay_limit ? 0.0 : std::exp(-z));
 }
 
-void phis_many(const double *z, Phi *out, int n)
+void phis_many(const double *z, double *decay, double *phi1, double *phi2, int n)
 {
-  constexpr int chunk = 64;
-  double decay[chunk];
-  for (int start = 0; start < n; start += chunk) {
-    const int m = std::min(chunk, n - start);
-    for (int k = 0; k < m; ++k) decay[k] = -std::min(z[start + k], decay_limit);
-    exp_many(decay, decay, m);
-    for (int k = 0; k < m; ++k) {
-      const double zk = z[start + k];
-      out[start + k] = std::abs(zk) < 0.5 || zk > decay_limit ? phis(zk) : phis_from_decay(zk, decay[k]);
-    }
+  for (int k = 0; k < n; ++k) decay[k] = -std::min(z[k], decay_limit);
+  exp_many(decay, decay, n);
+  // The direct forms for all (one vector loop), then phis() where they do not hold: near zero
+  // (cancellation) and beyond the decay limit (e^-z is 0 there).
+  for (int k = 0; k < n; ++k) {
+    const double inverse = 1.0 / z[k];
+    phi1[k] = (1.0 - decay[k]) * inverse;
+    phi2[k] = (z[k] - 1.0 + decay[k]) * inverse * inverse;
   }
+  for (int k = 0; k < n; ++k)
+    if (std::abs(z[k]) < 0.5 || z[k] > decay_limit) {
+      const Phi p = phis(z[k]);
+      decay[k] = p.decay;
+      phi1[k] = p.phi1;
+      phi2[k] = p.phi2;
+    }
 }
 
 double phi1(double z) { return phis(z).phi1; }
@@ -173,11 +178,78 @@ AlongSlip advance_along(const SphereDrag &drag, double mass, double s, double a_
 
 }    // namespace
 
+void SmoothBlock::slip()
+{
+  for (int n = 0; n < size_; ++n) {
+    const double w[3] = {v_[0][n] - u_[0][n], v_[1][n] - u_[1][n], v_[2][n] - u_[2][n]};
+    const double s = std::sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]);
+    const double inverse = 1.0 / s;    // s = 0: infinite, the direction is set below
+    for (int k = 0; k < 3; ++k) dir_[k][n] = w[k] * inverse;
+    speed_[n] = s;
+  }
+  for (int n = 0; n < size_; ++n) {
+    if (speed_[n] > 0.0) continue;
+    // At rest: along the drive, if there is one (NaN slips come here too and stay NaN below).
+    const double a[3] = {a_[0][n], a_[1][n], a_[2][n]};
+    const double a_norm = std::sqrt(dot(a, a));
+    for (int k = 0; k < 3; ++k) dir_[k][n] = a_norm > 0.0 ? a[k] / a_norm : k == 2 ? 1.0 : 0.0;
+  }
+  for (int n = 0; n < size_; ++n) {
+    a_par_[n] = a_[0][n] * dir_[0][n] + a_[1][n] * dir_[1][n] + a_[2][n] * dir_[2][n];
+    reynolds_[n] = reynolds_per_speed_[n] * speed_[n];
+  }
+}
+
+void SmoothBlock::rates(const DragModel &model, double dt)
+{
+  model.curves(reynolds_, voidage_, curve_, size_);
+  for (int n = 0; n < size_; ++n) {
+    const double k = rate_per_g_[n];
+    c_[n] = a_par_[n] + speed_[n] * k * curve_[n].re_dg;
+    z_[0][n] = k * (curve_[n].g + curve_[n].re_dg) * dt;
+    z_[1][n] = k * curve_[n].g * dt;
+  }
+}
+
+void SmoothBlock::advance_all(double dt)
+{
+  for (int n = 0; n < size_; ++n) {
+    // Along the slip: the slip's exact advance under ds/dt = c - k s (advance()); across it, the
+    // linear step. The weights of a_n are those of a_{n+1} (along_, across_) taken from the ETD2
+    // weights; drag_step_final adds a_{n+1}.
+    const double speed = speed_[n] * decay_[0][n] + c_[n] * dt * phi1_[0][n];
+    const double distance = speed_[n] * dt * phi1_[0][n] + c_[n] * dt * dt * phi2_[0][n];
+    along_[n] = dt * phi2_[0][n];
+    across_[n] = dt * phi2_[1][n];
+    const double along_now = speed - along_[n] * a_par_[n];    // along the slip, with a_n's share
+    const double across_now = dt * (phi1_[1][n] - phi2_[1][n]);
+    const double across_drift = dt * dt * phi2_[1][n];
+    for (int k = 0; k < 3; ++k) {
+      const double a_perp = a_[k][n] - a_par_[n] * dir_[k][n];
+      dx_[k][n] = u_[k][n] * dt + distance * dir_[k][n] + across_drift * a_perp;
+      v_[k][n] = u_[k][n] + along_now * dir_[k][n] + across_now * a_perp;
+    }
+  }
+}
+
+void SmoothBlock::step(const DragModel &model, double dt)
+{
+  slip();
+  rates(model, dt);
+  phis_many(z_[0], decay_[0], phi1_[0], phi2_[0], size_);
+  phis_many(z_[1], decay_[1], phi1_[1], phi2_[1], size_);
+  advance_all(dt);
+}
+
 StepCorrection smooth_step_initial(const SphereDrag &drag, double inverse_mass, const double a[3],
                                    const double u[3], double dt, double v[3], double dx[3])
 {
-  const SmoothLinearisation lin = smooth_linearise(drag, inverse_mass, a, u, dt, v);
-  return smooth_advance(lin, phis(lin.z_along), phis(lin.z_across), a, u, dt, v, dx);
+  SmoothBlock block;
+  block.add(drag, inverse_mass, a, u, v);
+  block.step(*drag.model, dt);
+  block.velocity(0, v);
+  block.displacement(0, dx);
+  return block.correction(0);
 }
 
 StepCorrection set_valued_step_initial(const SphereDrag &drag, double mass, const double a[3],

@@ -167,43 +167,26 @@ template <FixNVESphereFluid::HalfStep path, class Lookup> void FixNVESphereFluid
     }
   };
 
-  // Atoms under a smooth nonlinear law wait in a block of one law: their slips one by one, then the
-  // law's curves together, the rates, the exponentials together, then each atom's advance. The
-  // logarithms and exponentials of a block take vector instructions (sediment/batch_math.hpp), and
-  // each stage's atoms are independent, so the processor overlaps them instead of waiting on one
-  // atom's chain of square roots, divisions and exponentials.
+  // Atoms under a smooth nonlinear law wait in a block of one law (sediment::SmoothBlock), which
+  // steps them together, each stage one vector loop over the block; then each is finished here.
   struct Waiting {
     int i;
-    sediment::SphereDrag drag;
-    sediment::SmoothLinearisation lin;
-    double a[3];
-    const double *flow;
     double spin_rate;
     double per_mass;
   };
-  constexpr int block_size = 32;
-  Waiting block[block_size];
-  double reynolds[block_size], voidage[block_size], rates[2 * block_size];
-  sediment::DragCurve curves[block_size];
-  sediment::Phi phis[2 * block_size];    // along and across the slip of each atom in turn
+  sediment::SmoothBlock block;
+  Waiting waiting[sediment::SmoothBlock::capacity];
   const sediment::DragModel *block_model = nullptr;
-  int waiting = 0;
   auto step_block = [&]() {
-    block_model->curves(reynolds, voidage, curves, waiting);
-    for (int n = 0; n < waiting; ++n) {
-      Waiting &b = block[n];
-      sediment::smooth_rates(b.drag, b.per_mass, curves[n], dt, b.lin);
-      rates[2 * n] = b.lin.z_along;
-      rates[2 * n + 1] = b.lin.z_across;
-    }
-    sediment::phis_many(rates, phis, 2 * waiting);
-    for (int n = 0; n < waiting; ++n) {
-      const Waiting &b = block[n];
+    block.step(*block_model, dt);
+    for (int n = 0; n < block.size(); ++n) {
+      const Waiting &b = waiting[n];
       double dx[3];
-      finish(b.i, sediment::smooth_advance(b.lin, phis[2 * n], phis[2 * n + 1], b.a, b.flow, dt, v[b.i], dx), dx,
-             b.spin_rate, b.per_mass);
+      block.velocity(n, v[b.i]);
+      block.displacement(n, dx);
+      finish(b.i, block.correction(n), dx, b.spin_rate, b.per_mass);
     }
-    waiting = 0;
+    block.clear();
   };
 
   for (int i = 0; i < nlocal; ++i) {
@@ -233,25 +216,16 @@ template <FixNVESphereFluid::HalfStep path, class Lookup> void FixNVESphereFluid
       continue;
     }
     if (path == HalfStep::Blocked && sediment::step_kind(sphere) == sediment::StepKind::Smooth) {
-      if (waiting > 0 && sphere.model != block_model) step_block();
+      if (block.size() > 0 && sphere.model != block_model) step_block();
       block_model = sphere.model;
-      Waiting &b = block[waiting];
-      b.i = i;
-      b.drag = sphere;
-      b.lin = sediment::smooth_slip(a, flow, v[i]);
-      reynolds[waiting] = sediment::smooth_reynolds(sphere, b.lin);
-      voidage[waiting] = sphere.scale.voidage;
-      std::copy(a, a + 3, b.a);
-      b.flow = flow;
-      b.spin_rate = spin_rate;
-      b.per_mass = per_mass;
-      if (++waiting == block_size) step_block();
+      waiting[block.add(sphere, per_mass, a, flow, v[i])] = {i, spin_rate, per_mass};
+      if (block.full()) step_block();
       continue;
     }
     finish(i, sediment::drag_step_initial(sphere, per_mass, a, flow, dt, v[i], dx, &w[DRAG_MEMO]), dx, spin_rate,
            per_mass);
   }
-  if (path == HalfStep::Blocked && waiting > 0) step_block();
+  if (path == HalfStep::Blocked && block.size() > 0) step_block();
   check_finite();
   settle_on_floor();
 }

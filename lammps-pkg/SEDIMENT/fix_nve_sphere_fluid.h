@@ -55,7 +55,7 @@ class FixNVESphereFluid : public Fix {
   class FixFluidDrag *uniform;
   // How the first half steps the spheres in a fluid, decided in setup(): General (any law, one
   // sphere at a time), Blocked (some fluid/drag has a smooth nonlinear law: its spheres are stepped
-  // in blocks, sediment::smooth_linearise) or Linear (the uniform drag is linear in the slip, F = c d w:
+  // in blocks, sediment::SmoothBlock) or Linear (the uniform drag is linear in the slip, F = c d w:
   // c is taken once per run, and the step is sediment::linear_step_initial with no per-sphere
   // choice of law).
   enum class HalfStep { General, Blocked, Linear };

@@ -10,6 +10,8 @@
 #include <cmath>
 #include <functional>
 #include <limits>
+#include <array>
+#include <vector>
 
 using namespace sediment;
 
@@ -231,6 +233,75 @@ TEST_F(Bingham, BalanceInsideTheCdJumpStaysAtTheJumpForEveryStep)
         vmax = std::max(vmax, std::abs(-s.v[2] - jumps[j].speed));
       }
       EXPECT_LT(vmax, 1e-9 * jumps[j].speed) << "jump " << j << " dt " << dt;
+    }
+  }
+}
+
+TEST(SmoothBlock, EachSphereStepsAsAloneAndAsTheNewtonStep)
+{
+  // Spheres of three sizes under Dallavalle's law and under Di Felice's at three voidages, with
+  // slips across, along and against the drive, at rest (the direction is the drive's) and with
+  // no drive at all. In a block they step bit for bit as in a block of one, wherever they sit and
+  // whoever their neighbours are, and as the piecewise Newton step of a law with set-valued points
+  // (set_valued_step_initial: its own arithmetic, scalar exponentials; for a smooth law one piece).
+  const Fluid fluid{998.2, 1.002e-3, 0.0};
+  for (const DragLaw law : {DragLaw::Dallavalle, DragLaw::DiFelice}) {
+    const DragModel model(law, fluid);
+    struct Sphere {
+      SphereDrag drag;
+      double inverse_mass, a[3], u[3], v[3];
+    };
+    std::vector<Sphere> spheres;
+    int k = 0;
+    for (double d : {3e-6, 3e-5, 3e-4})
+      for (double voidage : {1.0, 0.9, 0.6})
+        for (const auto &v : {std::array<double, 3>{1e-4, 0.0, -3e-4}, std::array<double, 3>{0.0, 0.0, -2e-3},
+                              std::array<double, 3>{0.0, 0.0, 5e-3}, std::array<double, 3>{0.0, 0.0, 0.0},
+                              std::array<double, 3>{-1e-3, 2e-3, 0.5}}) {
+          Sphere sp{{&model, d, {1.0, 1.0, voidage}}, 1.0 / (2650.0 * sphere_volume(d)), {0.0, 0.3, -6.0},
+                    {0.0, 0.0, 1e-5 * (k % 3)}, {v[0], v[1], v[2]}};
+          if (k++ % 7 == 3) sp.a[0] = sp.a[1] = sp.a[2] = 0.0;    // no drive: at rest it stays
+          spheres.push_back(sp);
+        }
+    const double dt = 1e-4;
+    std::vector<std::array<double, 3>> v_block(spheres.size()), dx_block(spheres.size());
+    std::vector<StepCorrection> corr_block(spheres.size());
+    // Blocks of 32, 32 and the rest, starting one sphere in: every place of a block is taken.
+    SmoothBlock block;
+    const int n = static_cast<int>(spheres.size());
+    for (int start = 1; start < n + 1; start += SmoothBlock::capacity) {
+      std::vector<int> members;
+      for (int j = start; j < std::min(n + 1, start + SmoothBlock::capacity); ++j) members.push_back(j % n);
+      for (int j : members) block.add(spheres[j].drag, spheres[j].inverse_mass, spheres[j].a, spheres[j].u, spheres[j].v);
+      block.step(model, dt);
+      for (size_t m = 0; m < members.size(); ++m) {
+        block.velocity(static_cast<int>(m), v_block[members[m]].data());
+        block.displacement(static_cast<int>(m), dx_block[members[m]].data());
+        corr_block[members[m]] = block.correction(static_cast<int>(m));
+      }
+      block.clear();
+    }
+    for (int j = 0; j < n; ++j) {
+      const Sphere &sp = spheres[j];
+      SCOPED_TRACE(testing::Message() << drag_law_name(law) << " sphere " << j);
+      double v_alone[3] = {sp.v[0], sp.v[1], sp.v[2]}, dx_alone[3];
+      const StepCorrection alone = smooth_step_initial(sp.drag, sp.inverse_mass, sp.a, sp.u, dt, v_alone, dx_alone);
+      double v_newton[3] = {sp.v[0], sp.v[1], sp.v[2]}, dx_newton[3];
+      const StepCorrection newton =
+          set_valued_step_initial(sp.drag, 1.0 / sp.inverse_mass, sp.a, sp.u, dt, v_newton, dx_newton);
+      EXPECT_EQ(corr_block[j].along, alone.along);
+      EXPECT_EQ(corr_block[j].across, alone.across);
+      EXPECT_NEAR(corr_block[j].along, newton.along, 1e-12 * newton.along);
+      EXPECT_NEAR(corr_block[j].across, newton.across, 1e-12 * newton.across);
+      const double scale = std::abs(sp.v[0]) + std::abs(sp.v[1]) + std::abs(sp.v[2]) + dt * 6.0;
+      for (int c = 0; c < 3; ++c) {
+        EXPECT_EQ(v_block[j][c], v_alone[c]);
+        EXPECT_EQ(dx_block[j][c], dx_alone[c]);
+        EXPECT_EQ(corr_block[j].dir[c], alone.dir[c]);
+        EXPECT_NEAR(v_block[j][c], v_newton[c], 1e-12 * scale);
+        EXPECT_NEAR(dx_block[j][c], dx_newton[c], 1e-12 * scale * dt);
+        EXPECT_NEAR(corr_block[j].dir[c], newton.dir[c], 1e-15);
+      }
     }
   }
 }

@@ -32,8 +32,9 @@ struct Phi {
   double phi2;
 };
 Phi phis(double z);
-// phis of n rates at once, their exponentials taken together (exp_many): within a few ulp of phis.
-void phis_many(const double *z, Phi *out, int n);
+// phis of n rates at once, as three arrays, their exponentials taken together (exp_many): within a
+// few ulp of phis.
+void phis_many(const double *z, double *decay, double *phi1, double *phi2, int n);
 
 // phis(z) remembered for the last z a sphere saw, in memo = {z, decay, phi1, phi2} (z NaN: empty).
 // With a fixed step and a linear drag z does not change, so the exponential is taken once.
@@ -80,82 +81,74 @@ inline Segment advance(const Phi &p, double s0, double c, double t)
   return {s0 * p.decay + c * t * p.phi1, s0 * t * p.phi1 + c * t * t * p.phi2};
 }
 
-// The step of a smooth law (DragModel::smooth(): no yield, no Cd jump) in two parts, so that an
-// integrator can take the exponentials of a block of spheres together (independent work instead
-// of one long chain of dependent operations per sphere). One evaluation of the law gives the
-// Newton rate along the slip, k (G + Re G') / m, and the secant rate across it, k G / m
-// (F = k s G(Re), Re = K s); z_along and z_across are those rates times dt.
-struct SmoothLinearisation {
-  double dir[3];
-  double s;
-  double a_par;
-  double c;    // ds/dt = c - rate_along s, c = a_par - (F(s) - F'(s) s) / m
-  double z_along;
-  double z_across;
+// The step of a smooth law (DragModel::smooth(): no yield, no Cd jump) for a block of spheres under
+// one law, held as a structure of arrays: each stage (slip and direction, the law's curve, the rates,
+// their exponentials, the advance) is one loop over the block of independent spheres, which the
+// compiler turns into vector instructions and the processor overlaps, instead of one long chain of
+// square roots, divisions and exponentials per sphere. One evaluation of the law gives the Newton
+// rate along the slip, k (G + Re G') / m, and the secant rate across it, k G / m (F = k s G(Re),
+// Re = K s). The arithmetic of each sphere does not depend on the block it is in, nor on where.
+class SmoothBlock {
+ public:
+  static constexpr int capacity = 32;
+
+  int size() const { return size_; }
+  bool full() const { return size_ == capacity; }
+  void clear() { size_ = 0; }
+  // Adds a sphere (drag.model smooth and nonlinear, the block's law) with its velocity v, the flow u,
+  // the non-drag acceleration a_n and 1 / m; returns its place in the block.
+  int add(const SphereDrag &drag, double inverse_mass, const double a[3], const double u[3], const double v[3])
+  {
+    const int n = size_++;
+    for (int k = 0; k < 3; ++k) {
+      v_[k][n] = v[k];
+      u_[k][n] = u[k];
+      a_[k][n] = a[k];
+    }
+    reynolds_per_speed_[n] = drag.model->smooth_reynolds_per_speed(drag.diameter);
+    rate_per_g_[n] = drag.model->smooth_drag_per_speed(drag.diameter, drag.scale) * inverse_mass;
+    voidage_[n] = drag.scale.voidage;
+    return n;
+  }
+  // Steps every sphere of the block over dt under `model`, the law of all of them.
+  void step(const DragModel &model, double dt);
+  // After step(): the mid-step velocity, the displacement and the weights of a_{n+1} of sphere n.
+  void velocity(int n, double v[3]) const { copy3(v_, n, v); }
+  void displacement(int n, double dx[3]) const { copy3(dx_, n, dx); }
+  StepCorrection correction(int n) const
+  {
+    StepCorrection corr;
+    corr.along = along_[n];
+    corr.across = across_[n];
+    copy3(dir_, n, corr.dir);
+    return corr;
+  }
+
+ private:
+  static void copy3(const double (&from)[3][capacity], int n, double to[3])
+  {
+    to[0] = from[0][n];
+    to[1] = from[1][n];
+    to[2] = from[2][n];
+  }
+  void slip();
+  void rates(const DragModel &model, double dt);
+  void advance_all(double dt);
+
+  int size_ = 0;
+  // Per sphere, component first: velocity (the mid-step velocity after step()), flow, a_n,
+  // direction of the slip, displacement.
+  double v_[3][capacity], u_[3][capacity], a_[3][capacity], dir_[3][capacity], dx_[3][capacity];
+  double reynolds_per_speed_[capacity], rate_per_g_[capacity], voidage_[capacity];    // K, k / m, eps
+  double speed_[capacity], a_par_[capacity], reynolds_[capacity];
+  DragCurve curve_[capacity];
+  double c_[capacity];                                       // ds/dt = c - rate_along s
+  double z_[2][capacity];                                    // rates x dt along and across the slip
+  double decay_[2][capacity], phi1_[2][capacity], phi2_[2][capacity];
+  double along_[capacity], across_[capacity];
 };
 
-// The slip and its direction, the first stage of smooth_linearise (rates still zero).
-inline SmoothLinearisation smooth_slip(const double a[3], const double u[3], const double v[3])
-{
-  SmoothLinearisation lin{{0.0, 0.0, 1.0}, 0.0, 0.0, 0.0, 0.0, 0.0};
-  const double w[3] = {v[0] - u[0], v[1] - u[1], v[2] - u[2]};
-  const double s = std::sqrt(dot(w, w));
-  if (s > 0.0) {
-    const double inv_s = 1.0 / s;
-    for (int k = 0; k < 3; ++k) lin.dir[k] = w[k] * inv_s;
-  } else if (const double a_norm = std::sqrt(dot(a, a)); a_norm > 0.0) {
-    for (int k = 0; k < 3; ++k) lin.dir[k] = a[k] / a_norm;    // at rest: along the drive
-  }
-  lin.s = s;
-  lin.a_par = dot(a, lin.dir);
-  return lin;
-}
-
-// The law's Reynolds number at the slip of smooth_slip.
-inline double smooth_reynolds(const SphereDrag &drag, const SmoothLinearisation &lin)
-{
-  return drag.model->smooth_reynolds_per_speed(drag.diameter) * lin.s;
-}
-
-// The rates, from the law's curve g at that Reynolds number.
-inline void smooth_rates(const SphereDrag &drag, double inverse_mass, const DragCurve &g, double dt,
-                         SmoothLinearisation &lin)
-{
-  const double k = drag.model->smooth_drag_per_speed(drag.diameter, drag.scale) * inverse_mass;
-  lin.c = lin.a_par + lin.s * k * g.re_dg;
-  lin.z_along = k * (g.g + g.re_dg) * dt;
-  lin.z_across = k * g.g * dt;
-}
-
-inline SmoothLinearisation smooth_linearise(const SphereDrag &drag, double inverse_mass, const double a[3],
-                                            const double u[3], double dt, const double v[3])
-{
-  SmoothLinearisation lin = smooth_slip(a, u, v);
-  smooth_rates(drag, inverse_mass, drag.model->curve(smooth_reynolds(drag, lin), drag.scale.voidage), dt, lin);
-  return lin;
-}
-
-// The second part, given along = phis(z_along) and across = phis(z_across).
-inline StepCorrection smooth_advance(const SmoothLinearisation &lin, const Phi &along, const Phi &across,
-                                     const double a[3], const double u[3], double dt, double v[3], double dx[3])
-{
-  StepCorrection corr;
-  const double *dir = lin.dir;
-  const Segment full = advance(along, lin.s, lin.c, dt);
-  corr.along = dt * along.phi2;
-  corr.across = dt * across.phi2;
-  for (int n = 0; n < 3; ++n) {
-    corr.dir[n] = dir[n];
-    const double a_perp = a[n] - lin.a_par * dir[n];
-    // The share of a_n in the ETD2 weights; drag_step_final adds the same share of a_{n+1}.
-    v[n] = u[n] + full.speed * dir[n] + a_perp * dt * across.phi1 - corr.along * lin.a_par * dir[n] -
-        corr.across * a_perp;
-    dx[n] = u[n] * dt + full.distance * dir[n] + a_perp * dt * dt * across.phi2;
-  }
-  return corr;
-}
-
-// Both parts for one sphere (out of line, like the next).
+// The step of a smooth law for one sphere (a block of one).
 StepCorrection smooth_step_initial(const SphereDrag &drag, double inverse_mass, const double a[3],
                                    const double u[3], double dt, double v[3], double dx[3]);
 
