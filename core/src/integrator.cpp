@@ -40,6 +40,9 @@ inline Phi phis_from_decay(double z, double decay)
 // Beyond z = 745.13 e^-z rounds to 0, which libm reaches through its slow underflow path (an
 // eighth of a sedimentation test's step, where dt is 1e5 relaxation times of the fine grains).
 constexpr double decay_limit = 745.2;
+// Up to here e^-z is a normal number, which glibc's vector exp computes in its fast path; past it
+// (subnormal or zero) the vector exp falls back to the scalar exp, lane by lane, and its slow path.
+constexpr double normal_decay_limit = 708.0;
 
 }    // namespace
 
@@ -62,17 +65,17 @@ Phi phis(double z)
 
 void phis_many(const double *z, double *decay, double *phi1, double *phi2, int n)
 {
-  for (int k = 0; k < n; ++k) decay[k] = -std::min(z[k], decay_limit);
+  for (int k = 0; k < n; ++k) decay[k] = -std::min(z[k], normal_decay_limit);
   exp_many(decay, decay, n);
   // The direct forms for all (one vector loop), then phis() where they do not hold: near zero
-  // (cancellation) and beyond the decay limit (e^-z is 0 there).
+  // (cancellation) and past the normal range of e^-z (subnormal, or 0 beyond the decay limit).
   for (int k = 0; k < n; ++k) {
     const double inverse = 1.0 / z[k];
     phi1[k] = (1.0 - decay[k]) * inverse;
     phi2[k] = (z[k] - 1.0 + decay[k]) * inverse * inverse;
   }
   for (int k = 0; k < n; ++k)
-    if (std::abs(z[k]) < 0.5 || z[k] > decay_limit) {
+    if (std::abs(z[k]) < 0.5 || z[k] > normal_decay_limit) {
       const Phi p = phis(z[k]);
       decay[k] = p.decay;
       phi1[k] = p.phi1;
