@@ -11,6 +11,7 @@ import pytest
 
 from sediment import _core, cli
 from sediment.lab.psd import discretise, read_psd
+from sediment.sim.run import run_batch
 from sediment.sim.scene import Cylinder, Effects, plan, terminal_speed, write
 
 PSDS = Path(__file__).resolve().parents[2] / "examples" / "granulometry" / "psd"
@@ -71,6 +72,18 @@ def test_time_steps_double_after_the_largest_grains_have_left():
 def test_a_short_test_ends_on_time():
     scene = plan(read_psd(PSDS / "sample5.csv"), particles=2000, t_end=1e-6)
     assert sum(dt * n for dt, n in scene.stages()) == pytest.approx(1e-6, rel=1e-12)
+
+
+def test_the_deck_prints_where_the_time_goes_when_asked(tmp_path):
+    """`-var timing yes` gives LAMMPS's timing breakdown after each stage (benchmarks/planner.py
+    --scaling reads it); by default the stages stay quiet."""
+    scene = plan(read_psd(PSDS / "sample5.csv"), particles=500, t_end=600.0)
+    write(scene, tmp_path)
+    stages = len(scene.stages())
+    quiet = run_batch(tmp_path / "in.sedimentation")
+    timed = run_batch(tmp_path / "in.sedimentation", {"timing": "yes", "overwrite": "yes"})
+    assert len(quiet.loops) == len(timed.loops) == stages > 1
+    assert quiet.text.count("Modify  |") == 0 and timed.text.count("Modify  |") == stages
 
 
 def test_contacts_need_real_grains_and_set_the_step(tmp_path):

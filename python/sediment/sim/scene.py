@@ -442,6 +442,7 @@ def _deck(scene: Scene, data: str, layer_file: str) -> str:
         "variable        field_every index 1    # steps between refreshes of the concentration field the hindered drag reads",
         "variable        resume index no     # yes: start from ${restart_file} (sediment run --resume)",
         "variable        restart_file index restart.a.bin",
+        "variable        timing index no     # yes: LAMMPS's timing breakdown after each stage (where the time goes)",
         "",
         "# The weights (real grains each atom stands for) come from the data file, or back from the restart file.",
         'if "${resume} == yes" then "read_restart ${restart_file}" "fix weights all property/atom d_weight" else &',
@@ -494,7 +495,7 @@ def _deck(scene: Scene, data: str, layer_file: str) -> str:
     ]
     for k, (dt, steps) in enumerate(stages, start=1):
         lines += [f"variable        stage_end equal $(v_stage_end+ceil({steps}/v_dt_scale))",
-                  f'if "$(step) < ${{stage_end}}" then "timestep $({dt:.17g}*v_dt_scale)" "run ${{stage_end}} upto post no"']
+                  f'if "$(step) < ${{stage_end}}" then "timestep $({dt:.17g}*v_dt_scale)" "run ${{stage_end}} upto post ${{timing}}"']
     return "\n".join(lines) + "\n"
 
 
