@@ -216,6 +216,11 @@ template <FixNVESphereFluid::HalfStep path, class Lookup> void FixNVESphereFluid
       continue;
     }
     if (path == HalfStep::Blocked && sediment::step_kind(sphere) == sediment::StepKind::Smooth) {
+      if (rests_on_floor(i, flow)) {    // its step would end where it starts: skipped
+        w[ALONG] = w[ACROSS] = w[SPIN] = 0.0;
+        omega[i][0] = omega[i][1] = omega[i][2] = 0.0;
+        continue;
+      }
       if (block.size() > 0 && sphere.model != block_model) step_block();
       block_model = sphere.model;
       waiting[block.add(sphere, per_mass, a, flow, v[i])] = {i, spin_rate, per_mass};
@@ -363,6 +368,22 @@ void FixNVESphereFluid::find_non_finite() const
                "(x {} {} {}, v {} {} {}, f {} {} {}); check the forces acting on it and the timestep",
                atom->tag[i], update->ntimestep, x[0], x[1], x[2], v[0], v[1], v[2], f[0], f[1], f[2]);
   }
+}
+
+bool FixNVESphereFluid::rests_on_floor(int i, const double *flow) const
+{
+  // At rest on the floor, pressed onto it or not pushed at all, with nothing that moves it along
+  // the floor (force or flow): under a smooth drag law the step would take it into the floor and
+  // settle_on_floor would put it back where it was, at rest, its rotation stopped; the second half
+  // would add a velocity into the floor that settle_on_floor takes away again. So the step is the
+  // identity, bit for bit. (A yield-stress fluid is not smooth: its spheres take their step, which
+  // counts them as stuck.)
+  if (floor_axis < 0) return false;
+  const double *x = atom->x[i], *v = atom->v[i], *f = atom->f[i];
+  if (x[floor_axis] != floor_level + atom->radius[i] || f[floor_axis] > 0.0) return false;
+  for (int k = 0; k < 3; ++k)
+    if (v[k] != 0.0 || flow[k] != 0.0 || (k != floor_axis && f[k] != 0.0)) return false;
+  return true;
 }
 
 void FixNVESphereFluid::settle_on_floor()

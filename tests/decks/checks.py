@@ -514,13 +514,36 @@ def concentration_grid(np_ranks: int):
 
 
 # ---- deposit on a floor, weighted layers -----------------------------------------------------
+def deposit_run(np_ranks: int, law: str) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """The deposit deck under `law`: the states at 5 s and 50 s, the first layer profile, and the
+    state after ten spheres were pushed along the floor and ten lifted off it for 5 s."""
+    with tempfile.TemporaryDirectory() as tmp:
+        files = {name: Path(tmp) / f"{name}.txt" for name in ("mid", "final", "profile", "pushed")}
+        run_deck("deposit.lmp", {"law": law, **files}, np_ranks)
+        at5, at50 = np.loadtxt(files["mid"], skiprows=9), np.loadtxt(files["final"], skiprows=9)
+        first = np.loadtxt(files["profile"], comments="#", skiprows=4, max_rows=101)[:, 2]
+        pushed = np.loadtxt(files["pushed"], skiprows=9)
+    return at5, at50, first, pushed
+
+
+def check_moved_off_rest(law: str, at50: np.ndarray, pushed: np.ndarray) -> None:
+    """Settled spheres stay exactly at rest, unless pushed along the floor (they slide and stay on
+    it) or lifted off it (under a smooth law the step of a resting sphere is skipped: only while
+    nothing moves it)."""
+    x0, (x, z, vz, r) = at50[:, 7], pushed[:, 1:5].T    # at50: id z vz radius weight vx vy x
+    ids = pushed[:, 0]
+    push, lift, rest = ids <= 10, (ids > 10) & (ids <= 20), ids > 20
+    report(f"deposit under {law}: settled spheres still at rest {bool(np.all(z[rest] == r[rest]))}; "
+           f"pushed ones slid {np.min(np.abs(x[push] - x0[push])):.2e} m at least and stay on the floor "
+           f"{bool(np.all(z[push] == r[push]))}; lifted ones rose {np.min(z[lift] - r[lift]):.2e} m at least")
+    assert np.all(z[rest] == r[rest]) and np.all(vz[rest] == 0)
+    assert np.all(z[push] == r[push]) and np.all(x[push] != x0[push])
+    assert np.all(z[lift] > r[lift])
+
+
 @check
 def deposit(np_ranks: int):
-    with tempfile.TemporaryDirectory() as tmp:
-        mid, final, profile = (Path(tmp) / name for name in ("mid.txt", "final.txt", "profile.txt"))
-        run_deck("deposit.lmp", {"mid": mid, "final": final, "profile": profile}, np_ranks)
-        at5, at50 = np.loadtxt(mid, skiprows=9), np.loadtxt(final, skiprows=9)
-        first = np.loadtxt(profile, comments="#", skiprows=4, max_rows=101)[:, 2]
+    at5, at50, first, pushed = deposit_run(np_ranks, "stokes")
     z, vz, r, weight = at5[:, 1], at5[:, 2], at5[:, 3], at5[:, 4]
     vt, tau = stokes_reference(2 * r, 2650.0)
     t = 5.0
@@ -538,6 +561,10 @@ def deposit(np_ranks: int):
     report(f"weighted layers: sum of fraction x layer volume = {weighted:.6e} m3, sum of weight x sphere volume "
            f"= {solid:.6e} m3 (relative {abs(weighted - solid) / solid:.1e}); all {len(at50)} on the floor at 50 s")
     assert abs(weighted - solid) < 1e-12 * solid
+    check_moved_off_rest("stokes", at50, pushed)
+    _, at50, _, pushed = deposit_run(np_ranks, "dallavalle")
+    assert np.all(at50[:, 1] == at50[:, 3]) and np.all(at50[:, [2, 5, 6]] == 0)
+    check_moved_off_rest("dallavalle", at50, pushed)
 
 
 # ---- lubrication ------------------------------------------------------------------------------
