@@ -204,6 +204,15 @@ template <FixNVESphereFluid::HalfStep path, class Lookup> void FixNVESphereFluid
       continue;
     }
 
+    // A sphere resting on the floor whose step would end where it starts (rests_on_floor) is skipped;
+    // a set-valued law would count it as stuck, so it takes its step.
+    if (rests_on_floor(i, flow) &&
+        (path == HalfStep::Linear || sediment::step_kind(sphere) != sediment::StepKind::SetValued)) {
+      w[ALONG] = w[ACROSS] = w[SPIN] = 0.0;
+      omega[i][0] = omega[i][1] = omega[i][2] = 0.0;
+      continue;
+    }
+
     // Divisions dominate a cheap step: one for the forces and one for the torques, as fix nve/sphere
     // (fix fluid requires coherent units: ftm2v = 1, so per_mass is also the drag step's 1 / m).
     const double per_mass = ftm2v / rmass[i];
@@ -216,11 +225,6 @@ template <FixNVESphereFluid::HalfStep path, class Lookup> void FixNVESphereFluid
       continue;
     }
     if (path == HalfStep::Blocked && sediment::step_kind(sphere) == sediment::StepKind::Smooth) {
-      if (rests_on_floor(i, flow)) {    // its step would end where it starts: skipped
-        w[ALONG] = w[ACROSS] = w[SPIN] = 0.0;
-        omega[i][0] = omega[i][1] = omega[i][2] = 0.0;
-        continue;
-      }
       if (block.size() > 0 && sphere.model != block_model) step_block();
       block_model = sphere.model;
       waiting[block.add(sphere, per_mass, a, flow, v[i])] = {i, spin_rate, per_mass};
@@ -373,11 +377,10 @@ void FixNVESphereFluid::find_non_finite() const
 bool FixNVESphereFluid::rests_on_floor(int i, const double *flow) const
 {
   // At rest on the floor, pressed onto it or not pushed at all, with nothing that moves it along
-  // the floor (force or flow): under a smooth drag law the step would take it into the floor and
-  // settle_on_floor would put it back where it was, at rest, its rotation stopped; the second half
-  // would add a velocity into the floor that settle_on_floor takes away again. So the step is the
-  // identity, bit for bit. (A yield-stress fluid is not smooth: its spheres take their step, which
-  // counts them as stuck.)
+  // the floor (force or flow): under a drag law without set-valued points (linear or smooth) the
+  // step would take it into the floor and settle_on_floor would put it back where it was, at rest,
+  // its rotation stopped; the second half would add a velocity into the floor that settle_on_floor
+  // takes away again. So the step is the identity, bit for bit.
   if (floor_axis < 0) return false;
   const double *x = atom->x[i], *v = atom->v[i], *f = atom->f[i];
   if (x[floor_axis] != floor_level + atom->radius[i] || f[floor_axis] > 0.0) return false;
