@@ -61,14 +61,22 @@ static inline SphereArrays sphere_arrays(const Atom *atom)
 }
 
 // The first half of fix nve/sphere's step: kick, then drift over the whole step.
-static inline void nve_sphere_kick_drift(double *x, double *v, double *omega, const double *f,
-                                         const double *torque, double radius, double rmass, double dtf, double dt)
+// The sum of an atom's position and velocity: NaN or inf when any of them is (or when it overflows).
+static inline double state_sum(const double x[3], const double v[3])
 {
-  const auto [v0, v1, v2] = nve_sphere_kick(v, omega, f, torque, radius, rmass, dtf);
-  const double x0 = x[0] + dt * v0, x1 = x[1] + dt * v1, x2 = x[2] + dt * v2;
-  x[0] = x0;
-  x[1] = x1;
-  x[2] = x2;
+  return (x[0] + x[1] + x[2]) + (v[0] + v[1] + v[2]);
+}
+
+// Returns the state_sum of the new position and velocity, for the check of a finite state.
+static inline double nve_sphere_kick_drift(double *x, double *v, double *omega, const double *f,
+                                           const double *torque, double radius, double rmass, double dtf, double dt)
+{
+  const std::array<double, 3> kicked = nve_sphere_kick(v, omega, f, torque, radius, rmass, dtf);
+  const double new_x[3] = {x[0] + dt * kicked[0], x[1] + dt * kicked[1], x[2] + dt * kicked[2]};
+  x[0] = new_x[0];
+  x[1] = new_x[1];
+  x[2] = new_x[2];
+  return state_sum(new_x, kicked.data());
 }
 
 FixNVESphereFluid::FixNVESphereFluid(LAMMPS *lmp, int narg, char **arg) :
@@ -147,13 +155,16 @@ template <FixNVESphereFluid::HalfStep path, class Lookup> void FixNVESphereFluid
   static const double no_flow[3] = {0.0, 0.0, 0.0};
 
   // What follows the drag step of atom i: position, rotation, the weights for the second half
-  // (taken per unit mass and moment of inertia, so the second half divides by neither).
+  // (taken per unit mass and moment of inertia, so the second half divides by neither). Returns
+  // the state_sum of the new position and velocity, for the check of a finite state.
   auto finish = [&](int i, const sediment::StepCorrection &corr, const double dx[3], double spin_rate,
                     double per_mass) {
     double *w = weights[i];
-    x[i][0] += dx[0];
-    x[i][1] += dx[1];
-    x[i][2] += dx[2];
+    const double new_x[3] = {x[i][0] + dx[0], x[i][1] + dx[1], x[i][2] + dx[2]};
+    x[i][0] = new_x[0];
+    x[i][1] = new_x[1];
+    x[i][2] = new_x[2];
+    const double state = state_sum(new_x, v[i]);
     if (corr.state == sediment::SlipState::Stuck) counts[STUCK] += 1.0;
     if (corr.state == sediment::SlipState::HeldAtJump) counts[AT_JUMP] += 1.0;
 
@@ -165,6 +176,7 @@ template <FixNVESphereFluid::HalfStep path, class Lookup> void FixNVESphereFluid
     if (corr.along != corr.across) {    // the direction matters to the second half only then
       std::copy(corr.dir, corr.dir + 3, &w[DIRX]);
     }
+    return state;
   };
 
   // Atoms under a smooth nonlinear law wait in a block of one law (sediment::SmoothBlock), which
@@ -179,15 +191,21 @@ template <FixNVESphereFluid::HalfStep path, class Lookup> void FixNVESphereFluid
   const sediment::DragModel *block_model = nullptr;
   auto step_block = [&]() {
     block.step(*block_model, dt);
+    double state = 0.0;
     for (int n = 0; n < block.size(); ++n) {
       const Waiting &b = waiting[n];
       double dx[3];
       block.velocity(n, v[b.i]);
       block.displacement(n, dx);
-      finish(b.i, block.correction(n), dx, b.spin_rate, b.per_mass);
+      state += finish(b.i, block.correction(n), dx, b.spin_rate, b.per_mass);
     }
     block.clear();
+    return state;
   };
+
+  // The sum of the new positions and velocities of the group's atoms (NaN and inf survive a sum),
+  // taken as each atom is stepped; an atom left as it was (at rest on the floor) was checked before.
+  double state = 0.0;
 
   for (int i = 0; i < nlocal; ++i) {
     if (!(mask[i] & groupbit)) continue;
@@ -200,13 +218,13 @@ template <FixNVESphereFluid::HalfStep path, class Lookup> void FixNVESphereFluid
     w[IN_FLUID] = sphere.model ? 1.0 : 0.0;
     if (!sphere.model) {
       counts[OUTSIDE] += 1.0;
-      nve_sphere_kick_drift(x[i], v[i], omega[i], f[i], torque[i], radius[i], rmass[i], dtf, dt);
+      state += nve_sphere_kick_drift(x[i], v[i], omega[i], f[i], torque[i], radius[i], rmass[i], dtf, dt);
       continue;
     }
 
     // A sphere resting on the floor whose step would end where it starts (rests_on_floor) is skipped;
     // a set-valued law would count it as stuck, so it takes its step.
-    if (rests_on_floor(i, flow) &&
+    if (floor_axis >= 0 && rests_on_floor(i, flow) &&
         (path == HalfStep::Linear || sediment::step_kind(sphere) != sediment::StepKind::SetValued)) {
       w[ALONG] = w[ACROSS] = w[SPIN] = 0.0;
       omega[i][0] = omega[i][1] = omega[i][2] = 0.0;
@@ -220,22 +238,22 @@ template <FixNVESphereFluid::HalfStep path, class Lookup> void FixNVESphereFluid
     double dx[3];
     if constexpr (path == HalfStep::Linear) {    // sphere.diameter * c, as the law's linear_coefficient
       const double z = linear_per_diameter * sphere.diameter * per_mass * dt;
-      finish(i, sediment::linear_step_initial(sediment::phis(z, &w[DRAG_MEMO]), a, flow, dt, v[i], dx), dx,
-             spin_rate, per_mass);
+      state += finish(i, sediment::linear_step_initial(sediment::phis(z, &w[DRAG_MEMO]), a, flow, dt, v[i], dx),
+                      dx, spin_rate, per_mass);
       continue;
     }
     if (path == HalfStep::Blocked && sediment::step_kind(sphere) == sediment::StepKind::Smooth) {
-      if (block.size() > 0 && sphere.model != block_model) step_block();
+      if (block.size() > 0 && sphere.model != block_model) state += step_block();
       block_model = sphere.model;
       waiting[block.add(sphere, per_mass, a, flow, v[i])] = {i, spin_rate, per_mass};
-      if (block.full()) step_block();
+      if (block.full()) state += step_block();
       continue;
     }
-    finish(i, sediment::drag_step_initial(sphere, per_mass, a, flow, dt, v[i], dx, &w[DRAG_MEMO]), dx, spin_rate,
-           per_mass);
+    state += finish(i, sediment::drag_step_initial(sphere, per_mass, a, flow, dt, v[i], dx, &w[DRAG_MEMO]), dx,
+                    spin_rate, per_mass);
   }
-  if (path == HalfStep::Blocked && block.size() > 0) step_block();
-  check_finite();
+  if (path == HalfStep::Blocked && block.size() > 0) state += step_block();
+  check_finite(state);
   settle_on_floor();
 }
 
@@ -257,14 +275,15 @@ void FixNVESphereFluid::initial_integrate(int /*vflag*/)
     const auto [x, v, f, omega, torque, radius, rmass, mask, nlocal] = sphere_arrays(atom);
     const double dt = update->dt;
     const double dtf = 0.5 * dt * force->ftm2v;
-    int outside = 0;    // a local count: a store into the fix would alias the atom arrays
+    int outside = 0;    // local sums: a store into the fix would alias the atom arrays
+    double state = 0.0;
     for (int i = 0; i < nlocal; ++i)
       if (mask[i] & groupbit) {
-        nve_sphere_kick_drift(x[i], v[i], omega[i], f[i], torque[i], radius[i], rmass[i], dtf, dt);
+        state += nve_sphere_kick_drift(x[i], v[i], omega[i], f[i], torque[i], radius[i], rmass[i], dtf, dt);
         ++outside;
       }
     counts[OUTSIDE] = outside;
-    check_finite();
+    check_finite(state);
     settle_on_floor();
     return;
   }
@@ -342,21 +361,11 @@ void FixNVESphereFluid::final_integrate()
   settle_on_floor();
 }
 
-void FixNVESphereFluid::check_finite() const
+void FixNVESphereFluid::check_finite(double state) const
 {
-  // One pass over the positions and velocities of all local atoms, which LAMMPS keeps in two
-  // contiguous blocks of 3 nlocal values, with four independent partial sums (NaN and inf
-  // survive a sum): a few additions per atom, instead of a chain of them at the end of each
-  // atom's step.
-  const int n = 3 * atom->nlocal;
-  if (n == 0) return;
-  const double *x = atom->x[0], *v = atom->v[0];
-  double sums[4] = {0.0, 0.0, 0.0, 0.0};
-  int j = 0;
-  for (; j + 4 <= n; j += 4)
-    for (int k = 0; k < 4; ++k) sums[k] += x[j + k] + v[j + k];
-  for (; j < n; ++j) sums[0] += x[j] + v[j];
-  if (!std::isfinite((sums[0] + sums[1]) + (sums[2] + sums[3]))) find_non_finite();
+  // The sum is taken in the step's own loop, while the atom's values are in registers: a pass of
+  // its own over x and v cost a tenth of fix nve/sphere's step in memory traffic.
+  if (!std::isfinite(state)) find_non_finite();
 }
 
 void FixNVESphereFluid::find_non_finite() const

@@ -77,10 +77,10 @@ class FixNVESphereFluid : public Fix {
   enum { STUCK, AT_JUMP, OUTSIDE, CAPPED, NCOUNTS };
   RankSums<NCOUNTS> counts;
   // A NaN or inf spreads through contacts and grids without a trace: after the first half-step
-  // the sum of all positions and velocities is checked (NaN and inf survive a sum), and the run
-  // stops at the first atom whose own sum is not finite, before the forces and grids see it.
-  static double state_sum(const double *x, const double *v) { return x[0] + x[1] + x[2] + v[0] + v[1] + v[2]; }
-  void check_finite() const;       // after the first half: stops at a NaN or inf state
+  // the sum of the group's new positions and velocities is checked (NaN and inf survive a sum),
+  // and the run stops at the first atom whose own sum is not finite, before the forces and grids
+  // see it.
+  void check_finite(double state) const;    // after the first half: stops at a NaN or inf state
   void find_non_finite() const;    // names the atom
 };
 

@@ -856,14 +856,21 @@ print "RESULT capped $(f_step[4]) outside $(f_step[3])"
 """), {}, np_ranks, cwd=tmp)
         report(f"guards: local fraction above max_fraction 1e-6: {out.results['capped']:.0f} sphere(s)")
         assert out.results == {"capped": 1.0, "outside": 1.0}
-        # A force that overflows: stopped at once, naming the atom, instead of NaN spreading.
-        out = run_deck(guard_deck(tmp, "overflow", """fix drag all fluid/drag water law stokes
+        # A force that overflows: stopped at once, naming the atom, instead of NaN spreading; on every
+        # path of the step: no fluid/drag at all, a sphere in the air (atom 1) and one in the water
+        # (atom 2) under the linear and the blocked smooth step.
+        for name, drag, pushed in (("bare", "", 1), ("stokes", "fix drag all fluid/drag water law stokes", 1),
+                                   ("stokes_immersed", "fix drag all fluid/drag water law stokes", 2),
+                                   ("dallavalle", "fix drag all fluid/drag water law dallavalle", 2)):
+            out = run_deck(guard_deck(tmp, f"overflow_{name}", f"""{drag}
 fix step all nve/sphere/fluid
-fix push all addforce 0 0 1e308
+group pushed id {pushed}
+fix push pushed addforce 0 0 1e308
 timestep 1e-4
 run 10
 """), {}, np_ranks, expect_failure=True, cwd=tmp)
-        assert "Fix nve/sphere/fluid: atom 1 has a non-finite position or velocity at step 1" in out.text
+            assert f"Fix nve/sphere/fluid: atom {pushed} has a non-finite position or velocity at step 1" in out.text, \
+                f"overflow on the {name} path not caught:\n{out.text[-2000:]}"
         # Spheres leaving the box: LAMMPS's lost-atom policy applies, the fixes carry on with the rest.
         leave = """fix drag all fluid/drag water law stokes
 fix step all nve/sphere/fluid
