@@ -80,7 +80,7 @@ static inline double nve_sphere_kick_drift(double *x, double *v, double *omega, 
 }
 
 FixNVESphereFluid::FixNVESphereFluid(LAMMPS *lmp, int narg, char **arg) :
-    Fix(lmp, narg, arg), weights(nullptr), nmax_weights(0), uniform(nullptr), half_step(HalfStep::General),
+    Fix(lmp, narg, arg), weights(nullptr), spin_memos(nullptr), nmax_weights(0), uniform(nullptr), half_step(HalfStep::General),
     linear_per_diameter(0.0), floor_axis(-1), floor_level(0.0)
 {
   StyleArgs args(lmp, FLERR, "Fix nve/sphere/fluid", narg, arg, 3);
@@ -105,7 +105,7 @@ FixNVESphereFluid::FixNVESphereFluid(LAMMPS *lmp, int narg, char **arg) :
   size_vector = NCOUNTS;
   global_freq = 1;
   extvector = 1;
-  maxexchange = NCOLS;
+  maxexchange = NCOLS + sediment::PHI_MEMO_SIZE;
 
   grow_arrays(atom->nmax);
   atom->add_callback(Atom::GROW);
@@ -115,6 +115,7 @@ FixNVESphereFluid::~FixNVESphereFluid()
 {
   atom->delete_callback(id, Atom::GROW);
   memory->destroy(weights);
+  memory->destroy(spin_memos);
 }
 
 int FixNVESphereFluid::setmask()
@@ -170,10 +171,11 @@ template <FixNVESphereFluid::HalfStep path, class Lookup> void FixNVESphereFluid
 
     const double per_inertia = ftm2v / sediment::sphere_inertia(rmass[i], radius[i]);
     const double alpha[3] = {torque[i][0] * per_inertia, torque[i][1] * per_inertia, torque[i][2] * per_inertia};
-    w[SPIN] = sediment::rotation_step_initial(spin_rate, alpha, dt, omega[i], &w[SPIN_MEMO]) * per_inertia;
+    w[SPIN] = sediment::rotation_step_initial(spin_rate, alpha, dt, omega[i], spin_memos[i]) * per_inertia;
     w[ALONG] = corr.along * per_mass;
     w[ACROSS] = corr.across * per_mass;
     if (corr.along != corr.across) {    // the direction matters to the second half only then
+      w[DRAG_MEMO] = std::numeric_limits<double>::quiet_NaN();    // it takes the memo's place
       std::copy(corr.dir, corr.dir + 3, &w[DIRX]);
     }
     return state;
@@ -425,30 +427,34 @@ double FixNVESphereFluid::compute_vector(int n)
 void FixNVESphereFluid::grow_arrays(int nmax)
 {
   memory->grow(weights, nmax, NCOLS, "nve/sphere/fluid:weights");
+  memory->grow(spin_memos, nmax, sediment::PHI_MEMO_SIZE, "nve/sphere/fluid:spin_memos");
   // Empty memos for the new rows (a memo is used only when its z matches).
   for (int i = nmax_weights; i < nmax; ++i)
-    weights[i][DRAG_MEMO] = weights[i][SPIN_MEMO] = std::numeric_limits<double>::quiet_NaN();
+    weights[i][DRAG_MEMO] = spin_memos[i][0] = std::numeric_limits<double>::quiet_NaN();
   nmax_weights = nmax;
 }
 
 void FixNVESphereFluid::copy_arrays(int i, int j, int /*delflag*/)
 {
-  for (int k = 0; k < NCOLS; ++k) weights[j][k] = weights[i][k];
+  std::copy(weights[i], weights[i] + NCOLS, weights[j]);
+  std::copy(spin_memos[i], spin_memos[i] + sediment::PHI_MEMO_SIZE, spin_memos[j]);
 }
 
 int FixNVESphereFluid::pack_exchange(int i, double *buf)
 {
-  for (int k = 0; k < NCOLS; ++k) buf[k] = weights[i][k];
-  return NCOLS;
+  std::copy(weights[i], weights[i] + NCOLS, buf);
+  std::copy(spin_memos[i], spin_memos[i] + sediment::PHI_MEMO_SIZE, buf + NCOLS);
+  return NCOLS + sediment::PHI_MEMO_SIZE;
 }
 
 int FixNVESphereFluid::unpack_exchange(int nlocal, double *buf)
 {
-  for (int k = 0; k < NCOLS; ++k) weights[nlocal][k] = buf[k];
-  return NCOLS;
+  std::copy(buf, buf + NCOLS, weights[nlocal]);
+  std::copy(buf + NCOLS, buf + NCOLS + sediment::PHI_MEMO_SIZE, spin_memos[nlocal]);
+  return NCOLS + sediment::PHI_MEMO_SIZE;
 }
 
 double FixNVESphereFluid::memory_usage()
 {
-  return static_cast<double>(atom->nmax) * NCOLS * sizeof(double);
+  return static_cast<double>(atom->nmax) * (NCOLS + sediment::PHI_MEMO_SIZE) * sizeof(double);
 }

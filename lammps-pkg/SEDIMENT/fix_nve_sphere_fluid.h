@@ -16,7 +16,7 @@ FixStyle(nve/sphere/fluid,FixNVESphereFluid);
 #include "fix.h"
 #include "sediment_rank_sums.h"
 
-#include "sediment/drag.hpp"
+#include "sediment/integrator.hpp"
 
 #include <vector>
 
@@ -40,15 +40,18 @@ class FixNVESphereFluid : public Fix {
   double memory_usage() override;
 
  private:
-  // Per atom, from the first half of the step to the second: weights of the new force along
-  // and across the slip (per unit mass), the weight of the new torque (per moment of inertia), whether the atom was in a fluid (outside,
-  // the step is fix nve/sphere's, operation for operation), the exponentials of the last step's
-  // translational drag (sediment::phis memo); then the slip direction (needed only when the
-  // weights differ) and the memo of the rotational drag. 16 columns: in rows aligned to 64 bytes,
-  // a sphere with linear drag and no rotational drag touches only the first cache line of its row.
-  enum { ALONG, ACROSS, SPIN, IN_FLUID, DRAG_MEMO, DIRX = DRAG_MEMO + 4, DIRY, DIRZ, SPIN_MEMO, NCOLS = SPIN_MEMO + 5 };
+  // Per atom, from the first half of the step to the second, in a row of 8 doubles (one 64-byte
+  // cache line, as LAMMPS aligns its arrays): the weights of the new force along and across the slip
+  // (per unit mass), the weight of the new torque (per moment of inertia), whether the atom was in a
+  // fluid (outside, the step is fix nve/sphere's, operation for operation) and the exponentials of
+  // the last step's linear drag (sediment::phis memo). When the weights differ (a nonlinear law,
+  // which has no memo) the memo's last three places hold the slip direction instead, and its z is
+  // emptied.
+  enum { ALONG, ACROSS, SPIN, IN_FLUID, DRAG_MEMO, DIRX = DRAG_MEMO + 1, DIRY, DIRZ,
+         NCOLS = DRAG_MEMO + sediment::PHI_MEMO_SIZE };
   double **weights;
-  int nmax_weights;    // rows of weights with initialised memos
+  double **spin_memos;    // the memo of the rotational drag, apart: touched only when there is one
+  int nmax_weights;    // rows of weights and spin_memos with initialised memos
   std::vector<class FixFluidDrag *> drags;
   // Set in setup() when there is one fluid/drag and it is uniform() (every atom of its group wholly
   // immersed, no rotational drag): the step then skips the per-atom region and surface look-ups.
