@@ -2,7 +2,7 @@
 """Cost per particle-step of the SEDIMENT effects, as ratios measured in one run on this machine.
 
     /usr/bin/python3 benchmarks/cost.py [--particles 20000] [--steps 2000] [--repeats 3] [--baseline LMP]
-                                        [--scenes plain,drag,...]
+                                        [--scenes plain,drag,...] [--counts]
 
 Each scene runs `repeats` times, the scenes taking turns (so that a drift of the machine's speed
 during the run touches every scene alike); the best loop time is kept. LAMMPS reports the loop
@@ -11,18 +11,30 @@ commit) every scene also runs with it, the two taking turns scene by scene, and 
 the ratio this build / baseline, as the ratio of the best times and as the median of the ratios of
 back-to-back pairs (robust to the machine's drift during the run): on a machine whose speed drifts
 by 10 % between runs, the way to measure one change.
+
+With --counts the scenes run under valgrind's cachegrind instead of the clock, on a model of one
+core of this machine (32 KiB L1 data cache, the 512 KiB L2 as the last level; what misses it comes
+from the 32 MiB L3): instructions, L1 and L2 data misses per particle-step, from the difference of a
+run of `steps` and one of 3 x `steps` (so start-up cancels), and a rough estimate of cycles that
+charges each L1 miss the L2's latency and each L2 miss the L3's (12 and 40 cycles; no overlap, no
+prefetch). The counts are the same from run to run: a change of 2 % shows where the clock's noise on
+a shared machine hides it. Default 20 000 particles x 50 steps (about 10 minutes for all scenes).
 """
 from __future__ import annotations
 
 import argparse
 import os
+import shutil
 import statistics
+import subprocess
 import sys
+import tempfile
 from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE.parent / "python"))
 from sediment.cli.types import count  # noqa: E402
+from sediment.sim.paths import lmp_executable  # noqa: E402
 from sediment.sim.run import run_batch  # noqa: E402
 
 SCENES = {"plain": "nve/sphere + gravity (reference)",
@@ -50,6 +62,73 @@ def loop_time(scene: str, particles: int, steps: int, lmp: Path | None = None) -
             os.environ["SEDIMENT_LMP"] = previous
 
 
+# Cachegrind's model of one core: L1 data cache and, as the last level, the L2 (size, ways, line).
+CACHE_MODEL = ["--cache-sim=yes", "--I1=32768,8,64", "--D1=32768,8,64", "--LL=524288,8,64"]
+L2_LATENCY, L3_LATENCY = 12, 40    # cycles charged per L1 miss and per L2 miss in the estimate
+EVENTS = ("Ir", "D1mr", "D1mw", "DLmr", "DLmw")
+
+
+def cachegrind_totals(text: str) -> dict[str, int]:
+    """The program totals of a cachegrind output file (its "events:" and "summary:" lines)."""
+    lines = dict(line.split(":", 1) for line in text.splitlines() if line.startswith(("events:", "summary:")))
+    if "events" not in lines or "summary" not in lines:
+        raise ValueError("not a cachegrind output file (no events or summary line)")
+    names, values = lines["events"].split(), lines["summary"].split()
+    if len(names) != len(values):
+        raise ValueError("cachegrind output: the summary does not match the events")
+    return dict(zip(names, map(int, values)))
+
+
+def counts_per_step(scene: str, particles: int, steps: int, lmp: Path | None = None) -> dict[str, float]:
+    """Instructions, L1 and L2 data misses per particle-step, and the estimate of cycles."""
+    if shutil.which("valgrind") is None:
+        sys.exit("cost.py --counts needs valgrind (Debian package valgrind)")
+    totals = []
+    with tempfile.TemporaryDirectory() as tmp:
+        for run_steps in (steps, 3 * steps):
+            out = Path(tmp) / f"{scene}.{run_steps}"
+            cmd = ["valgrind", "--tool=cachegrind", *CACHE_MODEL, f"--cachegrind-out-file={out}",
+                   str(lmp or lmp_executable()), "-in", str(HERE / "in.cost"), "-log", "none", "-screen", "none",
+                   "-var", "scene", scene, "-var", "n", str(particles), "-var", "steps", str(run_steps)]
+            done = subprocess.run(cmd, capture_output=True, text=True, env=dict(os.environ, OMP_NUM_THREADS="1"))
+            if done.returncode != 0:
+                sys.exit(f"cost.py --counts: scene {scene} failed under cachegrind:\n{done.stderr[-2000:]}")
+            totals.append(cachegrind_totals(out.read_text()))
+    per = {e: (totals[1][e] - totals[0][e]) / (particles * 2 * steps) for e in EVENTS}
+    l1, l2 = per["D1mr"] + per["D1mw"], per["DLmr"] + per["DLmw"]
+    return {"instructions": per["Ir"], "L1 misses": l1, "L2 misses": l2,
+            "cycles (est.)": per["Ir"] + L2_LATENCY * l1 + L3_LATENCY * l2}
+
+
+def report_counts(scenes: dict[str, str], args: argparse.Namespace) -> None:
+    """The --counts table: this build, and the baseline when given (the counts need no turns)."""
+    steps = args.steps if args.steps_given else 50
+    columns = ("instructions", "L1 misses", "L2 misses", "cycles (est.)")
+    print(f"{args.particles} particles x ({steps}, {3 * steps}) steps under cachegrind, per particle-step")
+    print(f"{'scene':10s} " + " ".join(f"{c:>13s}" for c in columns) + (f" {'this/baseline':>14s}" if args.baseline
+                                                                         else "") + "  what")
+    cycles = {}
+    for s, what in scenes.items():
+        mine = counts_per_step(s, args.particles, steps)
+        cycles[s] = mine["cycles (est.)"]
+        ratio = ""
+        if args.baseline:
+            theirs = counts_per_step(s, args.particles, steps, args.baseline)
+            ratio = f" {mine['cycles (est.)'] / theirs['cycles (est.)']:14.3f}"
+        print(f"{s:10s} " + " ".join(f"{mine[c]:13.2f}" for c in columns) + ratio + f"  {what}", flush=True)
+    if "bare" in cycles:
+        print(f"every effect off: {100 * (cycles['bare'] / cycles['plain'] - 1):+.1f} % against fix nve/sphere "
+              "(estimated cycles)")
+    against_peer = [f"{s} {cycles[s] / cycles['peer']:.2f}x" for s in ("explicit", "drag", "nonlinear") if s in cycles]
+    if against_peer:
+        print("against the peer (estimated cycles): " + ", ".join(against_peer))
+    if "nonlinear" in cycles and "hindered" in cycles:
+        extra = [f"grid + Di Felice +{(cycles['hindered'] - cycles['nonlinear']) / cycles['peer']:.2f}x the peer"]
+        if "cells" in cycles:
+            extra.append(f"3d cells +{(cycles['cells'] - cycles['nonlinear']) / cycles['peer']:.2f}x")
+        print("on top of the nonlinear step (estimated cycles): " + ", ".join(extra))
+
+
 def existing_file(text: str) -> Path:
     path = Path(text)
     if not path.is_file():
@@ -69,13 +148,20 @@ def scene_list(text: str) -> list[str]:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--particles", type=count, default=20000)
-    parser.add_argument("--steps", type=count, default=2000)
+    parser.add_argument("--steps", type=count, help="steps of each run (default 2000; with --counts 50)")
     parser.add_argument("--repeats", type=count, default=3)
     parser.add_argument("--baseline", type=existing_file, help="another lmp_sediment to take turns with")
     parser.add_argument("--scenes", type=scene_list, default=list(SCENES),
                         help="comma-separated scenes to run (default: all; plain and peer always run, the ratios need them)")
+    parser.add_argument("--counts", action="store_true",
+                        help="instructions and cache misses under cachegrind instead of the clock (see above)")
     args = parser.parse_args()
+    args.steps_given = args.steps is not None
     scenes = {s: SCENES[s] for s in SCENES if s in args.scenes or s in ("plain", "peer")}
+    if args.counts:
+        report_counts(scenes, args)
+        return
+    args.steps = args.steps or 2000
     times = {s: float("inf") for s in scenes}
     baseline = {s: float("inf") for s in scenes}
     pair_ratios: dict[str, list[float]] = {s: [] for s in scenes}

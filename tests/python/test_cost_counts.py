@@ -1,0 +1,47 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
+"""benchmarks/cost.py --counts: cachegrind's totals read right, and a scene's counts per particle-step
+taken from the difference of two runs (start-up cancels)."""
+from __future__ import annotations
+
+import importlib.util
+import shutil
+import sys
+from pathlib import Path
+
+import pytest
+
+COST = Path(__file__).resolve().parents[2] / "benchmarks" / "cost.py"
+
+
+@pytest.fixture(scope="module")
+def cost():
+    spec = importlib.util.spec_from_file_location("cost", COST)
+    module = importlib.util.module_from_spec(spec)
+    sys.modules["cost"] = module
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_the_totals_are_the_summary_line_named_by_the_events_line(cost):
+    text = ("desc: I1 cache: 32768 B, 64 B, 8-way associative\ncmd: lmp_sediment\n"
+            "events: Ir I1mr ILmr Dr D1mr DLmr Dw D1mw DLmw \nfl=x.cpp\nfn=f\n1 5 0 0 2 1 0 1 0 0\n"
+            "summary: 783908481 155938 50669 237832565 30552875 26110653 224930158 3195509 2973816\n")
+    totals = cost.cachegrind_totals(text)
+    assert totals["Ir"] == 783908481 and totals["D1mr"] == 30552875 and totals["DLmw"] == 2973816
+    with pytest.raises(ValueError, match="not a cachegrind output file"):
+        cost.cachegrind_totals("Loop time of 1.2 on 1 procs\n")
+    with pytest.raises(ValueError, match="does not match"):
+        cost.cachegrind_totals("events: Ir D1mr\nsummary: 12\n")
+
+
+@pytest.mark.skipif(shutil.which("valgrind") is None, reason="needs valgrind")
+def test_a_scene_costs_its_step_per_particle_not_its_start_up(cost):
+    # fix nve/sphere + gravity: about 215 instructions per particle-step (a few hundred at most);
+    # with the start-up of LAMMPS (about 10^8 instructions) left in it would be tens of thousands.
+    # And the count is the same from run to run, which is what it is for (the clock's noise here is
+    # 10-15 %). Misses of a scene this small (it fits the caches) are near zero, of either sign.
+    first, again = (cost.counts_per_step("plain", 500, 5) for _ in range(2))
+    assert 100 < first["instructions"] < 500
+    assert again["instructions"] == pytest.approx(first["instructions"], rel=0.01)
+    assert abs(first["L2 misses"]) < 5 and first["cycles (est.)"] == pytest.approx(
+        first["instructions"] + 12 * first["L1 misses"] + 40 * first["L2 misses"])
