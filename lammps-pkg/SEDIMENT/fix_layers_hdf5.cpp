@@ -137,10 +137,12 @@ void create_frames(hid_t where, const char *name, hid_t type, int rank, const hs
              std::string("dataset ") + name);
 }
 
-// Resizes a frame dataset to `frames` and, if data is given, writes frame `frames - 1`.
-void put_frame(hid_t file, const char *name, hid_t type, hsize_t frames, const void *data)
+// The frame datasets, in the order of FixLayersHDF5::frame_sets.
+constexpr const char *FRAME_SETS[3] = {"time", "step", "fraction"};
+
+// Resizes an open frame dataset to `frames` and, if data is given, writes frame `frames - 1`.
+void put_frame(hid_t set, const char *name, hid_t type, hsize_t frames, const void *data)
 {
-  Handle set(H5Dopen2(file, name, H5P_DEFAULT), H5Dclose, std::string("dataset ") + name);
   hsize_t dims[3] = {frames, 0, 0};
   {
     Handle space(H5Dget_space(set), H5Sclose, "dataspace");
@@ -156,8 +158,7 @@ void put_frame(hid_t file, const char *name, hid_t type, hsize_t frames, const v
   hsize_t start[3] = {frames - 1, 0, 0}, count[3] = {1, dims[1], dims[2]};
   check(H5Sselect_hyperslab(space, H5S_SELECT_SET, start, nullptr, count, nullptr), "selection");
   Handle memory(H5Screate_simple(rank, count, nullptr), H5Sclose, "dataspace");
-  check(H5Dwrite(set, type, memory, space, H5P_DEFAULT, data), std::string("writing ") + name);
-  set.close();
+  check(H5Dwrite(set, type, memory, space, H5P_DEFAULT, data), std::string("writing ") + name + " (disk full?)");
 }
 
 bool file_exists(const std::string &name)
@@ -203,7 +204,7 @@ void copy_file(const std::string &from, const std::string &to)
 
 FixLayersHDF5::FixLayersHDF5(LAMMPS *lmp, int narg, char **arg) :
     Fix(lmp, narg, arg), compute_id(nullptr), fluid_id(nullptr), particle_density(0.0), grid(nullptr),
-    fluid(nullptr), file(-1), is_open(false), frames(0), overwrite(false)
+    fluid(nullptr), file(-1), frame_sets{-1, -1, -1}, is_open(false), frames(0), overwrite(false)
 {
   if (narg < 6)
     error->all(FLERR, "Fix layers/hdf5: expected 'fix ID group layers/hdf5 N FILE.h5 c_ID [keyword value ...]'");
@@ -237,6 +238,8 @@ FixLayersHDF5::FixLayersHDF5(LAMMPS *lmp, int narg, char **arg) :
 
 FixLayersHDF5::~FixLayersHDF5()
 {
+  for (long long &set : frame_sets)
+    if (set >= 0) H5Dclose(set);
   if (file >= 0) H5Fclose(file);
   // LAMMPS is done with the fix (end of input, unfix or clear; never after an error): the frames
   // are complete. Only now does the file replace an earlier result under its name.
@@ -326,7 +329,8 @@ void FixLayersHDF5::open_file()
       file = H5Fopen(writing.c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
       if (file < 0) throw std::runtime_error("cannot be opened for writing");
       frames = frames_before(file, step_now);
-      for (const char *name : {"time", "step", "fraction"}) put_frame(file, name, H5T_NATIVE_DOUBLE, frames, nullptr);
+      open_frame_sets();
+      for (int k = 0; k < 3; ++k) put_frame(frame_sets[k], FRAME_SETS[k], H5T_NATIVE_DOUBLE, frames, nullptr);
       set_attribute(file, "complete", 0.0);
       check(H5Fflush(file, H5F_SCOPE_GLOBAL), "flush");
       return;
@@ -354,6 +358,7 @@ void FixLayersHDF5::open_file()
     create_frames(file, "time", H5T_NATIVE_DOUBLE, 1, nullptr);
     create_frames(file, "step", H5T_NATIVE_LLONG, 1, nullptr);
     create_frames(file, "fraction", H5T_NATIVE_DOUBLE, 3, shape);
+    open_frame_sets();
     check(H5Fflush(file, H5F_SCOPE_GLOBAL), "flush");
   });
   is_open = true;
@@ -371,10 +376,12 @@ void FixLayersHDF5::write_frame()
     const double time = update->atime + (update->ntimestep - update->atimestep) * update->dt;
     const long long step = update->ntimestep;
     ++frames;
-    put_frame(file, "time", H5T_NATIVE_DOUBLE, frames, &time);
-    put_frame(file, "step", H5T_NATIVE_LLONG, frames, &step);
-    put_frame(file, "fraction", H5T_NATIVE_DOUBLE, frames, values.data());
-    check(H5Fflush(file, H5F_SCOPE_GLOBAL), "flush");    // a killed run keeps every finished frame
+    put_frame(frame_sets[0], FRAME_SETS[0], H5T_NATIVE_DOUBLE, frames, &time);
+    put_frame(frame_sets[1], FRAME_SETS[1], H5T_NATIVE_LLONG, frames, &step);
+    put_frame(frame_sets[2], FRAME_SETS[2], H5T_NATIVE_DOUBLE, frames, values.data());
+    // Writes the frame's chunks and the file's metadata: a killed run keeps every finished frame,
+    // and a full disk shows here.
+    check(H5Fflush(file, H5F_SCOPE_GLOBAL), "writing the frame (disk full?)");
   });
 }
 
@@ -449,12 +456,27 @@ std::string FixLayersHDF5::choose_file(bigint step_now, size_t layers, size_t co
 }
 
 
+void FixLayersHDF5::open_frame_sets()
+{
+  for (int k = 0; k < 3; ++k) {
+    frame_sets[k] = H5Dopen2(file, FRAME_SETS[k], H5P_DEFAULT);
+    if (frame_sets[k] < 0) throw std::runtime_error(std::string("dataset ") + FRAME_SETS[k] + " cannot be opened");
+  }
+}
+
 void FixLayersHDF5::close_file()
 {
   on_rank0([&] {
+    // Closing writes what is cached: a full disk shows here (each handle closed once, even then).
+    bool written = true;
+    for (long long &set : frame_sets) {
+      if (set >= 0) written = H5Dclose(set) >= 0 && written;
+      set = -1;
+    }
     const hid_t open = file;
     file = -1;
-    if (open >= 0) check(H5Fclose(open), "closing (disk full?)");
+    if (open >= 0) written = H5Fclose(open) >= 0 && written;
+    if (!written) throw std::runtime_error("closing (disk full?)");
   });
   is_open = false;
 }

@@ -43,6 +43,9 @@ class FixLayersHDF5 : public Fix {
   class ComputeConcentrationGrid *grid;
   class FixFluid *fluid;
   long long file;       // hid_t of the open file (rank 0), -1 when closed
+  // hid_t of its frame datasets time, step and fraction (rank 0), open while the file is: opening
+  // and closing them for each frame was three quarters of the cost of writing it.
+  long long frame_sets[3];
   bool is_open;         // the same on every rank (file is only meaningful on rank 0)
   long long frames;     // frames in the file
   bool overwrite;       // a new run may replace an earlier file of other parameters
@@ -53,6 +56,7 @@ class FixLayersHDF5 : public Fix {
   std::string choose_file(bigint step_now, size_t layers, size_t columns,
                           const std::vector<std::pair<const char *, double>> &identity, const std::string &run_id);
   void write_frame();
+  void open_frame_sets();    // rank 0, the file open
   void close_file();
   // Runs `action` on rank 0 and stops every rank with its message if it failed.
   template <typename Action> void on_rank0(Action action);
