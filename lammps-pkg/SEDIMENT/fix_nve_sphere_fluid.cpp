@@ -206,7 +206,7 @@ template <FixNVESphereFluid::HalfStep path, class Lookup> void FixNVESphereFluid
   };
 
   // The sum of the new positions and velocities of the group's atoms (NaN and inf survive a sum),
-  // taken as each atom is stepped; an atom left as it was (at rest on the floor) was checked before.
+  // taken as each atom is stepped (or left at rest on the floor).
   double state = 0.0;
 
   for (int i = 0; i < nlocal; ++i) {
@@ -230,6 +230,7 @@ template <FixNVESphereFluid::HalfStep path, class Lookup> void FixNVESphereFluid
         (path == HalfStep::Linear || sediment::step_kind(sphere) != sediment::StepKind::SetValued)) {
       w[ALONG] = w[ACROSS] = w[SPIN] = 0.0;
       omega[i][0] = omega[i][1] = omega[i][2] = 0.0;
+      state += state_sum(x[i], v[i]);    // its position along the floor is not among what the test reads
       continue;
     }
 
