@@ -213,14 +213,19 @@ void ComputeConcentrationGrid::profile()
 
   const double *weight = weight_index >= 0 ? atom->dvector[weight_index] : nullptr;
 
+  // Layers take the one-axis deposit directly (add_sphere_to_grid would find the axis per sphere).
+  auto deposit = [&](int i, int column, double count) {
+    if (axis >= 0)
+      sediment::add_sphere_to_layers(grid.axes[axis], x[i][axis], radius[i], local.data() + column, ncols, count);
+    else
+      sediment::add_sphere_to_grid(grid, x[i], radius[i], local.data() + column, ncols, count);
+  };
   for (int i = 0; i < atom->nlocal; ++i) {
     if (!(mask[i] & groupbit)) continue;
     const double count = weight ? weight[i] : 1.0;
-    int columns[3] = {0, -1, -1};
-    if (!class_edges.empty()) columns[1] = class_col + size_class(2.0 * radius[i]);
-    if (by_type) columns[2] = type_col + type[i] - 1;
-    for (int c : columns)
-      if (c >= 0) sediment::add_sphere_to_grid(grid, x[i], radius[i], local.data() + c, ncols, count);
+    deposit(i, 0, count);
+    if (!class_edges.empty()) deposit(i, class_col + size_class(2.0 * radius[i]), count);
+    if (by_type) deposit(i, type_col + type[i] - 1, count);
   }
   MPI_Allreduce(local.data(), fractions.data(), static_cast<int>(local.size()), MPI_DOUBLE, MPI_SUM, world);
 
@@ -259,8 +264,14 @@ void ComputeConcentrationGrid::compute_peratom()
   }
   double **x = atom->x;
   int *mask = atom->mask;
+  const double *total = fractions.data();    // column 0
+  if (axis >= 0) {    // the one-axis read, without finding the axis per sphere (as grid_value_at would)
+    for (int i = 0; i < atom->nlocal; ++i)
+      vector_atom[i] = (mask[i] & groupbit) ? sediment::profile_at(grid.axes[axis], total, x[i][axis], ncols) : 0.0;
+    return;
+  }
   for (int i = 0; i < atom->nlocal; ++i)
-    vector_atom[i] = (mask[i] & groupbit) ? sediment::grid_value_at(grid, fractions.data(), x[i], ncols) : 0.0;
+    vector_atom[i] = (mask[i] & groupbit) ? sediment::grid_value_at(grid, total, x[i], ncols) : 0.0;
 }
 
 double ComputeConcentrationGrid::memory_usage()
