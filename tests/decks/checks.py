@@ -871,6 +871,22 @@ run 10
 """), {}, np_ranks, expect_failure=True, cwd=tmp)
             assert f"Fix nve/sphere/fluid: atom {pushed} has a non-finite position or velocity at step 1" in out.text, \
                 f"overflow on the {name} path not caught:\n{out.text[-2000:]}"
+        # A NaN force pressing a grain that rests on the floor (atom 2 sits on it from the start): not
+        # taken for a grain at rest, nor put back on the floor, but stopped at once.
+        for law in ("stokes", "dallavalle"):
+            out = run_deck(guard_deck(tmp, f"nan_at_rest_{law}", f"""fix drag all fluid/drag water law {law}
+fix step all nve/sphere/fluid floor z -0.0105
+timestep 1e-3
+run 20
+print "RESULT z2 $(z[2]:%.17g) vz2 $(vz[2])"
+variable nan equal (1e308*10)-(1e308*10)
+group resting id 2
+fix push resting addforce 0 0 v_nan
+run 20
+"""), {}, np_ranks, expect_failure=True, cwd=tmp)
+            assert out.results == {"z2": -0.01, "vz2": 0.0}, out.results
+            assert "Fix nve/sphere/fluid: atom 2 has a non-finite position or velocity at step 21" in out.text, \
+                f"a NaN force on a grain at rest under {law} not caught:\n{out.text[-2000:]}"
         # Spheres leaving the box: LAMMPS's lost-atom policy applies, the fixes carry on with the rest.
         leave = """fix drag all fluid/drag water law stokes
 fix step all nve/sphere/fluid
