@@ -72,9 +72,6 @@ class FixNVESphereFluid : public Fix {
 
   int floor_axis;         // -1: no floor
   double floor_level;     // spheres stop with their lowest point here
-  void settle_on_floor();    // every sphere of the group that reached the floor
-  // An atom's drag step would leave it as it is, at rest on the floor (floor_axis >= 0).
-  bool rests_on_floor(const double *x, const double *v, const double *f, double radius, const double *flow) const;
 
   // Diagnostics of the last step (compute_vector): spheres stuck by the yield stress, held at a
   // Cd jump, outside every fluid, and with their local solid fraction capped (hindered drag).
