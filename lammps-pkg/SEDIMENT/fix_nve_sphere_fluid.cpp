@@ -61,14 +61,14 @@ static inline SphereArrays sphere_arrays(const Atom *atom)
   return {atom->x, atom->v, atom->f, atom->omega, atom->torque, atom->radius, atom->rmass, atom->mask, atom->nlocal};
 }
 
-// The first half of fix nve/sphere's step: kick, then drift over the whole step.
 // The sum of an atom's position and velocity: NaN or inf when any of them is (or when it overflows).
 static inline double state_sum(const double x[3], const double v[3])
 {
   return (x[0] + x[1] + x[2]) + (v[0] + v[1] + v[2]);
 }
 
-// Returns the state_sum of the new position and velocity, for the check of a finite state.
+// The first half of fix nve/sphere's step: kick, then drift over the whole step. Returns the
+// state_sum of the new position and velocity, for the check of a finite state.
 static inline double nve_sphere_kick_drift(double *x, double *v, double *omega, const double *f,
                                            const double *torque, double radius, double rmass, double dtf, double dt)
 {
@@ -81,8 +81,8 @@ static inline double nve_sphere_kick_drift(double *x, double *v, double *omega, 
 }
 
 FixNVESphereFluid::FixNVESphereFluid(LAMMPS *lmp, int narg, char **arg) :
-    Fix(lmp, narg, arg), weights(nullptr), spin_memos(nullptr), nmax_weights(0), uniform(nullptr), half_step(HalfStep::General),
-    linear_per_diameter(0.0), floor_axis(-1), floor_level(0.0)
+    Fix(lmp, narg, arg), weights(nullptr), spin_memos(nullptr), nmax_weights(0), uniform(nullptr),
+    half_step(HalfStep::General), linear_per_diameter(0.0), floor_axis(-1), floor_level(0.0)
 {
   StyleArgs args(lmp, FLERR, "Fix nve/sphere/fluid", narg, arg, 3);
   while (args.more()) {
@@ -414,8 +414,8 @@ void FixNVESphereFluid::final_integrate()
 
 void FixNVESphereFluid::check_finite(double state) const
 {
-  // The sum is taken in the step's own loop, while the atom's values are in registers: a pass of
-  // its own over x and v cost a tenth of fix nve/sphere's step in memory traffic.
+  // The sum is taken in the step's own loops, while the atom's values are in registers: a pass of
+  // its own over x and v cost 0.74 cache misses per atom-step (cachegrind, 20 000 atoms).
   if (!std::isfinite(state)) find_non_finite();
 }
 
