@@ -217,19 +217,18 @@ void SmoothBlock::rates(const DragModel &model, double dt)
 void SmoothBlock::advance_all(double dt)
 {
   for (int n = 0; n < size_; ++n) {
-    // Along the slip: the slip's exact advance under ds/dt = c - k s (advance()); across it, the
-    // linear step. The weights of a_n are those of a_{n+1} (along_, across_) taken from the ETD2
-    // weights; drag_step_final adds a_{n+1}.
-    const double speed = speed_[n] * decay_[0][n] + c_[n] * dt * phi1_[0][n];
-    const double distance = speed_[n] * dt * phi1_[0][n] + c_[n] * dt * dt * phi2_[0][n];
+    // Along the slip: the slip's exact advance under ds/dt = c - k s; across it, the linear step.
+    // The weights of a_n are those of a_{n+1} (along_, across_) taken from the ETD2 weights;
+    // drag_step_final adds a_{n+1}.
+    const Segment slip = advance(Phi{decay_[0][n], phi1_[0][n], phi2_[0][n]}, speed_[n], c_[n], dt);
     along_[n] = dt * phi2_[0][n];
     across_[n] = dt * phi2_[1][n];
-    const double along_now = speed - along_[n] * a_par_[n];    // along the slip, with a_n's share
+    const double along_now = slip.speed - along_[n] * a_par_[n];    // along the slip, with a_n's share
     const double across_now = dt * (phi1_[1][n] - phi2_[1][n]);
     const double across_drift = dt * dt * phi2_[1][n];
     for (int k = 0; k < 3; ++k) {
       const double a_perp = a_[k][n] - a_par_[n] * dir_[k][n];
-      dx_[k][n] = u_[k][n] * dt + distance * dir_[k][n] + across_drift * a_perp;
+      dx_[k][n] = u_[k][n] * dt + slip.distance * dir_[k][n] + across_drift * a_perp;
       v_[k][n] = u_[k][n] + along_now * dir_[k][n] + across_now * a_perp;
     }
   }
