@@ -494,6 +494,7 @@ def _deck(scene: Scene, data: str, layer_file: str) -> str:
         "# Two restart files in turn (one is always complete); each stage runs up to its last step, so a",
         "# resumed run skips the stages it has done and finishes the one it was in. One every twentieth of",
         f"# the run, and {RESTART_SPACING} steps apart at least: a restart file costs about two steps, written by rank 0.",
+        # max(a, b) written out: LAMMPS formulas have no two-argument max (its max() reduces a compute).
         f"variable        restart_every equal ceil({total_steps}/20/v_dt_scale)",
         f"restart         $(v_restart_every+(v_restart_every<{RESTART_SPACING})*({RESTART_SPACING}-v_restart_every)) "
         "restart.a.bin restart.b.bin",
