@@ -17,8 +17,9 @@ core of this machine (32 KiB L1 data cache, the 512 KiB L2 as the last level; wh
 from the 32 MiB L3): instructions, L1 and L2 data misses per particle-step, from the difference of a
 run of `steps` and one of 3 x `steps` (so start-up cancels), and a rough estimate of cycles that
 charges each L1 miss the L2's latency and each L2 miss the L3's (12 and 40 cycles; no overlap, no
-prefetch). The counts are the same from run to run: a change of 2 % shows where the clock's noise on
-a shared machine hides it. Default 20 000 particles x 50 steps (about 10 minutes for all scenes).
+prefetch). The counts are the same from run to run within 0.1 % at the default size (start-up, which
+varies by some ten thousand instructions, cancels but for that): a change of 2 % shows where the
+clock's noise on a shared machine hides it. Default 20 000 particles x 50 steps (about 10 minutes for all scenes).
 """
 from __future__ import annotations
 
