@@ -12,10 +12,17 @@ double sphere_slab_volume(double centre, double radius, double a, double b);
 // Regular layers [lo + k h, lo + (k + 1) h), k = 0 .. n - 1; along a periodic axis index k stands
 // for every k + m n.
 struct Layers {
-  double lo;
-  double thickness;
-  int count;
+  double lo = 0.0;
+  double thickness = 1.0;
+  int count = 1;
   bool periodic = false;
+  double per_thickness = 1.0;    // 1 / thickness: finding a sphere's layer multiplies (a division per sphere cost more)
+
+  Layers() = default;
+  Layers(double lo_, double thickness_, int count_, bool periodic_ = false) :
+      lo(lo_), thickness(thickness_), count(count_), periodic(periodic_), per_thickness(1.0 / thickness_)
+  {
+  }
   double hi() const { return lo + thickness * count; }
 };
 
