@@ -97,9 +97,11 @@ class SphereCuts {
     if (q <= 0.0) return 0.0;
     const double uc = std::sqrt(q);
     if (u <= -uc) return 0.0;
-    const double b = std::min(u, uc);
-    return 0.5 * (segment(b, y0) - segment(-uc, y0) + segment(b, z0) - segment(-uc, z0)) -
-        0.25 * pi * (disc(b) - disc(-uc)) + y0 * z0 * (b + uc);
+    // Past the corner's whole extent (the common case: a face along x outside the sphere) the
+    // antiderivatives are odd in u, so their difference from -uc is twice their value at uc.
+    if (u >= uc) return segment(uc, y0) + segment(uc, z0) - 0.5 * pi * disc(uc) + 2.0 * y0 * z0 * uc;
+    return 0.5 * (segment(u, y0) - segment(-uc, y0) + segment(u, z0) - segment(-uc, z0)) -
+        0.25 * pi * (disc(u) - disc(-uc)) + y0 * z0 * (u + uc);
   }
 
  private:
@@ -116,7 +118,8 @@ class SphereCuts {
     if (k2 <= 0.0) return 0.0;
     const double k = std::sqrt(k2);
     if (u <= -k) return 0.0;
-    return segment(std::min(u, k), e) - segment(-k, e);
+    if (u >= k) return pi / 3.0 * (r - e) * (r - e) * (2.0 * r + e);    // the whole cap beyond y = e
+    return segment(u, e) - segment(-k, e);
   }
 
   // Antiderivative along u of the segment area with y >= e >= 0, for |u| <= sqrt(r^2 - e^2):
