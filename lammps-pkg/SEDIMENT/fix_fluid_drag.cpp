@@ -129,13 +129,9 @@ void FixFluidDrag::refresh_concentration()
   if (concentration && concentration->invoked_peratom != update->ntimestep) concentration->compute_peratom();
 }
 
-sediment::SphereDrag FixFluidDrag::immersed_drag(int i) const
+FixFluidDrag::Immersed FixFluidDrag::immersed() const
 {
-  sediment::SphereDrag drag;
-  drag.model = model.get();
-  drag.diameter = 2.0 * atom->radius[i];
-  if (concentration) drag.scale.voidage = 1.0 - std::clamp(concentration->vector_atom[i], 0.0, max_fraction);
-  return drag;
+  return {model.get(), atom->radius, concentration ? concentration->vector_atom : nullptr, max_fraction};
 }
 
 sediment::SphereDrag FixFluidDrag::sphere_drag(int i) const
@@ -147,11 +143,6 @@ sediment::SphereDrag FixFluidDrag::sphere_drag(int i) const
   drag.scale.area = sub.area;
   drag.scale.wetted = sub.wetted;
   return drag;
-}
-
-bool FixFluidDrag::fraction_capped(int i) const
-{
-  return concentration && concentration->vector_atom[i] > max_fraction;
 }
 
 double FixFluidDrag::rotation_rate(int i, const sediment::SphereDrag &drag) const

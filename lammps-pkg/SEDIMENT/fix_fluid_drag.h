@@ -19,6 +19,7 @@ FixStyle(fluid/drag,FixFluidDrag);
 
 #include "sediment/integrator.hpp"
 
+#include <algorithm>
 #include <memory>
 
 namespace LAMMPS_NS {
@@ -39,7 +40,7 @@ class FixFluidDrag : public Fix {
   // The drag on local atom i during this step (model nullptr if it is not in the group/fluid).
   sediment::SphereDrag sphere_drag(int i) const;
   // True if the local solid fraction of atom i exceeds max_fraction (its drag uses max_fraction).
-  bool fraction_capped(int i) const;
+  bool fraction_capped(int i) const { return immersed().capped(i); }
   // Linear rate of the rotational drag torque, torque = -rate * I * omega (0 if off).
   double rotation_rate(int i, const sediment::SphereDrag &drag) const;
   // True when every atom of the group is wholly immersed (a fluid without surface or region) and
@@ -52,7 +53,25 @@ class FixFluidDrag : public Fix {
   double linear_per_diameter() const { return model->linear_coefficient(1.0); }
   const sediment::DragModel *drag_model() const { return model.get(); }
   // The drag on local atom i of the group when uniform(): its diameter and local fraction only.
-  sediment::SphereDrag immersed_drag(int i) const;
+  sediment::SphereDrag immersed_drag(int i) const { return immersed().drag(i); }
+  // immersed_drag() with the per-atom arrays taken once, for an integrator's per-atom loop (inline
+  // there: a call per atom into this fix cost as much as the look-up).
+  struct Immersed {
+    const sediment::DragModel *model;
+    const double *radius;
+    const double *fraction;    // local solid fraction per atom; nullptr without a concentration
+    double max_fraction;
+    sediment::SphereDrag drag(int i) const
+    {
+      sediment::SphereDrag drag;
+      drag.model = model;
+      drag.diameter = 2.0 * radius[i];
+      if (fraction) drag.scale.voidage = 1.0 - std::clamp(fraction[i], 0.0, max_fraction);
+      return drag;
+    }
+    bool capped(int i) const { return fraction && fraction[i] > max_fraction; }
+  };
+  Immersed immersed() const;
 
  private:
   char *fluid_id;

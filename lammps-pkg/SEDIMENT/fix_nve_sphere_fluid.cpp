@@ -342,11 +342,12 @@ void FixNVESphereFluid::initial_integrate(int /*vflag*/)
       });
       return;
     }
+    const FixFluidDrag::Immersed immersed = drag->immersed();
     step_first_half([&](int i, sediment::SphereDrag &sphere, const double *&u, double &) {
       if (!(mask[i] & drag_bit)) return;
-      sphere = drag->immersed_drag(i);
+      sphere = immersed.drag(i);
       u = flow;
-      if (drag->fraction_capped(i)) counts[CAPPED] += 1.0;
+      if (immersed.capped(i)) counts[CAPPED] += 1.0;
     });
     return;
   }
