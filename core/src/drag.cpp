@@ -87,9 +87,8 @@ double DragModel::force_at(double d, double speed, double g, DragScale scale) co
   return scale.wetted * yield + scale.area * 0.5 * sphere_area(d) * viscous_scale(d, speed) * g;
 }
 
-void DragModel::curves(const double *re, const double *voidage, DragCurve *out, int n) const
+void DragModel::hinder(const double *re, const double *voidage, DragCurve *out, int n, BatchMath kind) const
 {
-  for (int k = 0; k < n; ++k) out[k] = drag_curve(law_, re[k]);
   if (law_ != DragLaw::DiFelice) return;
   // The hindered spheres of each chunk: ln Re and ln eps, then the Gaussian of chi and the factor.
   constexpr int chunk = 64;
@@ -105,20 +104,20 @@ void DragModel::curves(const double *re, const double *voidage, DragCurve *out, 
         log_eps[m++] = voidage[k];
       }
     if (m == 0) continue;
-    log_many(log_re, log_re, m);
-    log_many(log_eps, log_eps, m);
+    log_many(log_re, log_re, m, kind);
+    log_many(log_eps, log_eps, m, kind);
     double t[chunk];
     for (int j = 0; j < m; ++j) {
       t[j] = 1.5 - log_re[j] * (1.0 / ln10);
       gauss[j] = -0.5 * t[j] * t[j];
     }
-    exp_many(gauss, gauss, m);
+    exp_many(gauss, gauss, m, kind);
     Exponent chi[chunk];
     for (int j = 0; j < m; ++j) {
       chi[j] = re[which[j]] > 0.0 ? di_felice_exponent(t[j], gauss[j]) : Exponent{3.7, 0.0};
       factor[j] = -(chi[j].value + hindrance_offset_) * log_eps[j];
     }
-    exp_many(factor, factor, m);
+    exp_many(factor, factor, m, kind);
     for (int j = 0; j < m; ++j) out[which[j]] = hindered_curve(out[which[j]], chi[j], log_eps[j], factor[j]);
   }
 }

@@ -9,6 +9,7 @@
 // s_A and s_w scale the projected area and the yield term for a partly submerged sphere.
 #pragma once
 
+#include "sediment/batch_math.hpp"
 #include "sediment/geometry.hpp"
 
 #include <array>
@@ -154,8 +155,26 @@ class DragModel {
     return hindered_curve(single, chi, log_eps, std::exp(-(chi.value + hindrance_offset_) * log_eps));
   }
   // curve() of n spheres at once, the hindrance's logarithms and exponentials taken together
-  // (exp_many, log_many): within a few ulp of curve().
-  void curves(const double *re, const double *voidage, DragCurve *out, int n) const;
+  // (exp_many, log_many, of this kind): within a few ulp of curve().
+  void curves(const double *re, const double *voidage, DragCurve *out, int n,
+              BatchMath kind = batch_math_kind()) const
+  {
+    single_curves(re, out, n);
+    hinder(re, voidage, out, n, kind);
+  }
+  // The two parts of curves(). The single-sphere curves inline, for a caller's loop compiled for
+  // its own instruction set; the law is fixed outside the loop, so the common smooth law's loop is
+  // vectorised (with the switch inside, each sphere took an indirect jump and stayed scalar).
+  void single_curves(const double *re, DragCurve *out, int n) const
+  {
+    if (law_ == DragLaw::Dallavalle || law_ == DragLaw::DiFelice) {
+      for (int k = 0; k < n; ++k) out[k] = drag_curve(DragLaw::Dallavalle, re[k]);
+    } else {
+      for (int k = 0; k < n; ++k) out[k] = drag_curve(law_, re[k]);
+    }
+  }
+  // Di Felice's hindrance applied to single-sphere curves (nothing under another law).
+  void hinder(const double *re, const double *voidage, DragCurve *out, int n, BatchMath kind) const;
   // F(0+): the largest force a sphere at rest resists (zero for a Newtonian fluid).
   double static_force(double d, DragScale scale = {}) const;
   // c when F(s) = c s exactly (Stokes in a Newtonian fluid), else 0.

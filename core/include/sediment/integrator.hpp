@@ -16,6 +16,7 @@
 // take the Verlet correction, so it stays exactly still instead of chattering.
 #pragma once
 
+#include "sediment/batch_math.hpp"
 #include "sediment/drag.hpp"
 
 #include <cmath>
@@ -32,9 +33,10 @@ struct Phi {
   double phi2;
 };
 Phi phis(double z);
-// phis of n rates at once, as three arrays, their exponentials taken together (exp_many): within a
-// few ulp of phis.
-void phis_many(const double *z, double *decay, double *phi1, double *phi2, int n);
+// phis of n rates at once, as three arrays, their exponentials taken together (exp_many of this
+// kind): within a few ulp of phis.
+void phis_many(const double *z, double *decay, double *phi1, double *phi2, int n,
+               BatchMath kind = batch_math_kind());
 
 // phis(z) remembered for the last z a sphere saw, in memo = {z, decay, phi1, phi2} (z NaN: empty).
 // With a fixed step and a linear drag z does not change, so the exponential is taken once.
@@ -110,8 +112,10 @@ class SmoothBlock {
     voidage_[n] = drag.scale.voidage;
     return n;
   }
-  // Steps every sphere of the block over dt under `model`, the law of all of them.
-  void step(const DragModel &model, double dt);
+  // Steps every sphere of the block over dt under `model`, the law of all of them. The kind sets the
+  // exponentials and logarithms (exp_many) and, with AVX2, the block's arithmetic runs in 4-wide
+  // vectors: the same operations without fused multiply-adds, so bit for bit those of SSE2.
+  void step(const DragModel &model, double dt, BatchMath kind = batch_math_kind());
   // After step(): the mid-step velocity, the displacement and the weights of a_{n+1} of sphere n.
   void velocity(int n, double v[3]) const { copy3(v_, n, v); }
   void displacement(int n, double dx[3]) const { copy3(dx_, n, dx); }
@@ -131,8 +135,11 @@ class SmoothBlock {
     to[1] = from[1][n];
     to[2] = from[2][n];
   }
+  // The stages, inlined into the step of each instruction set (integrator.cpp).
+  void stages(const DragModel &model, double dt, BatchMath kind);
+  void stages_avx2(const DragModel &model, double dt);
   void slip();
-  void rates(const DragModel &model, double dt);
+  void rates(const DragModel &model, double dt, BatchMath kind);
   void advance_all(double dt);
 
   int size_ = 0;
