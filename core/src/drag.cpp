@@ -1,7 +1,6 @@
 // SPDX-License-Identifier: GPL-2.0-or-later
 #include "sediment/drag.hpp"
 
-#include "sediment/batch_math.hpp"
 #include "sediment/geometry.hpp"
 
 #include <algorithm>
@@ -85,41 +84,6 @@ double DragModel::force_at(double d, double speed, double g, DragScale scale) co
 {
   const double yield = pi * pi * d * d / 4.0 * fluid_.yield_stress;
   return scale.wetted * yield + scale.area * 0.5 * sphere_area(d) * viscous_scale(d, speed) * g;
-}
-
-void DragModel::hinder(const double *re, const double *voidage, DragCurve *out, int n, BatchMath kind) const
-{
-  if (law_ != DragLaw::DiFelice) return;
-  // The hindered spheres of each chunk: ln Re and ln eps, then the Gaussian of chi and the factor.
-  constexpr int chunk = 64;
-  int which[chunk];
-  double log_re[chunk], log_eps[chunk], gauss[chunk], factor[chunk];
-  for (int start = 0; start < n; start += chunk) {
-    const int end = std::min(n, start + chunk);
-    int m = 0;
-    for (int k = start; k < end; ++k)
-      if (hindered(voidage[k])) {
-        which[m] = k;
-        log_re[m] = re[k] > 0.0 ? re[k] : 1.0;    // chi is 3.7 at Re = 0 (see di_felice_exponent)
-        log_eps[m++] = voidage[k];
-      }
-    if (m == 0) continue;
-    log_many(log_re, log_re, m, kind);
-    log_many(log_eps, log_eps, m, kind);
-    double t[chunk];
-    for (int j = 0; j < m; ++j) {
-      t[j] = 1.5 - log_re[j] * (1.0 / ln10);
-      gauss[j] = -0.5 * t[j] * t[j];
-    }
-    exp_many(gauss, gauss, m, kind);
-    Exponent chi[chunk];
-    for (int j = 0; j < m; ++j) {
-      chi[j] = re[which[j]] > 0.0 ? di_felice_exponent(t[j], gauss[j]) : Exponent{3.7, 0.0};
-      factor[j] = -(chi[j].value + hindrance_offset_) * log_eps[j];
-    }
-    exp_many(factor, factor, m, kind);
-    for (int j = 0; j < m; ++j) out[which[j]] = hindered_curve(out[which[j]], chi[j], log_eps[j], factor[j]);
-  }
 }
 
 double DragModel::force(double d, double speed, DragScale scale) const
