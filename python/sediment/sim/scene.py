@@ -173,9 +173,11 @@ FRAMES_PER_STAGE = 20
 MAX_PARTICLES = 10_000_000
 POISSON_RATIO = 0.3
 OVERLAP_TOLERANCE = 0.01    # largest contact overlap / diameter the soft contacts are made for
-# Steps between restart files at least: one costs about two steps of the main job's loop (1.9 ms for
-# 10 000 parcels), so they stay under 2 % of a short run's loop (a twentieth of a long run is more).
-RESTART_SPACING = 100
+# Steps between restart files at least: rank 0 writes one in about 4 ms for 10 000 parcels, some eight
+# steps of the main job's loop (0.5 ms a step), so two in its 645 steps cost 3 % of the loop; at 100
+# apart the six were 8 % (Output 0.014 against 0.026 s, benchmarks/planner.py --scaling). A twentieth
+# of a long run is more.
+RESTART_SPACING = 300
 # The most loaded contact of a settled bed carries more than the deposit's mean pressure on one grain's
 # cross-section (floor contacts lie farther apart than a diameter, and force chains): 2.2 times it in
 # the overdamped bed of benchmarks/contact_step.py (settled overlap 1.70 % under the mean load).
@@ -493,7 +495,7 @@ def _deck(scene: Scene, data: str, layer_file: str) -> str:
         f'print           "SEDIMENT plan steps $(ceil({total_steps}/v_dt_scale)) t_end {scene.t_end:.12g}"',
         "# Two restart files in turn (one is always complete); each stage runs up to its last step, so a",
         "# resumed run skips the stages it has done and finishes the one it was in. One every twentieth of",
-        f"# the run, and {RESTART_SPACING} steps apart at least: a restart file costs about two steps, written by rank 0.",
+        f"# the run, and {RESTART_SPACING} steps apart at least: rank 0 writes each one, in several steps' time.",
         # max(a, b) written out: LAMMPS formulas have no two-argument max (its max() reduces a compute).
         f"variable        restart_every equal ceil({total_steps}/20/v_dt_scale)",
         f"restart         $(v_restart_every+(v_restart_every<{RESTART_SPACING})*({RESTART_SPACING}-v_restart_every)) "
