@@ -114,7 +114,8 @@ class SmoothBlock {
   }
   // Steps every sphere of the block over dt under `model`, the law of all of them. The kind sets the
   // exponentials and logarithms (exp_many) and, with AVX2, the block's arithmetic runs in 4-wide
-  // vectors: the same operations without fused multiply-adds, so bit for bit those of SSE2.
+  // vectors: the same operations without fused multiply-adds, rounded as in the default build (the
+  // vector exp and log of each kind may differ in the last bit).
   void step(const DragModel &model, double dt, BatchMath kind = batch_math_kind());
   // After step(): the mid-step velocity, the displacement and the weights of a_{n+1} of sphere n.
   void velocity(int n, double v[3]) const { copy3(v_, n, v); }
