@@ -3,6 +3,7 @@
 // 30 um at random in a 4 x 4 x 20 mm box): the time per sphere of what compute concentration/grid
 // and the Di Felice law do each step. Ratios between kernels, or between two builds run back to back.
 //   build/bench_core_kernels [--benchmark_repetitions=5]
+#include "sediment/batch_math.hpp"
 #include "sediment/concentration.hpp"
 #include "sediment/drag.hpp"
 #include "sediment/integrator.hpp"
@@ -134,8 +135,9 @@ void PhisMany(benchmark::State &state) { phi_functions(state, true); }
 
 // The drag step of a smooth law (Dallavalle, 30 um quartz in water, slips around the terminal speed
 // of 0.74 mm/s, the step 1e-4 s): a block of one sphere at a time (smooth_step_initial), or blocks of
-// SmoothBlock::capacity (as fix nve/sphere/fluid steps them).
-void smooth_step(benchmark::State &state, bool blocks)
+// SmoothBlock::capacity (as fix nve/sphere/fluid steps them), on the fastest kind here or on SSE2 (the
+// default build's 2-wide arithmetic and exponentials).
+void smooth_step(benchmark::State &state, bool blocks, sediment::BatchMath kind = sediment::batch_math_kind())
 {
   const sediment::DragModel model(sediment::DragLaw::Dallavalle, {998.2, 1.002e-3, 0.0});
   const double diameter = 2 * radius, inverse_mass = 1.0 / (2650 * sediment::pi / 6 * diameter * diameter * diameter);
@@ -158,7 +160,7 @@ void smooth_step(benchmark::State &state, bool blocks)
       for (int start = 0; start < spheres; start += sediment::SmoothBlock::capacity) {
         const int end = std::min(spheres, start + sediment::SmoothBlock::capacity);
         for (int i = start; i < end; ++i) block.add(drag, inverse_mass, a[i].data(), flow, u[i].data());
-        block.step(model, dt);
+        block.step(model, dt, kind);
         for (int i = start; i < end; ++i) {
           block.velocity(i - start, u[i].data());
           block.displacement(i - start, dx[i].data());
@@ -176,6 +178,7 @@ void smooth_step(benchmark::State &state, bool blocks)
 }
 void SmoothStepOneByOne(benchmark::State &state) { smooth_step(state, false); }
 void SmoothStepBlocks(benchmark::State &state) { smooth_step(state, true); }
+void SmoothStepBlocksSSE2(benchmark::State &state) { smooth_step(state, true, sediment::BatchMath::SSE2); }
 
 BENCHMARK(LayerDeposit);
 BENCHMARK(LayerInterpolation);
@@ -187,6 +190,7 @@ BENCHMARK(Phis);
 BENCHMARK(PhisMany);
 BENCHMARK(SmoothStepOneByOne);
 BENCHMARK(SmoothStepBlocks);
+BENCHMARK(SmoothStepBlocksSSE2);
 
 }    // namespace
 
