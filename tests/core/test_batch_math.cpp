@@ -162,3 +162,22 @@ TEST(BatchMath, DragCurvesFollowTheCurveOfEachSphere)
     }
   }
 }
+
+TEST(BatchMath, DiFeliceCurvesInClearFluidAreDallavallesBitForBit)
+{
+  // Every sphere unhindered (eps >= 1, a chunk in clear fluid, which the hindrance skips): the
+  // single-sphere curve of Dallavalle's law, unchanged.
+  const Fluid water{998.2, 1.002e-3, 0.0};
+  const std::vector<double> re = uniform(0.0, 50.0, 200, 7), voidage = uniform(1.0, 1.5, 200, 8);
+  const DragModel felice(DragLaw::DiFelice, water), dalla(DragLaw::Dallavalle, water);
+  for (const BatchMath kind : kinds) {
+    if (!batch_math_available(kind)) continue;
+    std::vector<DragCurve> hindered(re.size()), single(re.size());
+    felice.curves(re.data(), voidage.data(), hindered.data(), static_cast<int>(re.size()), kind);
+    dalla.curves(re.data(), voidage.data(), single.data(), static_cast<int>(re.size()), kind);
+    for (size_t k = 0; k < re.size(); ++k) {
+      EXPECT_EQ(hindered[k].g, single[k].g) << batch_math_name(kind) << " " << k;
+      EXPECT_EQ(hindered[k].re_dg, single[k].re_dg) << batch_math_name(kind) << " " << k;
+    }
+  }
+}

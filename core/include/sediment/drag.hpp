@@ -186,6 +186,9 @@ class DragModel {
     double log_re[chunk], log_eps[chunk], t[chunk], gauss[chunk], value[chunk], slope[chunk], factor[chunk];
     for (int start = 0; start < n; start += chunk) {
       const int m = std::min(n - start, chunk);
+      bool any = false;    // a chunk in clear fluid costs nothing
+      for (int j = 0; j < m; ++j) any |= hindered(voidage[start + j]);
+      if (!any) continue;
       for (int j = 0; j < m; ++j) {
         log_re[j] = re[start + j] > 0.0 ? re[start + j] : 1.0;    // chi is 3.7 at Re = 0 (see di_felice_exponent)
         log_eps[j] = std::min(voidage[start + j], 1.0);           // eps >= 1: no hindrance; NaN stays NaN
