@@ -449,6 +449,10 @@ def _deck(scene: Scene, data: str, layer_file: str) -> str:
         "variable        restart_file index restart.a.bin",
         "variable        timing index no     # yes: LAMMPS's timing breakdown after each stage (where the time goes)",
         "",
+    ]
+    if not e.interacting:    # set before the box (and before read_restart), so in both branches below
+        lines.append("newton          off    # no pair forces: no forces on ghosts to send back each step")
+    lines += [
         "# The weights (real grains each atom stands for) come from the data file, or back from the restart file.",
         'if "${resume} == yes" then "read_restart ${restart_file}" "fix weights all property/atom d_weight" else &',
         '  "units si" "dimension ' + str(scene.dimension) + '" "atom_style sphere" "boundary ' + ('p f p' if slab else 'p p f')
