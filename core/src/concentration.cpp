@@ -194,33 +194,27 @@ double add_sphere_to_layers(const Layers &layers, double centre, double radius, 
   touched(layers, centre - radius, centre + radius, first, last);
   // below() of the whole sphere is +-half, so the volumes telescope to 2 half exactly.
   const double half = below(radius, radius), total = 2.0 * half;
+  double inside = 0.0;
+  auto add = [&](int k, double volume) {    // layer k's share, if the axis has that layer
+    const int cell = cell_of(layers, k);
+    if (cell < 0) return;
+    values[cell * stride] += weight * volume;
+    inside += volume;
+  };
   if (last - first <= 1) {
     // In one layer or across one face, as most spheres are when layers are not thinner than grains:
     // one split at the face above the first layer (the upper part is exactly 0 for a sphere inside
     // it), without the loop's branches, which the processor mispredicted about once per sphere.
     const double lower = below(radius, layers.lo + (first + 1) * layers.thickness - centre) + half;
-    const double upper = total - lower;
-    const int cell_lower = cell_of(layers, first), cell_upper = cell_of(layers, first + 1);
-    double inside = 0.0;
-    if (cell_lower >= 0) {
-      values[cell_lower * stride] += weight * lower;
-      inside += lower;
-    }
-    if (cell_upper >= 0) {
-      values[cell_upper * stride] += weight * upper;
-      inside += upper;
-    }
+    add(first, lower);
+    add(first + 1, total - lower);
     return total - inside;
   }
   clamp_to_axis(layers, first, last);
-  double lower = below(radius, layers.lo + first * layers.thickness - centre), inside = 0.0;
+  double lower = below(radius, layers.lo + first * layers.thickness - centre);
   for (int k = first; k <= last; ++k) {
     const double upper = below(radius, layers.lo + (k + 1) * layers.thickness - centre);
-    const int cell = cell_of(layers, k);
-    if (cell >= 0) {
-      values[cell * stride] += weight * (upper - lower);
-      inside += upper - lower;
-    }
+    add(k, upper - lower);
     lower = upper;
   }
   return total - inside;

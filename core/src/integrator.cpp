@@ -256,8 +256,8 @@ AlongSlip advance_along(const SphereDrag &drag, double mass, double s, double a_
 }
 
 #if defined(__x86_64__) && defined(__GNUC__)
-// The same stages in 4-wide vectors (the 2-wide SSE2 of the default build took 1.3x as long;
-// bench_core_kernels SmoothStepBlocks). No "fma" in the target: no contraction, the same roundings.
+// The same stages in 4-wide vectors (the 2-wide SSE2 of the default build takes 1.3-1.4x as long:
+// bench_core_kernels SmoothStepBlocks against SmoothStepBlocksSSE2). No "fma" in the target: no contraction, the same roundings.
 __attribute__((target("avx2"))) void SmoothBlock::stages_avx2(const DragModel &model, double dt)
 {
   stages(model, dt, BatchMath::AVX2);

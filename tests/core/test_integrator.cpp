@@ -352,10 +352,10 @@ TEST(SmoothBlock, TheArithmeticIsTheSameOnEveryKind)
 {
   // The AVX2 step runs the block's arithmetic in 4-wide vectors, the other kinds in the default
   // build's (2-wide SSE2 on x86-64), a short block's tail one by one; without fused multiply-adds
-  // each operation rounds alike in all of them, so where no
-  // vector exponential enters (every rate below 0.5 takes the scalar series of the phi functions;
-  // Dallavalle's law takes none) the kinds agree bit for bit. Elsewhere glibc's vector exp of each
-  // kind may differ from the others by an ulp, and the steps agree to round-off.
+  // each operation rounds alike in all of them, so where no vector exponential enters (every rate
+  // below 0.5 takes the scalar series of the phi functions; Dallavalle's law takes none) the kinds
+  // agree bit for bit. Elsewhere glibc's vector exp of each kind may differ from the others by an
+  // ulp, and the steps agree to round-off.
   const DragModel model(DragLaw::Dallavalle, {998.2, 1.002e-3, 0.0});
   const std::vector<BlockSphere> spheres = block_spheres(model);
   const std::vector<BlockResult> scalar_small = step_in_blocks(model, spheres, 1e-9, BatchMath::Scalar, false);

@@ -16,7 +16,9 @@ struct Layers {
   double thickness = 1.0;
   int count = 1;
   bool periodic = false;
-  double per_thickness = 1.0;    // 1 / thickness: finding a sphere's layer multiplies (a division per sphere cost more)
+  // 1 / thickness, set by the constructor (assign a new Layers, never thickness alone): finding a
+  // sphere's layer multiplies (a division per sphere cost more).
+  double per_thickness = 1.0;
 
   Layers() = default;
   Layers(double lo_, double thickness_, int count_, bool periodic_ = false) :
