@@ -173,10 +173,10 @@ FRAMES_PER_STAGE = 20
 MAX_PARTICLES = 10_000_000
 POISSON_RATIO = 0.3
 OVERLAP_TOLERANCE = 0.01    # largest contact overlap / diameter the soft contacts are made for
-# Steps between restart files at least: rank 0 writes one in about 4 ms for 10 000 parcels, some eight
-# steps of the main job's loop (0.5 ms a step), so two in its 645 steps cost 3 % of the loop; at 100
-# apart the six were 8 % (Output 0.014 against 0.026 s, benchmarks/planner.py --scaling). A twentieth
-# of a long run is more.
+# Steps between restart files at least: rank 0 writes one in about 3 ms for 10 000 parcels (Output
+# fell by 0.010-0.013 s for four fewer, benchmarks/planner.py --scaling), some six steps of the main
+# job's loop (0.5 ms a step), so the two of its 645 steps cost 2 % of the loop where the six at 100
+# apart cost 6 %. A twentieth of a long run is more.
 RESTART_SPACING = 300
 # The most loaded contact of a settled bed carries more than the deposit's mean pressure on one grain's
 # cross-section (floor contacts lie farther apart than a diameter, and force chains): 2.2 times it in
