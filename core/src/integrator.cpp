@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 
 namespace sediment {
@@ -78,6 +79,10 @@ namespace {
     phi1[k] = (1.0 - decay[k]) * inverse;
     phi2[k] = (z[k] - 1.0 + decay[k]) * inverse * inverse;
   }
+  // Found first in one vector loop: a scalar test per rate cost more than the rest of this stage.
+  std::int64_t any_outside = 0;    // 64 bits, as a lane of doubles: a bool does not vectorise
+  for (int k = 0; k < n; ++k) any_outside |= (std::abs(z[k]) < 0.5) | (z[k] > normal_decay_limit);
+  if (!any_outside) return;
   for (int k = 0; k < n; ++k)
     if (std::abs(z[k]) < 0.5 || z[k] > normal_decay_limit) {
       const Phi p = phis(z[k]);
@@ -201,7 +206,9 @@ AlongSlip advance_along(const SphereDrag &drag, double mass, double s, double a_
     for (int k = 0; k < 3; ++k) dir_[k][n] = w[k] * inverse;
     speed_[n] = s;
   }
-  for (int n = 0; n < size_; ++n) {
+  std::int64_t any_at_rest = 0;    // rare: one vector loop finds whether there is any
+  for (int n = 0; n < size_; ++n) any_at_rest |= !(speed_[n] > 0.0);
+  for (int n = 0; n < size_ && any_at_rest; ++n) {
     if (speed_[n] > 0.0) continue;
     // At rest: along the drive, if there is one (NaN slips come here too and stay NaN below).
     const double a[3] = {a_[0][n], a_[1][n], a_[2][n]};
