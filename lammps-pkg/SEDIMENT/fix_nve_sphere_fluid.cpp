@@ -391,14 +391,9 @@ void FixNVESphereFluid::final_integrate()
         nve_sphere_kick(v[i], omega[i], f[i], torque[i], radius[i], rmass[i], dtf);
       } else {
         // The weights are per unit mass: the step is linear in the force, so f takes the place of a = f / m.
-        sediment::StepCorrection corr;
-        corr.along = w[ALONG];
-        corr.across = w[ACROSS];
-        if (corr.along != corr.across) {    // written by the first half only then
-          std::copy(&w[DIRX], &w[DIRX] + 3, corr.dir);
-        }
+        // The direction is read only when the weights differ: the first half wrote it only then.
         const double spin = w[SPIN];    // read once: the stores into v and omega could alias w
-        sediment::drag_step_final(corr, f[i], v[i]);
+        sediment::add_weighted_acceleration(w[ALONG], w[ACROSS], &w[DIRX], f[i], v[i]);
         omega[i][0] += spin * torque[i][0];
         omega[i][1] += spin * torque[i][1];
         omega[i][2] += spin * torque[i][2];

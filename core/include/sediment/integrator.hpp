@@ -224,16 +224,25 @@ inline StepCorrection drag_step_initial(const SphereDrag &drag, double inverse_m
   return linear_step_initial(memo ? phis(z, memo) : phis(z), a, u, dt, v, dx);
 }
 
-// Second half: adds the weighted acceleration a_{n+1} = f_{n+1} / m.
-inline void drag_step_final(const StepCorrection &corr, const double a[3], double v[3])
+// Second half: adds the weighted acceleration a_{n+1} = f_{n+1} / m, weight `along` along the
+// direction dir (read only when the weights differ) and `across` across it, written as the isotropic
+// part plus the excess along dir (fewer operations than the two projections). Values copied first:
+// the stores into v could alias the other arrays, which would then be read anew after each store.
+inline void add_weighted_acceleration(double along, double across, const double dir[3], const double a[3],
+                                      double v[3])
 {
-  if (corr.along == corr.across) {    // isotropic: linear drag, no drag, or held
-    for (int k = 0; k < 3; ++k) v[k] += corr.along * a[k];
+  const double accel[3] = {a[0], a[1], a[2]};
+  if (along == across) {    // isotropic: linear drag, no drag, or held
+    for (int k = 0; k < 3; ++k) v[k] += along * accel[k];
     return;
   }
-  const double a_par = dot(a, corr.dir);
-  for (int k = 0; k < 3; ++k)
-    v[k] += corr.along * a_par * corr.dir[k] + corr.across * (a[k] - a_par * corr.dir[k]);
+  const double d[3] = {dir[0], dir[1], dir[2]};
+  const double excess = (along - across) * dot(accel, d);
+  for (int k = 0; k < 3; ++k) v[k] += across * accel[k] + excess * d[k];
+}
+inline void drag_step_final(const StepCorrection &corr, const double a[3], double v[3])
+{
+  add_weighted_acceleration(corr.along, corr.across, corr.dir, a, v);
 }
 
 // Largest time step at which this step is stable for a sphere on a linear spring of angular
