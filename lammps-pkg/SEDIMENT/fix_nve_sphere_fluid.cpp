@@ -209,7 +209,9 @@ template <FixNVESphereFluid::HalfStep path, class Lookup> void FixNVESphereFluid
     w[ACROSS] = corr.across * per_mass;
     if (corr.along != corr.across) {    // the direction matters to the second half only then
       w[DRAG_MEMO] = std::numeric_limits<double>::quiet_NaN();    // it takes the memo's place
-      std::copy(corr.dir, corr.dir + 3, &w[DIRX]);
+      w[DIRX] = corr.dir[0];
+      w[DIRY] = corr.dir[1];
+      w[DIRZ] = corr.dir[2];
     }
     if (floor_dim >= 0) settle_on_floor(x[i], v[i], omega[i], radius[i], floor_dim, floor_at);
     return state;
