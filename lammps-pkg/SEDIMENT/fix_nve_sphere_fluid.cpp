@@ -198,8 +198,10 @@ template <FixNVESphereFluid::HalfStep path, class Lookup> void FixNVESphereFluid
 
   // What follows the drag step of atom i: position, rotation, the weights for the second half
   // (taken per unit mass and moment of inertia, so the second half divides by neither). Returns
-  // the state_sum of the new position and velocity, for the check of a finite state.
-  auto finish = [&](int i, const sediment::StepCorrection &corr, const double dx[3], double spin_rate,
+  // the state_sum of the new position and velocity, for the check of a finite state. Captures by
+  // value, as the look-ups do: with references to the locals, the block's out-of-line step made the
+  // loop reload them from the stack for every atom.
+  auto finish = [=](int i, const sediment::StepCorrection &corr, const double dx[3], double spin_rate,
                     double per_mass) {
     double *w = weights[i];
     const double new_x[3] = {x[i][0] + dx[0], x[i][1] + dx[1], x[i][2] + dx[2]};
@@ -348,7 +350,7 @@ void FixNVESphereFluid::initial_integrate(int /*vflag*/)
     if (half_step == HalfStep::Linear) {    // a linear law has no local fraction: the diameter is all it needs
       const double *radius = atom->radius;
       const sediment::DragModel *model = drag->drag_model();
-      first_half<HalfStep::Linear>([&](int i, sediment::SphereDrag &sphere, const double *&u, double &) {
+      first_half<HalfStep::Linear>([=](int i, sediment::SphereDrag &sphere, const double *&u, double &) {
         if (!(mask[i] & drag_bit)) return;
         sphere.model = model;
         sphere.diameter = 2.0 * radius[i];
@@ -357,7 +359,7 @@ void FixNVESphereFluid::initial_integrate(int /*vflag*/)
       return;
     }
     const FixFluidDrag::Immersed immersed = drag->immersed();
-    step_first_half([&](int i, sediment::SphereDrag &sphere, const double *&u, double &) {
+    step_first_half([=](int i, sediment::SphereDrag &sphere, const double *&u, double &) {
       if (!(mask[i] & drag_bit)) return;
       sphere = immersed.drag(i);
       u = flow;
