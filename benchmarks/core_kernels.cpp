@@ -154,12 +154,13 @@ void smooth_step(benchmark::State &state, bool blocks, sediment::BatchMath kind 
   drag.model = &model;
   drag.diameter = diameter;
   sediment::SmoothBlock block;
+  block.set_flow(flow);
   for (auto _ : state) {
     auto u = v;    // the same start each time
     if (blocks) {
       for (int start = 0; start < spheres; start += sediment::SmoothBlock::capacity) {
         const int end = std::min(spheres, start + sediment::SmoothBlock::capacity);
-        for (int i = start; i < end; ++i) block.add(drag, inverse_mass, a[i].data(), flow, u[i].data());
+        for (int i = start; i < end; ++i) block.add(drag, inverse_mass, a[i].data(), u[i].data());
         block.step(model, dt, kind);
         for (int i = start; i < end; ++i) {
           block.velocity(i - start, u[i].data());

@@ -200,7 +200,7 @@ AlongSlip advance_along(const SphereDrag &drag, double mass, double s, double a_
 [[gnu::always_inline]] inline void SmoothBlock::slip()
 {
   for (int n = 0; n < size_; ++n) {
-    const double w[3] = {v_[0][n] - u_[0][n], v_[1][n] - u_[1][n], v_[2][n] - u_[2][n]};
+    const double w[3] = {v_[0][n] - u_[0], v_[1][n] - u_[1], v_[2][n] - u_[2]};
     const double s = std::sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]);
     const double inverse = 1.0 / s;    // s = 0: infinite, the direction is set below
     for (int k = 0; k < 3; ++k) dir_[k][n] = w[k] * inverse;
@@ -247,8 +247,8 @@ AlongSlip advance_along(const SphereDrag &drag, double mass, double s, double a_
     const double across_drift = dt * dt * phi2_[1][n];
     for (int k = 0; k < 3; ++k) {
       const double a_perp = a_[k][n] - a_par_[n] * dir_[k][n];
-      dx_[k][n] = u_[k][n] * dt + slip.distance * dir_[k][n] + across_drift * a_perp;
-      v_[k][n] = u_[k][n] + along_now * dir_[k][n] + across_now * a_perp;
+      dx_[k][n] = u_[k] * dt + slip.distance * dir_[k][n] + across_drift * a_perp;
+      v_[k][n] = u_[k] + along_now * dir_[k][n] + across_now * a_perp;
     }
   }
 }
@@ -285,7 +285,8 @@ StepCorrection smooth_step_initial(const SphereDrag &drag, double inverse_mass, 
                                    const double u[3], double dt, double v[3], double dx[3])
 {
   SmoothBlock block;
-  block.add(drag, inverse_mass, a, u, v);
+  block.set_flow(u);
+  block.add(drag, inverse_mass, a, v);
   block.step(*drag.model, dt);
   block.velocity(0, v);
   block.displacement(0, dx);

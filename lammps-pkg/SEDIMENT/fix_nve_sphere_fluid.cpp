@@ -297,9 +297,12 @@ template <FixNVESphereFluid::HalfStep path, class Lookup> void FixNVESphereFluid
       continue;
     }
     if (path == HalfStep::Blocked && sediment::step_kind(sphere) == sediment::StepKind::Smooth) {
-      if (block.size() > 0 && sphere.model != block_model) state += step_block();
-      block_model = sphere.model;
-      waiting[block.add(sphere, per_mass, a, flow, v[i])] = {i, spin_rate, per_mass};
+      if (sphere.model != block_model) {    // a block per law, and so per fluid/drag fix and flow
+        if (block.size() > 0) state += step_block();
+        block_model = sphere.model;
+        block.set_flow(flow);
+      }
+      waiting[block.add(sphere, per_mass, a, v[i])] = {i, spin_rate, per_mass};
       if (block.full()) state += step_block();
       continue;
     }

@@ -241,11 +241,14 @@ namespace {
 
 struct BlockSphere {
   SphereDrag drag;
-  double inverse_mass, a[3], u[3], v[3];
+  double inverse_mass, a[3], v[3];
 };
 
+// The fluid's velocity, shared by the spheres of a block: across and along the drive.
+const double block_flow[3] = {2e-5, 0.0, 1e-5};
+
 // Spheres of three sizes at three voidages, with slips across, along and against the drive, at rest
-// (the direction is the drive's) and with no drive at all.
+// (the direction is the drive's; block_flow is among the velocities) and with no drive at all.
 std::vector<BlockSphere> block_spheres(const DragModel &model)
 {
   std::vector<BlockSphere> spheres;
@@ -253,10 +256,11 @@ std::vector<BlockSphere> block_spheres(const DragModel &model)
   for (double d : {3e-6, 3e-5, 3e-4})
     for (double voidage : {1.0, 0.9, 0.6})
       for (const auto &v : {std::array<double, 3>{1e-4, 0.0, -3e-4}, std::array<double, 3>{0.0, 0.0, -2e-3},
-                            std::array<double, 3>{0.0, 0.0, 5e-3}, std::array<double, 3>{0.0, 0.0, 0.0},
+                            std::array<double, 3>{0.0, 0.0, 5e-3},
+                            std::array<double, 3>{block_flow[0], block_flow[1], block_flow[2]},
                             std::array<double, 3>{-1e-3, 2e-3, 0.5}}) {
         BlockSphere sp{{&model, d, {1.0, 1.0, voidage}}, 1.0 / (2650.0 * sphere_volume(d)), {0.0, 0.3, -6.0},
-                       {0.0, 0.0, 1e-5 * (k % 3)}, {v[0], v[1], v[2]}};
+                       {v[0], v[1], v[2]}};
         if (k++ % 7 == 3) sp.a[0] = sp.a[1] = sp.a[2] = 0.0;    // no drive: at rest it stays
         spheres.push_back(sp);
       }
@@ -276,10 +280,11 @@ std::vector<BlockResult> step_in_blocks(const DragModel &model, const std::vecto
   const int n = static_cast<int>(spheres.size()), size = alone ? 1 : SmoothBlock::capacity;
   std::vector<BlockResult> out(spheres.size());
   SmoothBlock block;
+  block.set_flow(block_flow);
   for (int start = alone ? 0 : 1; start < n + (alone ? 0 : 1); start += size) {
     std::vector<int> members;
     for (int j = start; j < std::min(n + (alone ? 0 : 1), start + size); ++j) members.push_back(j % n);
-    for (int j : members) block.add(spheres[j].drag, spheres[j].inverse_mass, spheres[j].a, spheres[j].u, spheres[j].v);
+    for (int j : members) block.add(spheres[j].drag, spheres[j].inverse_mass, spheres[j].a, spheres[j].v);
     block.step(model, dt, kind);
     for (size_t m = 0; m < members.size(); ++m) {
       BlockResult &r = out[members[m]];
@@ -329,12 +334,12 @@ TEST(SmoothBlock, EachSphereStepsAsAloneAndAsTheNewtonStep)
         expect_same_bits(blocks[j], alone[j]);
         if (kind == batch_math_kind()) {
           BlockResult initial{{sp.v[0], sp.v[1], sp.v[2]}, {}, {}};
-          initial.corr = smooth_step_initial(sp.drag, sp.inverse_mass, sp.a, sp.u, dt, initial.v.data(), initial.dx.data());
+          initial.corr = smooth_step_initial(sp.drag, sp.inverse_mass, sp.a, block_flow, dt, initial.v.data(), initial.dx.data());
           expect_same_bits(blocks[j], initial);
         }
         double v_newton[3] = {sp.v[0], sp.v[1], sp.v[2]}, dx_newton[3];
         const StepCorrection newton =
-            set_valued_step_initial(sp.drag, 1.0 / sp.inverse_mass, sp.a, sp.u, dt, v_newton, dx_newton);
+            set_valued_step_initial(sp.drag, 1.0 / sp.inverse_mass, sp.a, block_flow, dt, v_newton, dx_newton);
         EXPECT_NEAR(blocks[j].corr.along, newton.along, 1e-12 * newton.along);
         EXPECT_NEAR(blocks[j].corr.across, newton.across, 1e-12 * newton.across);
         const double scale = std::abs(sp.v[0]) + std::abs(sp.v[1]) + std::abs(sp.v[2]) + dt * 6.0;

@@ -90,6 +90,7 @@ inline Segment advance(const Phi &p, double s0, double c, double t)
 // square roots, divisions and exponentials per sphere. One evaluation of the law gives the Newton
 // rate along the slip, k (G + Re G') / m, and the secant rate across it, k G / m (F = k s G(Re),
 // Re = K s). The arithmetic of each sphere does not depend on the block it is in, nor on where.
+// The spheres of a block share their law and the fluid's velocity (one fluid/drag fix).
 class SmoothBlock {
  public:
   static constexpr int capacity = 32;
@@ -97,14 +98,18 @@ class SmoothBlock {
   int size() const { return size_; }
   bool full() const { return size_ == capacity; }
   void clear() { size_ = 0; }
-  // Adds a sphere (drag.model smooth and nonlinear, the block's law) with its velocity v, the flow u,
-  // the non-drag acceleration a_n and 1 / m; returns its place in the block.
-  int add(const SphereDrag &drag, double inverse_mass, const double a[3], const double u[3], const double v[3])
+  // The velocity u of the fluid around every sphere of the block; set while the block is empty.
+  void set_flow(const double u[3])
+  {
+    for (int k = 0; k < 3; ++k) u_[k] = u[k];
+  }
+  // Adds a sphere (drag.model smooth and nonlinear, the block's law) with its velocity v, the
+  // non-drag acceleration a_n and 1 / m; returns its place in the block.
+  int add(const SphereDrag &drag, double inverse_mass, const double a[3], const double v[3])
   {
     const int n = size_++;
     for (int k = 0; k < 3; ++k) {
       v_[k][n] = v[k];
-      u_[k][n] = u[k];
       a_[k][n] = a[k];
     }
     reynolds_per_speed_[n] = drag.model->smooth_reynolds_per_speed(drag.diameter);
@@ -144,9 +149,10 @@ class SmoothBlock {
   void advance_all(double dt);
 
   int size_ = 0;
-  // Per sphere, component first: velocity (the mid-step velocity after step()), flow, a_n,
-  // direction of the slip, displacement.
-  double v_[3][capacity], u_[3][capacity], a_[3][capacity], dir_[3][capacity], dx_[3][capacity];
+  double u_[3] = {0.0, 0.0, 0.0};    // the flow
+  // Per sphere, component first: velocity (the mid-step velocity after step()), a_n, direction of the
+  // slip, displacement.
+  double v_[3][capacity], a_[3][capacity], dir_[3][capacity], dx_[3][capacity];
   double reynolds_per_speed_[capacity], rate_per_g_[capacity], voidage_[capacity];    // K, k / m, eps
   double speed_[capacity], a_par_[capacity], reynolds_[capacity];
   DragCurve curve_[capacity];
