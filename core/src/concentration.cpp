@@ -306,20 +306,48 @@ double add_sphere_to_grid(const Grid &grid, const double centre[3], double radiu
   return add_sphere_to_layers(grid.axes[along], centre[along], radius, base, step[along] * stride, weight);
 }
 
-double grid_value_at(const Grid &grid, const double *values, const double point[3], int stride)
+namespace {
+
+// grid_value_at on a grid of cells (not layers), inline in the loops that read many points.
+[[gnu::always_inline]] inline double cells_value_at(const Grid &grid, const double *values, const double point[3],
+                                                    int stride)
 {
-  if (const int axis = layer_axis(grid); axis >= 0) return profile_at(grid.axes[axis], values, point[axis], stride);
   Bracket at[3];
   for (int d = 0; d < 3; ++d) at[d] = grid.resolved[d] ? bracket(grid.axes[d], point[d]) : Bracket{0, 0, 0.0};
   // Linear along x on the four edges around the point, then along y, then along z: no branch per
   // corner (an axis not resolved has k0 = k1 = 0 and weight 0, so it reads its one cell twice).
-  const int nx = grid.axes[0].count, ny = grid.axes[1].count;
-  auto along_x = [&](int j, int k) {
-    const double *row = values + nx * (j + ny * k) * stride;
-    return (1.0 - at[0].w) * row[at[0].k0 * stride] + at[0].w * row[at[0].k1 * stride];
+  // Indices become offsets into values once per axis, not once per corner.
+  const int step_y = grid.axes[0].count * stride, step_z = step_y * grid.axes[1].count;
+  const int x0 = at[0].k0 * stride, x1 = at[0].k1 * stride;
+  auto along_x = [&](int offset) {
+    const double *row = values + offset;
+    return (1.0 - at[0].w) * row[x0] + at[0].w * row[x1];
   };
-  auto along_y = [&](int k) { return (1.0 - at[1].w) * along_x(at[1].k0, k) + at[1].w * along_x(at[1].k1, k); };
-  return (1.0 - at[2].w) * along_y(at[2].k0) + at[2].w * along_y(at[2].k1);
+  auto along_y = [&](int offset) {
+    return (1.0 - at[1].w) * along_x(offset + at[1].k0 * step_y) + at[1].w * along_x(offset + at[1].k1 * step_y);
+  };
+  return (1.0 - at[2].w) * along_y(at[2].k0 * step_z) + at[2].w * along_y(at[2].k1 * step_z);
+}
+
+}    // namespace
+
+double grid_value_at(const Grid &grid, const double *values, const double point[3], int stride)
+{
+  if (const int axis = layer_axis(grid); axis >= 0) return profile_at(grid.axes[axis], values, point[axis], stride);
+  return cells_value_at(grid, values, point, stride);
+}
+
+void grid_values_at(const Grid &grid, const double *values, const double *const *points, int n, double *out,
+                    int stride)
+{
+  // A copy: a store into out could otherwise change the grid, for all the compiler knows, and every
+  // point would load it anew.
+  const Grid local = grid;
+  if (const int axis = layer_axis(local); axis >= 0) {
+    for (int i = 0; i < n; ++i) out[i] = profile_at(local.axes[axis], values, points[i][axis], stride);
+    return;
+  }
+  for (int i = 0; i < n; ++i) out[i] = cells_value_at(local, values, points[i], stride);
 }
 
 void smooth_grid(const Grid &grid, double *values, double width, double *scratch, int stride)

@@ -262,16 +262,11 @@ void ComputeConcentrationGrid::compute_peratom()
     nmax = atom->nmax;
     memory->create(vector_atom, nmax, "concentration/grid:vector_atom");
   }
-  double **x = atom->x;
-  int *mask = atom->mask;
-  const double *total = fractions.data();    // column 0
-  if (axis >= 0) {    // the one-axis read, without finding the axis per sphere (as grid_value_at would)
-    for (int i = 0; i < atom->nlocal; ++i)
-      vector_atom[i] = (mask[i] & groupbit) ? sediment::profile_at(grid.axes[axis], total, x[i][axis], ncols) : 0.0;
-    return;
-  }
+  // Read at every local atom (what depends on the grid alone taken once), then zero outside the group.
+  const int *mask = atom->mask;
+  sediment::grid_values_at(grid, fractions.data(), atom->x, atom->nlocal, vector_atom, ncols);    // column 0
   for (int i = 0; i < atom->nlocal; ++i)
-    vector_atom[i] = (mask[i] & groupbit) ? sediment::grid_value_at(grid, total, x[i], ncols) : 0.0;
+    if (!(mask[i] & groupbit)) vector_atom[i] = 0.0;
 }
 
 double ComputeConcentrationGrid::memory_usage()

@@ -62,6 +62,10 @@ double add_sphere_to_grid(const Grid &grid, const double centre[3], double radiu
 // Trilinear interpolation between cell centres (flat beyond the outer centres, wrapped along
 // periodic axes).
 double grid_value_at(const Grid &grid, const double *values, const double point[3], int stride = 1);
+// grid_value_at of n points, out[i] for points[i] (one row of three coordinates each, as LAMMPS keeps
+// positions): the same values, with what depends on the grid alone decided once.
+void grid_values_at(const Grid &grid, const double *values, const double *const *points, int n, double *out,
+                    int stride = 1);
 
 // smooth_profile along every resolved axis in turn (a separable Gaussian), in place; scratch needs
 // as many entries as the longest axis.
