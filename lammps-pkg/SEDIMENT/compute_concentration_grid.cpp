@@ -262,11 +262,16 @@ void ComputeConcentrationGrid::compute_peratom()
     nmax = atom->nmax;
     memory->create(vector_atom, nmax, "concentration/grid:vector_atom");
   }
-  // Read at every local atom (what depends on the grid alone taken once), then zero outside the group.
+  const double *total = fractions.data();    // column 0
+  if (groupbit == 1) {    // group all: every local atom, what depends on the grid alone taken once
+    sediment::grid_values_at(grid, total, atom->x, atom->nlocal, vector_atom, ncols);
+    return;
+  }
+  // Atoms outside the group are not read: their positions are not this compute's to trust.
+  double **x = atom->x;
   const int *mask = atom->mask;
-  sediment::grid_values_at(grid, fractions.data(), atom->x, atom->nlocal, vector_atom, ncols);    // column 0
   for (int i = 0; i < atom->nlocal; ++i)
-    if (!(mask[i] & groupbit)) vector_atom[i] = 0.0;
+    vector_atom[i] = (mask[i] & groupbit) ? sediment::grid_value_at(grid, total, x[i], ncols) : 0.0;
 }
 
 double ComputeConcentrationGrid::memory_usage()
