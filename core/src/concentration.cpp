@@ -277,11 +277,12 @@ int layer_axis(const Grid &grid)
 
 }    // namespace
 
-double add_sphere_to_grid(const Grid &grid, const double centre[3], double radius, double *values, int stride,
-                          double weight)
+namespace {
+
+// add_sphere_to_grid on a grid of cells (not layers), inline in the loop that deposits many spheres.
+[[gnu::always_inline]] inline double cells_deposit(const Grid &grid, const double centre[3], double radius,
+                                                   double *values, int stride, double weight)
 {
-  if (const int axis = layer_axis(grid); axis >= 0)
-    return add_sphere_to_layers(grid.axes[axis], centre[axis], radius, values, stride, weight);
   const double total = 4.0 / 3.0 * pi * radius * radius * radius;
   int first[3], last[3], ncrossing = 0, along = -1;
   bool crosses[3] = {false, false, false};
@@ -314,6 +315,32 @@ double add_sphere_to_grid(const Grid &grid, const double centre[3], double radiu
   }
   const int step[3] = {1, nx, nx * ny};
   return add_sphere_to_layers(grid.axes[along], centre[along], radius, base, step[along] * stride, weight);
+}
+
+}    // namespace
+
+double add_sphere_to_grid(const Grid &grid, const double centre[3], double radius, double *values, int stride,
+                          double weight)
+{
+  if (const int axis = layer_axis(grid); axis >= 0)
+    return add_sphere_to_layers(grid.axes[axis], centre[axis], radius, values, stride, weight);
+  return cells_deposit(grid, centre, radius, values, stride, weight);
+}
+
+double add_spheres_to_grid(const Grid &grid, const double *const *centres, const double *radius,
+                           const double *weight, int n, double *values, int stride)
+{
+  const Grid local = grid;    // a copy: the stores into values could otherwise change the grid
+  double outside = 0.0;
+  if (const int axis = layer_axis(local); axis >= 0) {
+    for (int i = 0; i < n; ++i)
+      outside += add_sphere_to_layers(local.axes[axis], centres[i][axis], radius[i], values, stride,
+                                      weight ? weight[i] : 1.0);
+    return outside;
+  }
+  for (int i = 0; i < n; ++i)
+    outside += cells_deposit(local, centres[i], radius[i], values, stride, weight ? weight[i] : 1.0);
+  return outside;
 }
 
 namespace {

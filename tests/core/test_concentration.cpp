@@ -6,8 +6,10 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
+#include <random>
 #include <vector>
 
 using namespace sediment;
@@ -253,4 +255,42 @@ TEST(Grid, ACornerCellMatchesDirectIntegrationOfChords)
     }
   direct *= 0.04 / (static_cast<double>(n) * n);
   EXPECT_NEAR(values[i + 5 * (j + 5 * k)], direct, 1e-5 * direct);
+}
+
+TEST(Grid, ManySpheresAtOnceAreTheSpheresOneByOne)
+{
+  // add_spheres_to_grid and grid_values_at, which compute concentration/grid calls for group all,
+  // give bit for bit what add_sphere_to_grid and grid_value_at give one sphere at a time: on layers
+  // and on cells, bounded and periodic, spheres inside, across faces and edges, and partly outside.
+  const Layers one{0.0, 1.0, 1}, column{0.0, 0.1, 10, true};
+  const std::vector<Grid> grids = {Grid{{one, one, column}, {false, false, true}}, cube_grid(0.0, 0.1, 10),
+                                   cube_grid(0.0, 0.1, 10, true)};
+  std::mt19937_64 random(3);
+  std::uniform_real_distribution<double> coordinate(-0.05, 1.05), size(0.005, 0.12), count(0.5, 3.0);
+  const int n = 500;
+  std::vector<std::array<double, 3>> centres(n);
+  std::vector<double> radius(n), weight(n);
+  std::vector<const double *> rows(n);
+  for (int i = 0; i < n; ++i) {
+    for (double &c : centres[i]) c = coordinate(random);
+    radius[i] = size(random);
+    weight[i] = count(random);
+    rows[i] = centres[i].data();
+  }
+  for (const Grid &grid : grids) {
+    for (const double *weights : {static_cast<const double *>(nullptr), static_cast<const double *>(weight.data())}) {
+      // Two columns, as the compute interleaves them: the batch fills the second.
+      std::vector<double> alone(2 * grid.cells(), 0.0), together(2 * grid.cells(), 0.0);
+      double outside_alone = 0.0;
+      for (int i = 0; i < n; ++i)
+        outside_alone += add_sphere_to_grid(grid, rows[i], radius[i], alone.data() + 1, 2, weights ? weights[i] : 1.0);
+      const double outside = add_spheres_to_grid(grid, rows.data(), radius.data(), weights, n, together.data() + 1, 2);
+      EXPECT_EQ(outside, outside_alone);
+      ASSERT_EQ(together, alone);
+
+      std::vector<double> read(n);
+      grid_values_at(grid, alone.data() + 1, rows.data(), n, read.data(), 2);
+      for (int i = 0; i < n; ++i) EXPECT_EQ(read[i], grid_value_at(grid, alone.data() + 1, rows[i], 2)) << "sphere " << i;
+    }
+  }
 }

@@ -58,6 +58,11 @@ struct Grid {
 // the sphere beyond three perpendicular planes (cost: the sphere's cell vertices).
 double add_sphere_to_grid(const Grid &grid, const double centre[3], double radius, double *values, int stride = 1,
                           double weight = 1.0);
+// add_sphere_to_grid of n spheres in turn (centres[i] one row of three coordinates, as LAMMPS keeps
+// positions; weight nullptr: one each), with what depends on the grid alone decided once: the same
+// sums in the same order. Returns the sum of their volumes outside the grid.
+double add_spheres_to_grid(const Grid &grid, const double *const *centres, const double *radius,
+                           const double *weight, int n, double *values, int stride = 1);
 
 // Trilinear interpolation between cell centres (flat beyond the outer centres, wrapped along
 // periodic axes).
