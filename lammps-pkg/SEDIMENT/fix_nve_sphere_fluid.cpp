@@ -30,11 +30,8 @@
 using namespace LAMMPS_NS;
 using namespace FixConst;
 
-// The kick of fix nve/sphere, written as it does, so that a scene without fluid is bitwise the
-// same as with fix nve/sphere. dtf = dt ftm2v / 2. Returns the new velocity: read back from v, it
-// would wait for the stores just made.
-// The rotational half of that kick, which is also the rotation of a sphere in a fluid without a
-// rotational drag. Returns the torque's weight, dtf / I.
+// The rotational half of fix nve/sphere's kick (below), which is also the rotation of a sphere in a
+// fluid without a rotational drag. Returns the torque's weight, dtf / I.
 static inline double nve_sphere_spin(double *omega, const double *torque, double radius, double rmass, double dtf)
 {
   const double dtirotate = dtf / sediment::solid_sphere_inertia / (radius * radius * rmass);
@@ -44,6 +41,9 @@ static inline double nve_sphere_spin(double *omega, const double *torque, double
   return dtirotate;
 }
 
+// The kick of fix nve/sphere, written as it does, so that a scene without fluid is bitwise the
+// same as with fix nve/sphere. dtf = dt ftm2v / 2. Returns the new velocity: read back from v, it
+// would wait for the stores just made.
 static inline std::array<double, 3> nve_sphere_kick(double *v, double *omega, const double *f, const double *torque,
                                                     double radius, double rmass, double dtf)
 {
