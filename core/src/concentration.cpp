@@ -88,6 +88,9 @@ class SphereCuts {
  public:
   explicit SphereCuts(double radius) : r(radius), r2(radius * radius) {}
 
+  // Volume with x <= u and y >= e (z free).
+  double quarter(double u, double e) const { return half(std::clamp(u, -r, r), e); }
+
   // Volume with x <= u, y >= y0 and z >= z0.
   double corner(double u, double y0, double z0) const
   {
@@ -177,6 +180,37 @@ double spread_over_cells(const Grid &grid, const double centre[3], double radius
         values[(cells[0][i] + nx * (cells[1][j] + ny * cells[2][k])) * stride] += weight * volume;
         inside += volume;
       }
+  return inside;
+}
+
+// Spreads a sphere that crosses one face along each of two axes p and q, and none along the third
+// (whose cell is other_cell), over its four cells: one quarter volume (x_p <= a, x_q >= b) and the
+// two slabs below a and above b give all four, where the vertices' inclusion-exclusion took eighteen
+// corner volumes. face[d] is the face's unwrapped index along d. Returns the volume put in cells.
+double spread_across_two_faces(const Grid &grid, const double centre[3], double radius, int p, int q,
+                               const int face[3], int other_cell, double *values, int stride, double weight)
+{
+  const Layers &along_p = grid.axes[p], &along_q = grid.axes[q];
+  const double a = along_p.lo + face[p] * along_p.thickness - centre[p];
+  const double b = along_q.lo + face[q] * along_q.thickness - centre[q];
+  const double half_sphere = below(radius, radius);
+  const double below_a = below(radius, a) + half_sphere, above_b = half_sphere - below(radius, b);
+  const double corner = SphereCuts(radius).quarter(a, b);
+  // [side along p][side along q], 0 below the face, 1 above it
+  const double volume[2][2] = {{below_a - corner, corner},
+                               {2.0 * half_sphere - below_a - above_b + corner, above_b - corner}};
+  const int nx = grid.axes[0].count, ny = grid.axes[1].count;
+  int index[3];
+  index[3 - p - q] = other_cell;
+  double inside = 0.0;
+  for (int side_p = 0; side_p < 2; ++side_p)
+    for (int side_q = 0; side_q < 2; ++side_q) {
+      index[p] = cell_of(along_p, face[p] - 1 + side_p);
+      index[q] = cell_of(along_q, face[q] - 1 + side_q);
+      if (index[p] < 0 || index[q] < 0) continue;    // beyond an outer face of a bounded axis
+      values[(index[0] + nx * (index[1] + ny * index[2])) * stride] += weight * volume[side_p][side_q];
+      inside += volume[side_p][side_q];
+    }
   return inside;
 }
 
@@ -284,8 +318,8 @@ namespace {
                                                    double *values, int stride, double weight)
 {
   const double total = 4.0 / 3.0 * pi * radius * radius * radius;
-  int first[3], last[3], ncrossing = 0, along = -1;
-  bool crosses[3] = {false, false, false};
+  int first[3], last[3], face[3], ncrossing = 0, along = -1, before = -1;
+  bool crosses[3] = {false, false, false}, one_face = true;
   for (int d = 0; d < 3; ++d) {
     first[d] = last[d] = 0;
     if (!grid.resolved[d]) continue;
@@ -294,11 +328,21 @@ namespace {
     // A sphere crossing a face (an outer one too) is split along d; the range is clamped after.
     if (first[d] != last[d]) {
       crosses[d] = true;
+      before = along;
       along = d;
       ++ncrossing;
+      face[d] = first[d] + 1;
+      one_face = one_face && last[d] == face[d];
     }
     clamp_to_axis(axis, first[d], last[d]);
     if (first[d] > last[d]) return total;
+  }
+  if (ncrossing == 2 && one_face) {    // the common split in two axes: four cells around one edge
+    const int other = 3 - along - before;
+    const int other_cell = grid.resolved[other] ? cell_of(grid.axes[other], first[other]) : 0;
+    if (other_cell < 0) return total;
+    return total - spread_across_two_faces(grid, centre, radius, before, along, face, other_cell, values, stride,
+                                           weight);
   }
   if (ncrossing > 1)
     return total - spread_over_cells(grid, centre, radius, first, last, crosses, values, stride, weight);

@@ -294,3 +294,31 @@ TEST(Grid, ManySpheresAtOnceAreTheSpheresOneByOne)
     }
   }
 }
+
+TEST(Grid, ASphereAcrossOneFaceInEachOfTwoAxesAgreesWithRefinedCells)
+{
+  // On cells of 0.25 each sphere crosses one face along two axes and none along the third (its four
+  // cells from one quarter volume); on cells of 0.0625 it crosses several along all three (the
+  // vertices' inclusion-exclusion). Inside, across an outer face of a bounded grid (the part beyond
+  // is outside), and across a periodic one (it wraps).
+  struct Case {
+    double centre[3];
+    bool periodic;
+  };
+  const double r = 0.1, total = 4.0 / 3.0 * pi * r * r * r;
+  for (const Case &c : {Case{{0.27, 0.52, 0.62}, false}, Case{{0.45, 0.97, 0.125}, false},
+                        Case{{0.03, 0.55, 0.375}, true}}) {
+    const Grid coarse = cube_grid(0.0, 0.25, 4, c.periodic), fine = cube_grid(0.0, 0.0625, 16, c.periodic);
+    std::vector<double> coarse_values(64, 0.0), fine_values(4096, 0.0);
+    const double outside = add_sphere_to_grid(coarse, c.centre, r, coarse_values.data());
+    EXPECT_NEAR(outside, add_sphere_to_grid(fine, c.centre, r, fine_values.data()), 1e-14 * total);
+    EXPECT_NEAR(sum(coarse_values), total - outside, 1e-14 * total);
+    for (int cell = 0; cell < 64; ++cell) {
+      const int i = cell % 4, j = cell / 4 % 4, k = cell / 16;
+      double refined = 0.0;
+      for (int sub = 0; sub < 64; ++sub)
+        refined += fine_values[(4 * i + sub % 4) + 16 * ((4 * j + sub / 4 % 4) + 16 * (4 * k + sub / 16))];
+      EXPECT_NEAR(coarse_values[cell], refined, 1e-14 * total) << "cell " << cell;
+    }
+  }
+}
