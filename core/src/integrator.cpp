@@ -66,14 +66,18 @@ Phi phis(double z)
 
 namespace {
 
+// Where phis_many's direct forms do not hold and phis() takes over: near zero (cancellation) and past
+// the normal range of e^-z (subnormal, or 0 beyond the decay limit). Both tests are evaluated, without
+// a branch, so that the loop finding any such rate vectorises.
+inline bool beyond_direct_forms(double z) { return (std::abs(z) < 0.5) | (z > normal_decay_limit); }
+
 // The body of phis_many, inlined into the block's step of each instruction set.
 [[gnu::always_inline]] inline void fill_phis(const double *z, double *decay, double *phi1, double *phi2, int n,
                                              BatchMath kind)
 {
   for (int k = 0; k < n; ++k) decay[k] = -std::min(z[k], normal_decay_limit);
   exp_many(decay, decay, n, kind);
-  // The direct forms for all (one vector loop), then phis() where they do not hold: near zero
-  // (cancellation) and past the normal range of e^-z (subnormal, or 0 beyond the decay limit).
+  // The direct forms for all (one vector loop), then phis() where they do not hold.
   for (int k = 0; k < n; ++k) {
     const double inverse = 1.0 / z[k];
     phi1[k] = (1.0 - decay[k]) * inverse;
@@ -81,10 +85,10 @@ namespace {
   }
   // Found first in one vector loop: a scalar test per rate cost more than the rest of this stage.
   std::int64_t any_outside = 0;    // 64 bits, as a lane of doubles: a bool does not vectorise
-  for (int k = 0; k < n; ++k) any_outside |= (std::abs(z[k]) < 0.5) | (z[k] > normal_decay_limit);
+  for (int k = 0; k < n; ++k) any_outside |= beyond_direct_forms(z[k]);
   if (!any_outside) return;
   for (int k = 0; k < n; ++k)
-    if (std::abs(z[k]) < 0.5 || z[k] > normal_decay_limit) {
+    if (beyond_direct_forms(z[k])) {
       const Phi p = phis(z[k]);
       decay[k] = p.decay;
       phi1[k] = p.phi1;
