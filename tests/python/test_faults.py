@@ -111,9 +111,12 @@ def test_frames_of_another_fluid_are_not_spliced(tmp_path):
 
 
 def test_a_killed_run_keeps_the_earlier_result_and_resumes_to_the_same_frames(tmp_path):
-    whole = sample(tmp_path / "whole", "--particles", 15000)
+    # 8600 steps (24 h at Courant 0.5): restart files at steps 2000 and 4000, and steps after them
+    # for the kill to find the run going
+    options = ("--particles", 5000, "--t-end", 86400, "--courant", 0.5)
+    whole = sample(tmp_path / "whole", *options)
     assert sediment("run", whole, "--quiet").returncode == 0
-    cut = sample(tmp_path / "cut", "--particles", 15000)
+    cut = sample(tmp_path / "cut", *options)
     # An earlier complete result in the folder, which the killed rerun (--force) must not damage.
     assert sediment("run", cut, "--quiet").returncode == 0
     earlier = digest(cut.parent / "layers.h5")

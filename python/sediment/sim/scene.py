@@ -173,11 +173,12 @@ FRAMES_PER_STAGE = 20
 MAX_PARTICLES = 10_000_000
 POISSON_RATIO = 0.3
 OVERLAP_TOLERANCE = 0.01    # largest contact overlap / diameter the soft contacts are made for
-# Steps between restart files at least: rank 0 writes one in about 3 ms for 10 000 parcels (Output
-# fell by 0.010-0.013 s for four fewer, benchmarks/planner.py --scaling), some six steps of the main
-# job's loop (0.5 ms a step), so the two of its 645 steps cost 2 % of the loop where the six at 100
-# apart cost 6 %. A twentieth of a long run is more.
-RESTART_SPACING = 300
+# Steps between restart files at least. Rank 0 writes one in about 7 ms for 10 000 parcels (Output
+# 0.015-0.017 s with the main job's two, 0.001 s without, benchmarks/planner.py --scaling), as long
+# as some 16 of its 0.43 ms steps, and both scale with the parcels: 2000 apart keeps them under 1 %
+# of a run's steps (a twentieth of a run is more past 40 000 steps). A run shorter than that writes
+# none, and a killed one starts again from the beginning.
+RESTART_SPACING = 2000
 # The most loaded contact of a settled bed carries more than the deposit's mean pressure on one grain's
 # cross-section (floor contacts lie farther apart than a diameter, and force chains): 2.2 times it in
 # the overdamped bed of benchmarks/contact_step.py (settled overlap 1.70 % under the mean load).
@@ -464,8 +465,9 @@ def _deck(scene: Scene, data: str, layer_file: str) -> str:
     ]
     if e.interacting:    # pair forces need ghosts within a contact or film reach
         lines.append(f"comm_modify     cutoff {3 * d_max:.6g} vel yes")
-    else:                # no pair forces: a thin shell of ghosts only keeps LAMMPS from warning
-        lines.append(f"comm_modify     cutoff {0.01 * min(scene.width, scene.thickness):.6g}")
+    else:                # no pair forces, no ghosts needed: a cutoff far below any grain copies none
+        # (each ghost is sent to the next rank every step) and keeps LAMMPS from warning of a zero one
+        lines.append(f"comm_modify     cutoff {1e-9 * min(scene.width, scene.thickness):.6g}")
     lines += [
         "",
         f"fix             grav all gravity {f.gravity:.12g} vector {gravity}",
