@@ -47,7 +47,13 @@ class FixLayersHDF5 : public Fix {
   // and closing them for each frame was three quarters of the cost of writing it.
   long long frame_sets[3];
   bool is_open;         // the same on every rank (file is only meaningful on rank 0)
-  long long frames;     // frames in the file
+  long long frames;     // frames taken: in the file and waiting to be written (rank 0)
+  // Frames taken but not yet in the file (rank 0), row by row, and when the file was last written.
+  std::vector<double> pending_time, pending_values;
+  std::vector<long long> pending_step;
+  double last_write;
+  static constexpr double WRITE_INTERVAL = 1.0;             // seconds a frame waits at most
+  static constexpr size_t PENDING_BYTES = size_t(64) << 20;    // or until this many bytes wait
   bool overwrite;       // a new run may replace an earlier file of other parameters
   std::string writing;  // the file the frames go to (rank 0): PATH.partial until LAMMPS is done
 
@@ -55,7 +61,8 @@ class FixLayersHDF5 : public Fix {
   std::vector<std::pair<const char *, double>> parameters(const sediment::Layers &layers) const;
   std::string choose_file(bigint step_now, size_t layers, size_t columns,
                           const std::vector<std::pair<const char *, double>> &identity, const std::string &run_id);
-  void write_frame();
+  void take_frame(bool write_now);    // takes a frame; writes the waiting ones if due or write_now
+  void write_pending();
   void open_frame_sets();    // rank 0, the file open
   void close_file();
   // Runs `action` on rank 0 and stops every rank with its message if it failed.

@@ -10,6 +10,7 @@ import argparse
 import csv
 import math
 import os
+import shutil
 import tempfile
 from pathlib import Path
 
@@ -744,8 +745,17 @@ def layers_hdf5(np_ranks: int):
         solid = run_deck(deck, {"tend": 2.0, "file": tmp / "whole.h5"}, np_ranks, cwd=tmp).results["solid_volume"]
         run_deck(deck, {"tend": 1.0, "file": tmp / "split.h5", "restart": 1,
                                     "restart_file": tmp / "poly.restart"}, np_ranks, cwd=tmp)
+        shutil.copy(tmp / "split.h5", tmp / "cut.h5")
         run_deck("layers_restart.lmp", {"restart": tmp / "poly.restart", "file": tmp / "split.h5"}, np_ranks, cwd=tmp)
-        whole, split = read_layers(tmp / "whole.h5"), read_layers(tmp / "split.h5")
+        # Cut short at step 170 after a restart file at step 160: the frame of step 150 was still
+        # waiting to be written when a restart file came due, and a resumed run continues after it.
+        cut = run_deck("layers_restart.lmp", {"restart": tmp / "poly.restart", "file": tmp / "cut.h5",
+                                              "cut_at": 170, "restart_every": 80, "cut_restart": tmp / "cut.restart"},
+                       np_ranks, expect_failure=True, cwd=tmp)
+        assert "Fix halt condition" in cut.text
+        left = read_layers(tmp / "cut.h5.partial")
+        run_deck("layers_restart.lmp", {"restart": tmp / "cut.restart.160", "file": tmp / "cut.h5"}, np_ranks, cwd=tmp)
+        whole, split, resumed = (read_layers(tmp / f"{name}.h5") for name in ("whole", "split", "cut"))
         serial = None
         if np_ranks > 1:
             run_deck(deck, {"tend": 2.0, "file": tmp / "serial.h5"}, 1, cwd=tmp)
@@ -761,6 +771,13 @@ def layers_hdf5(np_ranks: int):
     diff = float(np.max(np.abs(split.fraction - whole.fraction)))
     report(f"restart: split run vs whole run max difference of the layer fractions {diff:.1e}")
     assert diff < 1e-12
+    report(f"cut at step 170 (restart file at 160): frames left {left.step.tolist()}; resumed frames "
+           f"{resumed.step.tolist()}")
+    assert left.step.tolist() == [0, 50, 100, 150] and not left.complete
+    assert resumed.step.tolist() == whole.step.tolist()
+    cut_diff = float(np.max(np.abs(resumed.fraction - whole.fraction)))
+    report(f"cut and resumed vs whole run: max difference of the layer fractions {cut_diff:.1e}")
+    assert cut_diff < 1e-12
     if serial is not None:
         rank_diff = float(np.max(np.abs(serial.fraction - whole.fraction)))
         report(f"1 vs {np_ranks} ranks: max difference of the layer fractions {rank_diff:.1e}")
