@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import hashlib
 import os
+import shutil
 import signal
 import subprocess
 import time
@@ -153,6 +154,18 @@ def test_a_batch_run_streams_its_lines_and_is_stopped_at_its_timeout(tmp_path):
     assert not processes_in(tmp_path)
     ticks = [t for t, line in seen if line.split()[:1] and line.split()[0].isdigit()]
     assert len(ticks) > 3 and ticks[0] < 2    # read as printed, not at the end of the run
+
+
+def test_a_rerun_over_frames_a_killed_run_left_says_how_to_go_on(tmp_path):
+    deck = sample(tmp_path / "left", "--particles", 2000)
+    assert sediment("run", deck, "--quiet").returncode == 0
+    # What a run killed before its first restart file leaves: its frames under layers.h5.partial
+    shutil.copy(deck.parent / "layers.h5", deck.parent / "layers.h5.partial")
+    again = sediment("run", deck, "--quiet")
+    assert again.returncode == 2 and "unfinished run's frames" in again.stderr
+    assert "--resume" in again.stderr and "--force starts it anew" in again.stderr
+    assert sediment("run", deck, "--quiet", "--force").returncode == 0
+    assert read_layers(deck.parent / "layers.h5").complete and not (deck.parent / "layers.h5.partial").exists()
 
 
 def test_resume_needs_a_restart_file(tmp_path):

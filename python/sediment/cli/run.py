@@ -27,8 +27,16 @@ def run(args: argparse.Namespace) -> int:
     """Runs the deck and says what it did."""
     from ..sim.run import run_deck
 
-    result = run_deck(args.deck, ranks=args.np, variables=dict(args.var or []), progress=not args.quiet,
-                      oversubscribe=args.oversubscribe, force=args.force, resume=args.resume)
+    try:
+        result = run_deck(args.deck, ranks=args.np, variables=dict(args.var or []), progress=not args.quiet,
+                          oversubscribe=args.oversubscribe, force=args.force, resume=args.resume)
+    except RuntimeError as exc:
+        if "'overwrite yes'" not in str(exc):
+            raise
+        # LAMMPS names its own variable; here the same choice is an option (a killed run shorter than
+        # the restart spacing has no restart file, so its frames can only be started anew).
+        raise RuntimeError(f"{exc}\n  sediment run --resume continues a killed run from its last restart file; "
+                           "--force starts it anew (-var overwrite yes)") from None
     print(f"{result.deck.name}: {result.steps} steps, {result.simulated_time:.6g} s simulated in "
           f"{result.wall_seconds:.1f} s on {args.np} rank(s); log {result.log}")
     return 0
