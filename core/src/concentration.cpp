@@ -7,6 +7,11 @@
 #include <cmath>
 #include <vector>
 
+#if defined(__x86_64__) && defined(__GNUC__)
+#define SEDIMENT_GRID_AVX2 1
+#include <immintrin.h>
+#endif
+
 namespace sediment {
 
 namespace {
@@ -418,17 +423,137 @@ double grid_value_at(const Grid &grid, const double *values, const double point[
   return cells_value_at(grid, values, point, stride);
 }
 
+namespace {
+
+// grid_value_at of points[i], i < n, one by one (what the vector read leaves, and all of it without AVX2).
+void values_at_one_by_one(const Grid &grid, int axis, const double *values, const double *const *points, int first,
+                          int n, double *out, int stride)
+{
+  if (axis >= 0)
+    for (int i = first; i < n; ++i) out[i] = layers_value_at(grid.axes[axis], values, points[i][axis], stride);
+  else
+    for (int i = first; i < n; ++i) out[i] = cells_value_at(grid, values, points[i], stride);
+}
+
+#ifdef SEDIMENT_GRID_AVX2
+const bool grid_has_avx2 = (__builtin_cpu_init(), __builtin_cpu_supports("avx2"));
+
+// bracket() of four coordinates along an axis: the two centres' indices (whole numbers, as doubles)
+// and the weight of the second, by the same operations, so the same values. False when a lane lies
+// beyond one period of a periodic axis (or is NaN): the caller reads those four points one by one.
+__attribute__((target("avx2"))) inline bool brackets4(const Layers &axis, __m256d x, __m256d &k0, __m256d &k1,
+                                                      __m256d &w)
+{
+  const __m256d s = _mm256_sub_pd(
+      _mm256_mul_pd(_mm256_sub_pd(x, _mm256_set1_pd(axis.lo)), _mm256_set1_pd(axis.per_thickness)),
+      _mm256_set1_pd(0.5));
+  const __m256d zero = _mm256_setzero_pd(), one = _mm256_set1_pd(1.0), last = _mm256_set1_pd(axis.count - 1);
+  if (axis.periodic) {
+    const __m256d k = _mm256_floor_pd(s);
+    const __m256d within = _mm256_and_pd(_mm256_cmp_pd(k, _mm256_set1_pd(-1.0), _CMP_GE_OQ),
+                                         _mm256_cmp_pd(k, last, _CMP_LE_OQ));
+    if (_mm256_movemask_pd(within) != 0xF) return false;
+    const __m256d count = _mm256_set1_pd(axis.count), next = _mm256_add_pd(k, one);
+    w = _mm256_sub_pd(s, k);
+    k0 = _mm256_blendv_pd(k, _mm256_add_pd(k, count), _mm256_cmp_pd(k, zero, _CMP_LT_OQ));    // -1 wraps to n - 1
+    k1 = _mm256_blendv_pd(next, zero, _mm256_cmp_pd(next, count, _CMP_EQ_OQ));                // n wraps to 0
+    return true;
+  }
+  if (_mm256_movemask_pd(_mm256_cmp_pd(s, s, _CMP_ORD_Q)) != 0xF) return false;
+  // Flat beyond the outer centres: index 0 at or below the first, count - 1 at or past the last.
+  const __m256d high = _mm256_cmp_pd(s, last, _CMP_GE_OQ);
+  const __m256d ends = _mm256_or_pd(_mm256_cmp_pd(s, zero, _CMP_LE_OQ), high), end = _mm256_and_pd(high, last);
+  const __m256d k = _mm256_round_pd(s, _MM_FROUND_TO_ZERO | _MM_FROUND_NO_EXC);
+  w = _mm256_blendv_pd(_mm256_sub_pd(s, k), zero, ends);
+  k0 = _mm256_blendv_pd(k, end, ends);
+  k1 = _mm256_blendv_pd(_mm256_add_pd(k, one), end, ends);
+  return true;
+}
+
+// (1 - w) a + w b, lane by lane, as the scalar read computes it.
+__attribute__((target("avx2"))) inline __m256d between(__m256d a, __m256d b, __m256d w)
+{
+  return _mm256_add_pd(_mm256_mul_pd(_mm256_sub_pd(_mm256_set1_pd(1.0), w), a), _mm256_mul_pd(w, b));
+}
+
+// values at four element offsets (whole numbers below 2^31, as doubles)
+__attribute__((target("avx2"))) inline __m256d gather(const double *values, __m256d offset)
+{
+  return _mm256_i32gather_pd(values, _mm256_cvttpd_epi32(offset), 8);
+}
+
+// Linear along x between the centres' values on the edge at `offset`, then along y between two such
+// edges, as cells_value_at (lambdas would not take the target).
+__attribute__((target("avx2"))) inline __m256d along_x(const double *values, __m256d offset, const __m256d lower[3],
+                                                       const __m256d upper[3], const __m256d w[3])
+{
+  return between(gather(values, _mm256_add_pd(offset, lower[0])), gather(values, _mm256_add_pd(offset, upper[0])),
+                 w[0]);
+}
+
+__attribute__((target("avx2"))) inline __m256d along_y(const double *values, __m256d offset, const __m256d lower[3],
+                                                       const __m256d upper[3], const __m256d w[3])
+{
+  return between(along_x(values, _mm256_add_pd(offset, lower[1]), lower, upper, w),
+                 along_x(values, _mm256_add_pd(offset, upper[1]), lower, upper, w), w[1]);
+}
+
+// grid_values_at four points at a time, bit for bit the scalar read: the corners' values gathered,
+// the same operations lane by lane (no fused multiply-add in this target, so the same roundings).
+__attribute__((target("avx2"))) void values_at_avx2(const Grid &grid, int axis, const double *values,
+                                                    const double *const *points, int n, double *out, int stride)
+{
+  const __m256d zero = _mm256_setzero_pd();
+  const double step[3] = {static_cast<double>(stride), static_cast<double>(grid.axes[0].count) * stride,
+                          static_cast<double>(grid.axes[0].count) * grid.axes[1].count * stride};
+  int i = 0;
+  for (; i + 4 <= n; i += 4) {
+    __m256d lower[3], upper[3], w[3];    // per axis: the two centres' offsets into values, the weight
+    bool in_common_range = true;
+    for (int d = 0; d < 3; ++d) {
+      if (axis >= 0 ? d != axis : !grid.resolved[d]) {
+        lower[d] = upper[d] = w[d] = zero;
+        continue;
+      }
+      const __m256d x = _mm256_set_pd(points[i + 3][d], points[i + 2][d], points[i + 1][d], points[i][d]);
+      if (!brackets4(grid.axes[d], x, lower[d], upper[d], w[d])) {
+        in_common_range = false;
+        break;
+      }
+      lower[d] = _mm256_mul_pd(lower[d], _mm256_set1_pd(axis >= 0 ? stride : step[d]));
+      upper[d] = _mm256_mul_pd(upper[d], _mm256_set1_pd(axis >= 0 ? stride : step[d]));
+    }
+    if (!in_common_range) {
+      values_at_one_by_one(grid, axis, values, points, i, i + 4, out, stride);
+      continue;
+    }
+    if (axis >= 0) {
+      _mm256_storeu_pd(out + i, between(gather(values, lower[axis]), gather(values, upper[axis]), w[axis]));
+      continue;
+    }
+    _mm256_storeu_pd(out + i, between(along_y(values, lower[2], lower, upper, w), along_y(values, upper[2], lower, upper, w),
+                                      w[2]));
+  }
+  values_at_one_by_one(grid, axis, values, points, i, n, out, stride);
+}
+#endif
+
+}    // namespace
+
 void grid_values_at(const Grid &grid, const double *values, const double *const *points, int n, double *out,
                     int stride)
 {
   // A copy: a store into out could otherwise change the grid, for all the compiler knows, and every
   // point would load it anew.
   const Grid local = grid;
-  if (const int axis = layer_axis(local); axis >= 0) {
-    for (int i = 0; i < n; ++i) out[i] = layers_value_at(local.axes[axis], values, points[i][axis], stride);
+  const int axis = layer_axis(local);
+#ifdef SEDIMENT_GRID_AVX2
+  if (grid_has_avx2) {
+    values_at_avx2(local, axis, values, points, n, out, stride);
     return;
   }
-  for (int i = 0; i < n; ++i) out[i] = cells_value_at(local, values, points[i], stride);
+#endif
+  values_at_one_by_one(local, axis, values, points, 0, n, out, stride);
 }
 
 void smooth_grid(const Grid &grid, double *values, double width, double *scratch, int stride)

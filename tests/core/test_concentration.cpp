@@ -261,7 +261,8 @@ TEST(Grid, ManySpheresAtOnceAreTheSpheresOneByOne)
 {
   // add_spheres_to_grid and grid_values_at, which compute concentration/grid calls for group all,
   // give bit for bit what add_sphere_to_grid and grid_value_at give one sphere at a time: on layers
-  // and on cells, bounded and periodic, spheres inside, across faces and edges, and partly outside.
+  // and on cells, bounded and periodic, spheres inside, across faces and edges, partly and far
+  // outside (the read goes four points at a time where the processor has AVX2).
   const Layers one{0.0, 1.0, 1}, column{0.0, 0.1, 10, true};
   const std::vector<Grid> grids = {Grid{{one, one, column}, {false, false, true}}, cube_grid(0.0, 0.1, 10),
                                    cube_grid(0.0, 0.1, 10, true)};
@@ -277,6 +278,8 @@ TEST(Grid, ManySpheresAtOnceAreTheSpheresOneByOne)
     weight[i] = count(random);
     rows[i] = centres[i].data();
   }
+  // Some far outside along one axis: beyond the flat ends, or periods away along a periodic axis.
+  for (int i = 0; i < 12; ++i) centres[7 * i][i % 3] += i % 2 ? 3.3 : -4.7;
   for (const Grid &grid : grids) {
     for (const double *weights : {static_cast<const double *>(nullptr), static_cast<const double *>(weight.data())}) {
       // Two columns, as the compute interleaves them: the batch fills the second.
