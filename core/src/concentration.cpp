@@ -133,7 +133,14 @@ class SphereCuts {
     const double k = std::sqrt(k2);
     if (u <= -k) return 0.0;
     if (u >= k) return pi / 3.0 * (r - e) * (r - e) * (2.0 * r + e);    // the whole cap beyond y = e
-    return segment(u, e) - segment(-k, e);
+    return segment(u, e) - segment_from(k2, e);
+  }
+
+  // segment(-k, e), where the segment closes (sqrt(rho^2 - e^2) = 0): its three angles are 0 (pi/2 at
+  // e = 0), -pi/2 and -pi/2 (0 at e = 0), which leave one closed form, without atan2.
+  double segment_from(double k2, double e) const
+  {
+    return 0.5 * pi * (e * k2 / 3.0 + 2.0 / 3.0 * e * r2 - 2.0 / 3.0 * r2 * r);
   }
 
   // Antiderivative along u of the segment area with y >= e >= 0, for |u| <= sqrt(r^2 - e^2):
@@ -193,34 +200,50 @@ double spread_over_cells(const Grid &grid, const double centre[3], double radius
   return inside;
 }
 
-// Spreads a sphere that crosses one face along each of two axes p and q, and none along the third
-// (whose cell is other_cell), over its four cells: one quarter volume (x_p <= a, x_q >= b) and the
-// two slabs below a and above b give all four, where the vertices' inclusion-exclusion took eighteen
-// corner volumes. face[d] is the face's unwrapped index along d. Returns the volume put in cells.
-double spread_across_two_faces(const Grid &grid, const double centre[3], double radius, int p, int q,
-                               const int face[3], int other_cell, double *values, int stride, double weight)
+// Spreads a sphere that crosses one face along each of two or three axes (crossing[d]) and none along
+// the others (in cell[d] there) over its four or eight cells, by inclusion-exclusion of the parts
+// below the faces: below the faces of a set of axes lies the sphere, a slab, a slab less a quarter
+// volume, or (three axes) two faces' part less a quarter volume plus a corner volume, where the
+// vertices' inclusion-exclusion took 18 or 27 corner volumes. face[d] is the face's unwrapped index
+// along d. Returns the volume put in cells.
+double spread_across_faces(const Grid &grid, const double centre[3], double radius, const bool crossing[3],
+                           const int face[3], const int cell[3], double *values, int stride, double weight)
 {
-  const Layers &along_p = grid.axes[p], &along_q = grid.axes[q];
-  const double a = along_p.lo + face[p] * along_p.thickness - centre[p];
-  const double b = along_q.lo + face[q] * along_q.thickness - centre[q];
-  const double half_sphere = below(radius, radius);
-  const double below_a = below(radius, a) + half_sphere, above_b = half_sphere - below(radius, b);
-  const double corner = SphereCuts(radius).quarter(a, b);
-  // [side along p][side along q], 0 below the face, 1 above it
-  const double volume[2][2] = {{below_a - corner, corner},
-                               {2.0 * half_sphere - below_a - above_b + corner, above_b - corner}};
-  const int nx = grid.axes[0].count, ny = grid.axes[1].count;
-  int index[3];
-  index[3 - p - q] = other_cell;
-  double inside = 0.0;
-  for (int side_p = 0; side_p < 2; ++side_p)
-    for (int side_q = 0; side_q < 2; ++side_q) {
-      index[p] = cell_of(along_p, face[p] - 1 + side_p);
-      index[q] = cell_of(along_q, face[q] - 1 + side_q);
-      if (index[p] < 0 || index[q] < 0) continue;    // beyond an outer face of a bounded axis
-      values[(index[0] + nx * (index[1] + ny * index[2])) * stride] += weight * volume[side_p][side_q];
-      inside += volume[side_p][side_q];
+  int axes[3], n = 0;
+  double offset[3];    // of each crossing axis's face from the centre
+  for (int d = 0; d < 3; ++d)
+    if (crossing[d]) {
+      axes[n] = d;
+      offset[n++] = grid.axes[d].lo + face[d] * grid.axes[d].thickness - centre[d];
     }
+  const SphereCuts cuts(radius);
+  const double half = below(radius, radius);
+  // part[set]: below the faces of the crossing axes whose bits are set (bit k for axes[k])
+  double part[8];
+  part[0] = 2.0 * half;
+  for (int k = 0; k < n; ++k) part[1 << k] = below(radius, offset[k]) + half;
+  for (int j = 0; j < n; ++j)
+    for (int k = j + 1; k < n; ++k) part[1 << j | 1 << k] = part[1 << j] - cuts.quarter(offset[j], offset[k]);
+  if (n == 3) part[7] = part[3] - cuts.quarter(offset[0], offset[2]) + cuts.corner(offset[0], offset[1], offset[2]);
+
+  const int nx = grid.axes[0].count, ny = grid.axes[1].count, all = (1 << n) - 1;
+  double inside = 0.0;
+  for (int above = 0; above <= all; ++above) {    // bit k: the cell beyond the face along axes[k]
+    double volume = 0.0;
+    for (int beyond = above;; beyond = (beyond - 1) & above) {    // every subset of above
+      volume += (__builtin_popcount(beyond) % 2 ? -1.0 : 1.0) * part[(all & ~above) | beyond];
+      if (beyond == 0) break;
+    }
+    int index[3] = {cell[0], cell[1], cell[2]};
+    bool outside = false;
+    for (int k = 0; k < n; ++k) {
+      index[axes[k]] = cell_of(grid.axes[axes[k]], face[axes[k]] - 1 + (above >> k & 1));
+      outside = outside || index[axes[k]] < 0;    // beyond an outer face of a bounded axis
+    }
+    if (outside) continue;
+    values[(index[0] + nx * (index[1] + ny * index[2])) * stride] += weight * volume;
+    inside += volume;
+  }
   return inside;
 }
 
@@ -328,7 +351,7 @@ namespace {
                                                    double *values, int stride, double weight)
 {
   const double total = 4.0 / 3.0 * pi * radius * radius * radius;
-  int first[3], last[3], face[3], ncrossing = 0, along = -1, before = -1;
+  int first[3], last[3], face[3], ncrossing = 0, along = -1;
   bool crosses[3] = {false, false, false}, one_face = true;
   for (int d = 0; d < 3; ++d) {
     first[d] = last[d] = 0;
@@ -338,7 +361,6 @@ namespace {
     // A sphere crossing a face (an outer one too) is split along d; the range is clamped after.
     if (first[d] != last[d]) {
       crosses[d] = true;
-      before = along;
       along = d;
       ++ncrossing;
       face[d] = first[d] + 1;
@@ -347,12 +369,13 @@ namespace {
     clamp_to_axis(axis, first[d], last[d]);
     if (first[d] > last[d]) return total;
   }
-  if (ncrossing == 2 && one_face) {    // the common split in two axes: four cells around one edge
-    const int other = 3 - along - before;
-    const int other_cell = grid.resolved[other] ? cell_of(grid.axes[other], first[other]) : 0;
-    if (other_cell < 0) return total;
-    return total - spread_across_two_faces(grid, centre, radius, before, along, face, other_cell, values, stride,
-                                           weight);
+  if (ncrossing > 1 && one_face) {    // the common splits in two or three axes: around one edge or vertex
+    int cell[3];
+    for (int d = 0; d < 3; ++d) {
+      cell[d] = crosses[d] || !grid.resolved[d] ? 0 : cell_of(grid.axes[d], first[d]);
+      if (cell[d] < 0) return total;
+    }
+    return total - spread_across_faces(grid, centre, radius, crosses, face, cell, values, stride, weight);
   }
   if (ncrossing > 1)
     return total - spread_over_cells(grid, centre, radius, first, last, crosses, values, stride, weight);

@@ -298,10 +298,11 @@ TEST(Grid, ManySpheresAtOnceAreTheSpheresOneByOne)
   }
 }
 
-TEST(Grid, ASphereAcrossOneFaceInEachOfTwoAxesAgreesWithRefinedCells)
+TEST(Grid, ASphereAcrossOneFaceInEachOfTwoOrThreeAxesAgreesWithRefinedCells)
 {
   // On cells of 0.25 each sphere crosses one face along two axes and none along the third (its four
-  // cells from one quarter volume); on cells of 0.0625 it crosses several along all three (the
+  // cells from one quarter volume), or one along each of the three (its eight from three quarter
+  // volumes and a corner volume); on cells of 0.0625 it crosses several along all three (the
   // vertices' inclusion-exclusion). Inside, across an outer face of a bounded grid (the part beyond
   // is outside), and across a periodic one (it wraps).
   struct Case {
@@ -310,7 +311,8 @@ TEST(Grid, ASphereAcrossOneFaceInEachOfTwoAxesAgreesWithRefinedCells)
   };
   const double r = 0.1, total = 4.0 / 3.0 * pi * r * r * r;
   for (const Case &c : {Case{{0.27, 0.52, 0.62}, false}, Case{{0.45, 0.97, 0.125}, false},
-                        Case{{0.03, 0.55, 0.375}, true}}) {
+                        Case{{0.03, 0.55, 0.375}, true}, Case{{0.27, 0.52, 0.73}, false},
+                        Case{{0.95, 0.48, 0.27}, false}, Case{{0.03, 0.74, 0.52}, true}}) {
     const Grid coarse = cube_grid(0.0, 0.25, 4, c.periodic), fine = cube_grid(0.0, 0.0625, 16, c.periodic);
     std::vector<double> coarse_values(64, 0.0), fine_values(4096, 0.0);
     const double outside = add_sphere_to_grid(coarse, c.centre, r, coarse_values.data());
