@@ -226,21 +226,25 @@ double spread_across_faces(const Grid &grid, const double centre[3], double radi
     for (int k = j + 1; k < n; ++k) part[1 << j | 1 << k] = part[1 << j] - cuts.quarter(offset[j], offset[k]);
   if (n == 3) part[7] = part[3] - cuts.quarter(offset[0], offset[2]) + cuts.corner(offset[0], offset[1], offset[2]);
 
+  int sides[3][2];    // each crossing axis's cells below and above its face (-1: beyond a bounded end)
+  for (int k = 0; k < n; ++k)
+    for (int above = 0; above < 2; ++above) sides[k][above] = cell_of(grid.axes[axes[k]], face[axes[k]] - 1 + above);
+  constexpr double parity[8] = {1.0, -1.0, -1.0, 1.0, -1.0, 1.0, 1.0, -1.0};    // (-1)^(bits set)
   const int nx = grid.axes[0].count, ny = grid.axes[1].count, all = (1 << n) - 1;
   double inside = 0.0;
   for (int above = 0; above <= all; ++above) {    // bit k: the cell beyond the face along axes[k]
-    double volume = 0.0;
-    for (int beyond = above;; beyond = (beyond - 1) & above) {    // every subset of above
-      volume += (__builtin_popcount(beyond) % 2 ? -1.0 : 1.0) * part[(all & ~above) | beyond];
-      if (beyond == 0) break;
-    }
     int index[3] = {cell[0], cell[1], cell[2]};
     bool outside = false;
     for (int k = 0; k < n; ++k) {
-      index[axes[k]] = cell_of(grid.axes[axes[k]], face[axes[k]] - 1 + (above >> k & 1));
-      outside = outside || index[axes[k]] < 0;    // beyond an outer face of a bounded axis
+      index[axes[k]] = sides[k][above >> k & 1];
+      outside = outside || index[axes[k]] < 0;
     }
     if (outside) continue;
+    double volume = 0.0;
+    for (int beyond = above;; beyond = (beyond - 1) & above) {    // every subset of above
+      volume += parity[beyond] * part[(all & ~above) | beyond];
+      if (beyond == 0) break;
+    }
     values[(index[0] + nx * (index[1] + ny * index[2])) * stride] += weight * volume;
     inside += volume;
   }
