@@ -474,22 +474,27 @@ __attribute__((target("avx2"))) double layers_deposit_avx2(const Layers &layers,
   return outside;
 }
 
-// cells_deposit of n spheres in turn, four at a time finding those wholly inside one cell (most, where
-// cells are wider than grains: 61 % in cost.py's cells scene) and their cell and volume in vectors,
-// by the same operations as touched() and cells_deposit; the others take cells_deposit. Deposits go
-// in sphere order, so the sums are the same as one by one.
+// cells_deposit of n spheres in turn, four at a time sorting out in vectors, by the same operations as
+// touched(), cells_deposit and add_sphere_to_layers, those wholly inside one cell (most, where cells
+// are wider than grains: 61 % in cost.py's cells scene), with their cell and volume, and those across
+// one face of an inner cell (33 %), with their two cells and the split of add_sphere_to_layers' fast
+// path; the others take cells_deposit. Deposits go in sphere order, so the sums are the same as one
+// by one.
 __attribute__((target("avx2"))) double cells_deposit_avx2(const Grid &grid, const double *const *centres,
                                                           const double *radius, const double *weight, int n,
                                                           double *values, int stride)
 {
   const double step[3] = {1.0, static_cast<double>(grid.axes[0].count),
                           static_cast<double>(grid.axes[0].count) * grid.axes[1].count};
-  const __m256d zero = _mm256_setzero_pd();
+  const double resolved = grid.resolved[0] + grid.resolved[1] + grid.resolved[2];
+  const __m256d zero = _mm256_setzero_pd(), one = _mm256_set1_pd(1.0);
   double outside = 0.0;
   int i = 0;
   for (; i + 4 <= n; i += 4) {
-    const __m256d r = _mm256_loadu_pd(radius + i);
-    __m256d inside = _mm256_cmp_pd(zero, zero, _CMP_EQ_OQ), cell = zero;
+    const __m256d r = _mm256_loadu_pd(radius + i), half = below4(r, r);
+    // per sphere: axes in one inner cell and across one face between inner cells, the first cell's
+    // index, and along the crossing axis the index step and the part below the face
+    __m256d within = zero, across = zero, cell = zero, next = zero, lower = zero;
     for (int d = 0; d < 3; ++d) {
       if (!grid.resolved[d]) continue;    // one cell along d
       const Layers &axis = grid.axes[d];
@@ -497,23 +502,45 @@ __attribute__((target("avx2"))) double cells_deposit_avx2(const Grid &grid, cons
       const __m256d c = _mm256_set_pd(centres[i + 3][d], centres[i + 2][d], centres[i + 1][d], centres[i][d]);
       const __m256d first = _mm256_floor_pd(_mm256_mul_pd(_mm256_sub_pd(_mm256_sub_pd(c, r), lo), per));
       const __m256d last = _mm256_floor_pd(_mm256_mul_pd(_mm256_sub_pd(_mm256_add_pd(c, r), lo), per));
-      inside = _mm256_and_pd(inside, _mm256_cmp_pd(first, last, _CMP_EQ_OQ));
-      inside = _mm256_and_pd(inside, _mm256_cmp_pd(first, zero, _CMP_GE_OQ));
-      inside = _mm256_and_pd(inside, _mm256_cmp_pd(first, _mm256_set1_pd(axis.count - 1), _CMP_LE_OQ));
-      cell = _mm256_add_pd(cell, _mm256_mul_pd(first, _mm256_set1_pd(step[d])));    // used where inside
+      const __m256d inner = _mm256_and_pd(_mm256_cmp_pd(first, zero, _CMP_GE_OQ),
+                                          _mm256_cmp_pd(last, _mm256_set1_pd(axis.count - 1), _CMP_LE_OQ));
+      const __m256d same = _mm256_and_pd(inner, _mm256_cmp_pd(first, last, _CMP_EQ_OQ));
+      const __m256d crossing = _mm256_and_pd(inner, _mm256_cmp_pd(_mm256_sub_pd(last, first), one, _CMP_EQ_OQ));
+      within = _mm256_add_pd(within, _mm256_and_pd(same, one));
+      across = _mm256_add_pd(across, _mm256_and_pd(crossing, one));
+      cell = _mm256_add_pd(cell, _mm256_mul_pd(first, _mm256_set1_pd(step[d])));    // used where inner
+      next = _mm256_add_pd(next, _mm256_and_pd(crossing, _mm256_set1_pd(step[d])));
+      const __m256d face = _mm256_sub_pd(_mm256_add_pd(lo, _mm256_mul_pd(_mm256_add_pd(first, one),
+                                                                         _mm256_set1_pd(axis.thickness))), c);
+      lower = _mm256_add_pd(lower, _mm256_and_pd(crossing, _mm256_add_pd(below4(r, face), half)));
     }
-    const int whole = _mm256_movemask_pd(inside);
-    alignas(32) double volume[4];
-    alignas(16) int index[4];
+    const __m256d all_within = _mm256_cmp_pd(within, _mm256_set1_pd(resolved), _CMP_EQ_OQ);
+    const __m256d one_face = _mm256_and_pd(_mm256_cmp_pd(across, one, _CMP_EQ_OQ),
+                                           _mm256_cmp_pd(within, _mm256_set1_pd(resolved - 1.0), _CMP_EQ_OQ));
+    const int whole = _mm256_movemask_pd(all_within), split = _mm256_movemask_pd(one_face);
+    alignas(32) double volume[4], below_face[4], both[4];
+    alignas(16) int index[4], beyond[4];
     _mm256_store_pd(volume, _mm256_mul_pd(_mm256_mul_pd(_mm256_mul_pd(_mm256_set1_pd(4.0 / 3.0 * pi), r), r), r));
+    _mm256_store_pd(below_face, lower);
+    _mm256_store_pd(both, _mm256_mul_pd(_mm256_set1_pd(2.0), half));    // add_sphere_to_layers' total
     _mm_store_si128(reinterpret_cast<__m128i *>(index), _mm256_cvttpd_epi32(cell));
+    _mm_store_si128(reinterpret_cast<__m128i *>(beyond), _mm256_cvttpd_epi32(_mm256_add_pd(cell, next)));
     _mm256_zeroupper();    // as in layers_deposit_avx2: for the SSE code cells_deposit calls
     for (int k = 0; k < 4; ++k) {
       const double count = weight ? weight[i + k] : 1.0;
-      if (whole >> k & 1)
+      if (whole >> k & 1) {
         values[index[k] * stride] += count * volume[k];
-      else
+      } else if (split >> k & 1) {
+        const double upper = both[k] - below_face[k];
+        values[index[k] * stride] += count * below_face[k];
+        values[beyond[k] * stride] += count * upper;
+        double inside = 0.0;
+        inside += below_face[k];
+        inside += upper;
+        outside += both[k] - inside;
+      } else {
         outside += cells_deposit(grid, centres[i + k], radius[i + k], values, stride, count);
+      }
     }
   }
   _mm256_zeroupper();
