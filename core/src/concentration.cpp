@@ -415,7 +415,7 @@ namespace {
 // pick as std::min and std::max do, NaN included).
 __attribute__((target("avx2"))) inline __m256d below4(__m256d radius, __m256d u)
 {
-  const __m256d v = _mm256_min_pd(radius, _mm256_max_pd(_mm256_sub_pd(_mm256_setzero_pd(), radius), u));
+  const __m256d v = _mm256_min_pd(radius, _mm256_max_pd(_mm256_xor_pd(radius, _mm256_set1_pd(-0.0)), u));
   return _mm256_mul_pd(_mm256_mul_pd(_mm256_set1_pd(pi), v),
                        _mm256_sub_pd(_mm256_mul_pd(radius, radius),
                                      _mm256_mul_pd(_mm256_mul_pd(v, v), _mm256_set1_pd(1.0 / 3.0))));
@@ -450,7 +450,9 @@ __attribute__((target("avx2"))) double layers_deposit_avx2(const Layers &layers,
     _mm256_store_pd(total, _mm256_mul_pd(_mm256_set1_pd(2.0), half));
     _mm_store_si128(reinterpret_cast<__m128i *>(index), _mm256_cvttpd_epi32(first));
     const int split = _mm256_movemask_pd(near);
-    _mm256_zeroupper();    // the SSE code of add_sphere_to_layers runs 1.5-2x slower after dirty upper halves
+    // Upper halves cleared before the SSE code below: GCC left them dirty, and this processor ran that
+    // code 1.5-2x slower after them.
+    _mm256_zeroupper();
     for (int k = 0; k < 4; ++k) {
       const double count = weight ? weight[i + k] : 1.0;
       if (!(split >> k & 1)) {
@@ -468,7 +470,7 @@ __attribute__((target("avx2"))) double layers_deposit_avx2(const Layers &layers,
       outside += total[k] - inside;
     }
   }
-  _mm256_zeroupper();    // GCC left the upper halves dirty here, which slowed the SSE code after it 2x
+  _mm256_zeroupper();
   for (; i < n; ++i)
     outside += add_sphere_to_layers(layers, centres[i][axis], radius[i], values, stride, weight ? weight[i] : 1.0);
   return outside;
@@ -477,7 +479,7 @@ __attribute__((target("avx2"))) double layers_deposit_avx2(const Layers &layers,
 // cells_deposit of n spheres in turn, four at a time sorting out in vectors, by the same operations as
 // touched(), cells_deposit and add_sphere_to_layers, those wholly inside one cell (most, where cells
 // are wider than grains: 61 % in cost.py's cells scene), with their cell and volume, and those across
-// one face of an inner cell (33 %), with their two cells and the split of add_sphere_to_layers' fast
+// one face between inner cells (33 %), with their two cells and the split of add_sphere_to_layers' fast
 // path; the others take cells_deposit. Deposits go in sphere order, so the sums are the same as one
 // by one.
 __attribute__((target("avx2"))) double cells_deposit_avx2(const Grid &grid, const double *const *centres,
@@ -525,7 +527,7 @@ __attribute__((target("avx2"))) double cells_deposit_avx2(const Grid &grid, cons
     _mm256_store_pd(both, _mm256_mul_pd(_mm256_set1_pd(2.0), half));    // add_sphere_to_layers' total
     _mm_store_si128(reinterpret_cast<__m128i *>(index), _mm256_cvttpd_epi32(cell));
     _mm_store_si128(reinterpret_cast<__m128i *>(beyond), _mm256_cvttpd_epi32(_mm256_add_pd(cell, next)));
-    _mm256_zeroupper();    // as in layers_deposit_avx2: for the SSE code cells_deposit calls
+    _mm256_zeroupper();    // before the SSE code, as in layers_deposit_avx2
     for (int k = 0; k < 4; ++k) {
       const double count = weight ? weight[i + k] : 1.0;
       if (whole >> k & 1) {
@@ -534,7 +536,7 @@ __attribute__((target("avx2"))) double cells_deposit_avx2(const Grid &grid, cons
         const double upper = both[k] - below_face[k];
         values[index[k] * stride] += count * below_face[k];
         values[beyond[k] * stride] += count * upper;
-        double inside = 0.0;
+        double inside = 0.0;    // summed as add_sphere_to_layers sums it: the same outside
         inside += below_face[k];
         inside += upper;
         outside += both[k] - inside;
@@ -713,7 +715,7 @@ __attribute__((target("avx2"))) void values_at_avx2(const Grid &grid, int axis, 
     _mm256_storeu_pd(out + i, between(along_y(values, lower[2], lower, upper, w), along_y(values, upper[2], lower, upper, w),
                                       w[2]));
   }
-  _mm256_zeroupper();    // GCC left the upper halves dirty at the return, which slowed the SSE code after it 2x
+  _mm256_zeroupper();    // GCC left the upper halves dirty at the return: the SSE code after it ran 2x slower
   values_at_one_by_one(grid, axis, values, points, i, n, out, stride);
 }
 #endif
