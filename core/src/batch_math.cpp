@@ -44,9 +44,6 @@ void with_sse2(const double *x, double *out, int n, __m128d (*f)(__m128d))
   _mm_storeu_pd(padded, f(_mm_loadu_pd(padded)));
   out[k] = padded[0];
 }
-
-// The AVX2 functions take their vectors in 256-bit registers: only where the processor has them.
-const bool has_avx2 = (__builtin_cpu_init(), __builtin_cpu_supports("avx2"));
 #endif
 
 template <class Scalar> void one_by_one(const double *x, double *out, int n, Scalar f)
@@ -56,10 +53,22 @@ template <class Scalar> void one_by_one(const double *x, double *out, int n, Sca
 
 }    // namespace
 
+namespace {
+// Set at load time, not on first use: read per block and per batch, a guarded static cost about one
+// instruction per sphere-step (cost.py --counts). Not for other files' static initialisers.
+#if defined(__x86_64__) && defined(__GNUC__)
+const bool has_avx2 = (__builtin_cpu_init(), __builtin_cpu_supports("avx2"));
+#else
+const bool has_avx2 = false;
+#endif
+}    // namespace
+
+bool processor_has_avx2() { return has_avx2; }
+
 BatchMath batch_math_kind()
 {
 #ifdef SEDIMENT_LIBMVEC
-  return has_avx2 ? BatchMath::AVX2 : BatchMath::SSE2;
+  return processor_has_avx2() ? BatchMath::AVX2 : BatchMath::SSE2;
 #else
   return BatchMath::Scalar;
 #endif
@@ -68,7 +77,7 @@ BatchMath batch_math_kind()
 bool batch_math_available(BatchMath kind)
 {
 #ifdef SEDIMENT_LIBMVEC
-  return kind != BatchMath::AVX2 || has_avx2;
+  return kind != BatchMath::AVX2 || processor_has_avx2();
 #else
   return kind == BatchMath::Scalar;
 #endif
@@ -90,7 +99,7 @@ const char *batch_math_name(BatchMath kind)
 void exp_many(const double *x, double *out, int n, BatchMath kind)
 {
 #ifdef SEDIMENT_LIBMVEC
-  if (kind == BatchMath::AVX2 && has_avx2) return with_avx2(x, out, n, _ZGVdN4v_exp);
+  if (kind == BatchMath::AVX2 && processor_has_avx2()) return with_avx2(x, out, n, _ZGVdN4v_exp);
   if (kind == BatchMath::SSE2) return with_sse2(x, out, n, _ZGVbN2v_exp);
 #endif
   one_by_one(x, out, n, [](double v) { return std::exp(v); });
@@ -99,7 +108,7 @@ void exp_many(const double *x, double *out, int n, BatchMath kind)
 void log_many(const double *x, double *out, int n, BatchMath kind)
 {
 #ifdef SEDIMENT_LIBMVEC
-  if (kind == BatchMath::AVX2 && has_avx2) return with_avx2(x, out, n, _ZGVdN4v_log);
+  if (kind == BatchMath::AVX2 && processor_has_avx2()) return with_avx2(x, out, n, _ZGVdN4v_log);
   if (kind == BatchMath::SSE2) return with_sse2(x, out, n, _ZGVbN2v_log);
 #endif
   one_by_one(x, out, n, [](double v) { return std::log(v); });

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: GPL-2.0-or-later
 #include "sediment/concentration.hpp"
 
+#include "sediment/batch_math.hpp"
 #include "sediment/geometry.hpp"
 
 #include <algorithm>
@@ -15,11 +16,6 @@
 namespace sediment {
 
 namespace {
-
-#ifdef SEDIMENT_GRID_AVX2
-// The batch deposit into cells and the batch read go four spheres at a time where the processor has AVX2.
-const bool grid_has_avx2 = (__builtin_cpu_init(), __builtin_cpu_supports("avx2"));
-#endif
 
 // Volume of the sphere below height u above its centre, minus half the sphere: pi (r^2 u - u^3/3).
 double below(double radius, double u)
@@ -421,6 +417,33 @@ __attribute__((target("avx2"))) inline __m256d below4(__m256d radius, __m256d u)
                                      _mm256_mul_pd(_mm256_mul_pd(v, v), _mm256_set1_pd(1.0 / 3.0))));
 }
 
+// Coordinate d of rows i to i + 3.
+__attribute__((target("avx2"))) inline __m256d coordinates4(const double *const *rows, int i, int d)
+{
+  return _mm256_set_pd(rows[i + 3][d], rows[i + 2][d], rows[i + 1][d], rows[i][d]);
+}
+
+// touched() of four spheres: the first and last layer (whole numbers, as doubles).
+__attribute__((target("avx2"))) inline void touched4(const Layers &axis, __m256d c, __m256d r, __m256d &first,
+                                                     __m256d &last)
+{
+  const __m256d lo = _mm256_set1_pd(axis.lo), per = _mm256_set1_pd(axis.per_thickness);
+  first = _mm256_floor_pd(_mm256_mul_pd(_mm256_sub_pd(_mm256_sub_pd(c, r), lo), per));
+  last = _mm256_floor_pd(_mm256_mul_pd(_mm256_sub_pd(_mm256_add_pd(c, r), lo), per));
+}
+
+// The part of four spheres below the face above their first layer, as add_sphere_to_layers' fast path
+// computes it (half: below4(r, r)).
+__attribute__((target("avx2"))) inline __m256d below_next_face4(const Layers &axis, __m256d c, __m256d r,
+                                                               __m256d first, __m256d half)
+{
+  const __m256d face = _mm256_sub_pd(
+      _mm256_add_pd(_mm256_set1_pd(axis.lo),
+                    _mm256_mul_pd(_mm256_add_pd(first, _mm256_set1_pd(1.0)), _mm256_set1_pd(axis.thickness))),
+      c);
+  return _mm256_add_pd(below4(r, face), half);
+}
+
 // add_sphere_to_layers of n spheres in turn (their coordinate along the layers' axis), four at a
 // time splitting those in one layer or across one face (most) in vectors, by the same operations as
 // its fast path; the others take add_sphere_to_layers. Deposits go in sphere order, so the sums are
@@ -429,24 +452,19 @@ __attribute__((target("avx2"))) double layers_deposit_avx2(const Layers &layers,
                                                            const double *const *centres, const double *radius,
                                                            const double *weight, int n, double *values, int stride)
 {
-  const __m256d lo = _mm256_set1_pd(layers.lo), per = _mm256_set1_pd(layers.per_thickness);
   const __m256d one = _mm256_set1_pd(1.0), reach = _mm256_set1_pd(1 << 30);
   double outside = 0.0;
   int i = 0;
   for (; i + 4 <= n; i += 4) {
-    const __m256d r = _mm256_loadu_pd(radius + i);
-    const __m256d c = _mm256_set_pd(centres[i + 3][axis], centres[i + 2][axis], centres[i + 1][axis], centres[i][axis]);
-    const __m256d first = _mm256_floor_pd(_mm256_mul_pd(_mm256_sub_pd(_mm256_sub_pd(c, r), lo), per));
-    const __m256d last = _mm256_floor_pd(_mm256_mul_pd(_mm256_sub_pd(_mm256_add_pd(c, r), lo), per));
+    const __m256d r = _mm256_loadu_pd(radius + i), c = coordinates4(centres, i, axis), half = below4(r, r);
+    __m256d first, last;
+    touched4(layers, c, r, first, last);
     // At most one face crossed, and indices an int holds as they are (NaN: neither)
     const __m256d near = _mm256_and_pd(_mm256_cmp_pd(_mm256_sub_pd(last, first), one, _CMP_LE_OQ),
                                        _mm256_cmp_pd(_mm256_andnot_pd(_mm256_set1_pd(-0.0), first), reach, _CMP_LE_OQ));
-    const __m256d half = below4(r, r);
-    const __m256d face = _mm256_sub_pd(_mm256_add_pd(lo, _mm256_mul_pd(_mm256_add_pd(first, one),
-                                                                       _mm256_set1_pd(layers.thickness))), c);
     alignas(32) double lower[4], total[4];
     alignas(16) int index[4];
-    _mm256_store_pd(lower, _mm256_add_pd(below4(r, face), half));
+    _mm256_store_pd(lower, below_next_face4(layers, c, r, first, half));
     _mm256_store_pd(total, _mm256_mul_pd(_mm256_set1_pd(2.0), half));
     _mm_store_si128(reinterpret_cast<__m128i *>(index), _mm256_cvttpd_epi32(first));
     const int split = _mm256_movemask_pd(near);
@@ -500,10 +518,9 @@ __attribute__((target("avx2"))) double cells_deposit_avx2(const Grid &grid, cons
     for (int d = 0; d < 3; ++d) {
       if (!grid.resolved[d]) continue;    // one cell along d
       const Layers &axis = grid.axes[d];
-      const __m256d lo = _mm256_set1_pd(axis.lo), per = _mm256_set1_pd(axis.per_thickness);
-      const __m256d c = _mm256_set_pd(centres[i + 3][d], centres[i + 2][d], centres[i + 1][d], centres[i][d]);
-      const __m256d first = _mm256_floor_pd(_mm256_mul_pd(_mm256_sub_pd(_mm256_sub_pd(c, r), lo), per));
-      const __m256d last = _mm256_floor_pd(_mm256_mul_pd(_mm256_sub_pd(_mm256_add_pd(c, r), lo), per));
+      const __m256d c = coordinates4(centres, i, d);
+      __m256d first, last;
+      touched4(axis, c, r, first, last);
       const __m256d inner = _mm256_and_pd(_mm256_cmp_pd(first, zero, _CMP_GE_OQ),
                                           _mm256_cmp_pd(last, _mm256_set1_pd(axis.count - 1), _CMP_LE_OQ));
       const __m256d same = _mm256_and_pd(inner, _mm256_cmp_pd(first, last, _CMP_EQ_OQ));
@@ -512,9 +529,7 @@ __attribute__((target("avx2"))) double cells_deposit_avx2(const Grid &grid, cons
       across = _mm256_add_pd(across, _mm256_and_pd(crossing, one));
       cell = _mm256_add_pd(cell, _mm256_mul_pd(first, _mm256_set1_pd(step[d])));    // used where inner
       next = _mm256_add_pd(next, _mm256_and_pd(crossing, _mm256_set1_pd(step[d])));
-      const __m256d face = _mm256_sub_pd(_mm256_add_pd(lo, _mm256_mul_pd(_mm256_add_pd(first, one),
-                                                                         _mm256_set1_pd(axis.thickness))), c);
-      lower = _mm256_add_pd(lower, _mm256_and_pd(crossing, _mm256_add_pd(below4(r, face), half)));
+      lower = _mm256_add_pd(lower, _mm256_and_pd(crossing, below_next_face4(axis, c, r, first, half)));
     }
     const __m256d all_within = _mm256_cmp_pd(within, _mm256_set1_pd(resolved), _CMP_EQ_OQ);
     const __m256d one_face = _mm256_and_pd(_mm256_cmp_pd(across, one, _CMP_EQ_OQ),
@@ -560,7 +575,7 @@ double add_spheres_to_grid(const Grid &grid, const double *const *centres, const
   double outside = 0.0;
   const int axis = layer_axis(local);
 #ifdef SEDIMENT_GRID_AVX2
-  if (grid_has_avx2)
+  if (processor_has_avx2())    // four spheres at a time
     return axis >= 0 ? layers_deposit_avx2(local.axes[axis], axis, centres, radius, weight, n, values, stride)
                      : cells_deposit_avx2(local, centres, radius, weight, n, values, stride);
 #endif
@@ -696,8 +711,7 @@ __attribute__((target("avx2"))) void values_at_avx2(const Grid &grid, int axis, 
         lower[d] = upper[d] = w[d] = zero;
         continue;
       }
-      const __m256d x = _mm256_set_pd(points[i + 3][d], points[i + 2][d], points[i + 1][d], points[i][d]);
-      if (!brackets4(grid.axes[d], x, lower[d], upper[d], w[d])) {
+      if (!brackets4(grid.axes[d], coordinates4(points, i, d), lower[d], upper[d], w[d])) {
         in_common_range = false;
         break;
       }
@@ -730,7 +744,7 @@ void grid_values_at(const Grid &grid, const double *values, const double *const 
   const Grid local = grid;
   const int axis = layer_axis(local);
 #ifdef SEDIMENT_GRID_AVX2
-  if (grid_has_avx2) {
+  if (processor_has_avx2()) {    // four points at a time
     values_at_avx2(local, axis, values, points, n, out, stride);
     return;
   }

@@ -11,6 +11,10 @@ namespace sediment {
 
 enum class BatchMath { Scalar, SSE2, AVX2 };
 
+// Whether this processor runs AVX2 instructions (checked once per process; false off x86-64 GCC/Clang):
+// what every function with an AVX2 path asks.
+bool processor_has_avx2();
+
 // The fastest kind this build has on this processor (decided once per process), and whether a
 // kind runs here at all (Scalar always does).
 BatchMath batch_math_kind();
