@@ -7,6 +7,7 @@
 #include "sediment_args.h"
 
 #include "atom.h"
+#include "comm.h"
 #include "domain.h"
 #include "error.h"
 #include "memory.h"
@@ -232,11 +233,15 @@ void ComputeConcentrationGrid::profile()
       if (!class_edges.empty()) deposit(i, class_col + size_class(2.0 * radius[i]), count);
       if (by_type) deposit(i, type_col + type[i] - 1, count);
     }
-  MPI_Allreduce(local.data(), fractions.data(), static_cast<int>(local.size()), MPI_DOUBLE, MPI_SUM, world);
-
   // Solid volume per cell -> solid fraction (in 2d a disc of radius r stands for a sphere whose
-  // volume is spread over the slab thickness), then optional smoothing column by column.
-  for (double &v : fractions) v /= cell_volume;
+  // volume is spread over the slab thickness), then optional smoothing column by column. On one rank
+  // the sum is the rank's own: one pass instead of MPI's copy and a second pass over the cells.
+  if (comm->nprocs == 1) {
+    for (size_t k = 0; k < local.size(); ++k) fractions[k] = local[k] / cell_volume;
+  } else {
+    MPI_Allreduce(local.data(), fractions.data(), static_cast<int>(local.size()), MPI_DOUBLE, MPI_SUM, world);
+    for (double &v : fractions) v /= cell_volume;
+  }
   if (smooth_width > 0.0)
     for (int c = 0; c < ncols; ++c) sediment::smooth_grid(grid, fractions.data() + c, smooth_width, scratch.data(), ncols);
 }
