@@ -5,14 +5,14 @@
                                         [--scenes plain,drag,...] [--counts]
 
 Each scene runs `repeats` times, the scenes taking turns (so that a drift of the machine's speed
-during the run touches every scene alike); the best loop time is kept. The targets' ratios (the
-effects against fix nve/sphere and against the peer) are printed from the best times and as the
-median and range of each round's ratios. LAMMPS reports the loop
-time, which excludes start-up. With --baseline (another lmp_sediment, e.g. a build of an earlier
-commit) every scene also runs with it, the two taking turns scene by scene, and the table gains
-the ratio this build / baseline, as the ratio of the best times and as the median of the ratios of
-back-to-back pairs (robust to the machine's drift during the run): on a machine whose speed drifts
-by 10 % between runs, the way to measure one change.
+during the run touches every scene alike); the best loop time is kept. LAMMPS reports the loop
+time, which excludes start-up. The targets' ratios (the effects against fix nve/sphere and against
+the peer) are printed from the best times and as the median and range of each round's ratios. With
+--baseline (another lmp_sediment, e.g. a build of an earlier commit) every scene also runs with it,
+the two taking turns scene by scene, and the table gains the ratio this build / baseline, as the
+ratio of the best times and as the median of the ratios of back-to-back pairs (robust to the
+machine's drift during the run): on a machine whose speed drifts by 10 % between runs, the way to
+measure one change.
 
 With --counts the scenes run under valgrind's cachegrind instead of the clock, on a model of one
 core of this machine (32 KiB L1 data cache, the 512 KiB L2 as the last level; what misses it comes
@@ -218,6 +218,7 @@ def report_targets(times: dict[str, float], rounds: list[dict[str, float]]) -> N
         each = [ratio(r) for r in rounds]
         print(f"{label:48s} {best:10.3f} {statistics.median(each):17.3f} {min(each):7.3f} - {max(each):6.3f} "
               f"{f'<= {limit:g}' if limit else '':>7s}")
+
 
 if __name__ == "__main__":
     main()

@@ -1,6 +1,6 @@
 # SPDX-License-Identifier: GPL-2.0-or-later
-"""benchmarks/cost.py --counts: cachegrind's totals read right, and a scene's counts per particle-step
-taken from the difference of two runs (start-up cancels)."""
+"""benchmarks/cost.py: cachegrind's totals read right, a scene's counts per particle-step taken from
+the difference of two runs (start-up cancels), and the targets' ratios from the rounds' times."""
 from __future__ import annotations
 
 import importlib.util
@@ -47,3 +47,15 @@ def test_a_scene_costs_its_step_per_particle_not_its_start_up(cost):
     assert again["instructions"] == pytest.approx(first["instructions"], rel=0.01)
     assert abs(first["L2 misses"]) < 5 and first["cycles (est.)"] == pytest.approx(
         first["instructions"] + 12 * first["L1 misses"] + 40 * first["L2 misses"])
+
+
+def test_the_targets_come_from_the_best_times_and_each_round(cost, capsys):
+    # Two rounds: the best times mix them (plain from the first, bare from the second), the rounds'
+    # ratios do not; a target whose scenes did not run is left out.
+    rounds = [{"plain": 1.0, "peer": 1.1, "bare": 1.3}, {"plain": 2.0, "peer": 2.2, "bare": 1.2}]
+    best = {s: min(r[s] for r in rounds) for s in rounds[0]}
+    cost.report_targets(best, rounds)
+    lines = capsys.readouterr().out.splitlines()
+    off = next(line for line in lines if line.startswith("every effect off"))
+    assert off.split()[-7:] == ["1.200", "0.950", "0.600", "-", "1.300", "<=", "1.02"]
+    assert not any(line.startswith("explicit") for line in lines)
