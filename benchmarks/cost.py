@@ -33,6 +33,7 @@ import subprocess
 import sys
 import tempfile
 from pathlib import Path
+from typing import Callable
 
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE.parent / "python"))
@@ -103,6 +104,30 @@ def counts_per_step(scene: str, particles: int, steps: int, lmp: Path | None = N
             "cycles (est.)": per["Ir"] + L2_LATENCY * l1 + L3_LATENCY * l2}
 
 
+# The targets of the per-step cost: what is measured, from the scenes' loop times (or counts), and its limit.
+TARGETS = [
+    ("every effect off / fix nve/sphere", lambda t: t["bare"] / t["plain"], 1.02),
+    ("explicit stokes + buoyancy / peer", lambda t: t["explicit"] / t["peer"], 1.2),
+    ("implicit stokes + buoyancy / peer", lambda t: t["drag"] / t["peer"], 1.3),
+    ("nonlinear implicit (dallavalle) / peer", lambda t: t["nonlinear"] / t["peer"], 2.0),
+    ("grid + Di Felice on top of nonlinear / peer", lambda t: (t["hindered"] - t["nonlinear"]) / t["peer"], 1.0),
+    ("3d cells + Di Felice on top of nonlinear / peer", lambda t: (t["cells"] - t["nonlinear"]) / t["peer"], 2.0),
+    ("lubrication on top of implicit stokes / plain", lambda t: (t["lubricated"] - t["drag"]) / t["plain"], None),
+]
+
+
+def measured(ratio: Callable[[dict[str, float]], float], values: dict[str, float]) -> float | None:
+    """A target's ratio of these scenes' values; None when one of its scenes did not run."""
+    try:
+        return ratio(values)
+    except KeyError:
+        return None
+
+
+def target_text(limit: float | None) -> str:
+    return f"<= {limit:g}" if limit else ""
+
+
 def report_counts(scenes: dict[str, str], args: argparse.Namespace) -> None:
     """The --counts table: this build, and the baseline when given (the counts need no turns)."""
     steps = args.steps if args.steps_given else 50
@@ -114,23 +139,17 @@ def report_counts(scenes: dict[str, str], args: argparse.Namespace) -> None:
     for s, what in scenes.items():
         mine = counts_per_step(s, args.particles, steps)
         cycles[s] = mine["cycles (est.)"]
-        ratio = ""
+        against = ""
         if args.baseline:
             theirs = counts_per_step(s, args.particles, steps, args.baseline)
-            ratio = f" {mine['cycles (est.)'] / theirs['cycles (est.)']:14.3f}"
-        print(f"{s:10s} " + " ".join(f"{mine[c]:13.2f}" for c in columns) + ratio + f"  {what}", flush=True)
-    if "bare" in cycles:
-        print(f"every effect off: {100 * (cycles['bare'] / cycles['plain'] - 1):+.1f} % against fix nve/sphere "
-              "(estimated cycles)")
-    against_peer = [f"{s} {cycles[s] / cycles['peer']:.2f}x" for s in ("explicit", "drag", "nonlinear") if s in cycles]
-    if against_peer:
-        print("against the peer (estimated cycles): " + ", ".join(against_peer))
-    if "nonlinear" in cycles and "hindered" in cycles:
-        extra = [f"grid + Di Felice +{(cycles['hindered'] - cycles['nonlinear']) / cycles['peer']:.2f}x the peer"]
-        if "cells" in cycles:
-            extra.append(f"3d cells +{(cycles['cells'] - cycles['nonlinear']) / cycles['peer']:.2f}x")
-        print("on top of the nonlinear step (estimated cycles): " + ", ".join(extra))
-
+            against = f" {mine['cycles (est.)'] / theirs['cycles (est.)']:14.3f}"
+        print(f"{s:10s} " + " ".join(f"{mine[c]:13.2f}" for c in columns) + against + f"  {what}", flush=True)
+    print()
+    print(f"{'ratio (estimated cycles)':48s} {'value':>10s} {'target':>7s}")
+    for label, ratio, limit in TARGETS:
+        value = measured(ratio, cycles)
+        if value is not None:
+            print(f"{label:48s} {value:10.3f} {target_text(limit):>7s}")
 
 def existing_file(text: str) -> Path:
     path = Path(text)
@@ -193,32 +212,18 @@ def main() -> None:
     report_targets(times, rounds)
 
 
-# The targets of the per-step cost: what is measured, from which scenes' loop times, and its limit.
-TARGETS = [
-    ("every effect off / fix nve/sphere", lambda t: t["bare"] / t["plain"], 1.02),
-    ("explicit stokes + buoyancy / peer", lambda t: t["explicit"] / t["peer"], 1.2),
-    ("implicit stokes + buoyancy / peer", lambda t: t["drag"] / t["peer"], 1.3),
-    ("nonlinear implicit (dallavalle) / peer", lambda t: t["nonlinear"] / t["peer"], 2.0),
-    ("grid + Di Felice on top of nonlinear / peer", lambda t: (t["hindered"] - t["nonlinear"]) / t["peer"], 1.0),
-    ("3d cells + Di Felice on top of nonlinear / peer", lambda t: (t["cells"] - t["nonlinear"]) / t["peer"], 2.0),
-    ("lubrication on top of implicit stokes / plain", lambda t: (t["lubricated"] - t["drag"]) / t["plain"], None),
-]
-
-
 def report_targets(times: dict[str, float], rounds: list[dict[str, float]]) -> None:
     """Each target's ratio from the best loop times, and its median and range over the rounds (the
     scenes of a round run one after the other, so a drift of the machine's speed between rounds
     cancels in a round's ratio)."""
     print(f"{'ratio':48s} {'best times':>10s} {'median of rounds':>17s} {'range of rounds':>16s} {'target':>7s}")
     for label, ratio, limit in TARGETS:
-        try:
-            best = ratio(times)
-        except KeyError:    # a scene not run
+        best = measured(ratio, times)
+        if best is None:
             continue
         each = [ratio(r) for r in rounds]
         print(f"{label:48s} {best:10.3f} {statistics.median(each):17.3f} {min(each):7.3f} - {max(each):6.3f} "
-              f"{f'<= {limit:g}' if limit else '':>7s}")
-
+              f"{target_text(limit):>7s}")
 
 if __name__ == "__main__":
     main()

@@ -236,12 +236,12 @@ void ComputeConcentrationGrid::profile()
   // Solid volume per cell -> solid fraction (in 2d a disc of radius r stands for a sphere whose
   // volume is spread over the slab thickness), then optional smoothing column by column. On one rank
   // the sum is the rank's own: one pass instead of MPI's copy and a second pass over the cells.
-  if (comm->nprocs == 1) {
-    for (size_t k = 0; k < local.size(); ++k) fractions[k] = local[k] / cell_volume;
-  } else {
+  const double *sums = local.data();
+  if (comm->nprocs > 1) {
     MPI_Allreduce(local.data(), fractions.data(), static_cast<int>(local.size()), MPI_DOUBLE, MPI_SUM, world);
-    for (double &v : fractions) v /= cell_volume;
+    sums = fractions.data();
   }
+  for (size_t k = 0; k < fractions.size(); ++k) fractions[k] = sums[k] / cell_volume;
   if (smooth_width > 0.0)
     for (int c = 0; c < ncols; ++c) sediment::smooth_grid(grid, fractions.data() + c, smooth_width, scratch.data(), ncols);
 }
