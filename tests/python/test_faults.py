@@ -175,7 +175,9 @@ def test_resume_needs_a_restart_file(tmp_path):
 
 
 def test_two_runs_in_one_folder_and_signals(tmp_path):
-    deck = sample(tmp_path / "busy", "--particles", 15000)
+    # Courant 0.1 (28 800 steps, some 8 s on 2 ranks): the second run and the signal must find the
+    # first still running; at Courant 1 it had finished within the second run's start-up now and then
+    deck = sample(tmp_path / "busy", "--particles", 15000, "--courant", 0.1)
     first = subprocess.Popen(SEDIMENT + ["run", str(deck), "--quiet", "--np", "2"], stdout=subprocess.PIPE,
                              stderr=subprocess.PIPE, text=True)
     wait_for(lambda: len(processes_in(deck.parent)) >= 2)
