@@ -139,8 +139,8 @@ void PhisMany(benchmark::State &state) { phi_functions(state, true); }
 
 // The drag step of a smooth law (Dallavalle, 30 um quartz in water, slips around the terminal speed
 // of 0.74 mm/s, the step 1e-4 s): a block of one sphere at a time (smooth_step_initial), or blocks of
-// SmoothBlock::capacity (as fix nve/sphere/fluid steps them), on the fastest kind here or on SSE2 (the
-// default build's 2-wide arithmetic and exponentials).
+// SmoothBlock::capacity (as fix nve/sphere/fluid steps them), on the fastest kind here, on AVX2, or
+// on SSE2 (the default build's 2-wide arithmetic and exponentials).
 void smooth_step(benchmark::State &state, bool blocks, sediment::BatchMath kind = sediment::batch_math_kind())
 {
   const sediment::DragModel model(sediment::DragLaw::Dallavalle, {998.2, 1.002e-3, 0.0});
@@ -183,6 +183,7 @@ void smooth_step(benchmark::State &state, bool blocks, sediment::BatchMath kind 
 }
 void SmoothStepOneByOne(benchmark::State &state) { smooth_step(state, false); }
 void SmoothStepBlocks(benchmark::State &state) { smooth_step(state, true); }
+void SmoothStepBlocksAVX2(benchmark::State &state) { smooth_step(state, true, sediment::BatchMath::AVX2); }
 void SmoothStepBlocksSSE2(benchmark::State &state) { smooth_step(state, true, sediment::BatchMath::SSE2); }
 
 BENCHMARK(LayerDeposit);
@@ -195,6 +196,7 @@ BENCHMARK(Phis);
 BENCHMARK(PhisMany);
 BENCHMARK(SmoothStepOneByOne);
 BENCHMARK(SmoothStepBlocks);
+BENCHMARK(SmoothStepBlocksAVX2);
 BENCHMARK(SmoothStepBlocksSSE2);
 
 }    // namespace

@@ -8,12 +8,14 @@
 #define SEDIMENT_LIBMVEC 1
 #include <immintrin.h>
 // glibc's vector functions (names of the x86-64 vector ABI; libm.so pulls libmvec in as needed):
-// b = SSE2, 2 doubles; d = AVX2, 4 doubles.
+// b = SSE2, 2 doubles; d = AVX2, 4 doubles; e = AVX-512, 8 doubles.
 extern "C" {
 __m128d _ZGVbN2v_exp(__m128d);
 __m128d _ZGVbN2v_log(__m128d);
 __m256d _ZGVdN4v_exp(__m256d);
 __m256d _ZGVdN4v_log(__m256d);
+__m512d _ZGVeN8v_exp(__m512d);
+__m512d _ZGVeN8v_log(__m512d);
 }
 #endif
 
@@ -24,6 +26,16 @@ namespace {
 #ifdef SEDIMENT_LIBMVEC
 // A short last group is padded with ones (finite for both functions) to a full vector: each value
 // takes the same function wherever it sits.
+__attribute__((target("avx512f"))) void with_avx512(const double *x, double *out, int n, __m512d (*f)(__m512d))
+{
+  int k = 0;
+  for (; k + 8 <= n; k += 8) _mm512_storeu_pd(out + k, f(_mm512_loadu_pd(x + k)));
+  if (k == n) return;
+  // The tail under a mask: the lanes past n are ones, loaded and stored nowhere.
+  const __mmask8 tail = static_cast<__mmask8>((1u << (n - k)) - 1u);
+  _mm512_mask_storeu_pd(out + k, tail, f(_mm512_mask_loadu_pd(_mm512_set1_pd(1.0), tail, x + k)));
+}
+
 __attribute__((target("avx2"))) void with_avx2(const double *x, double *out, int n, __m256d (*f)(__m256d))
 {
   int k = 0;
@@ -58,17 +70,20 @@ namespace {
 // instruction per sphere-step (cost.py --counts). Not for other files' static initialisers.
 #if defined(__x86_64__) && defined(__GNUC__)
 const bool has_avx2 = (__builtin_cpu_init(), __builtin_cpu_supports("avx2"));
+const bool has_avx512 = (__builtin_cpu_init(), __builtin_cpu_supports("avx512f"));
 #else
 const bool has_avx2 = false;
+const bool has_avx512 = false;
 #endif
 }    // namespace
 
 bool processor_has_avx2() { return has_avx2; }
+bool processor_has_avx512() { return has_avx512; }
 
 BatchMath batch_math_kind()
 {
 #ifdef SEDIMENT_LIBMVEC
-  return processor_has_avx2() ? BatchMath::AVX2 : BatchMath::SSE2;
+  return processor_has_avx512() ? BatchMath::AVX512 : processor_has_avx2() ? BatchMath::AVX2 : BatchMath::SSE2;
 #else
   return BatchMath::Scalar;
 #endif
@@ -77,6 +92,7 @@ BatchMath batch_math_kind()
 bool batch_math_available(BatchMath kind)
 {
 #ifdef SEDIMENT_LIBMVEC
+  if (kind == BatchMath::AVX512) return processor_has_avx512();
   return kind != BatchMath::AVX2 || processor_has_avx2();
 #else
   return kind == BatchMath::Scalar;
@@ -90,6 +106,8 @@ const char *batch_math_name(BatchMath kind)
       return "sse2";
     case BatchMath::AVX2:
       return "avx2";
+    case BatchMath::AVX512:
+      return "avx512";
     case BatchMath::Scalar:
       break;
   }
@@ -99,6 +117,7 @@ const char *batch_math_name(BatchMath kind)
 void exp_many(const double *x, double *out, int n, BatchMath kind)
 {
 #ifdef SEDIMENT_LIBMVEC
+  if (kind == BatchMath::AVX512 && processor_has_avx512()) return with_avx512(x, out, n, _ZGVeN8v_exp);
   if (kind == BatchMath::AVX2 && processor_has_avx2()) return with_avx2(x, out, n, _ZGVdN4v_exp);
   if (kind == BatchMath::SSE2) return with_sse2(x, out, n, _ZGVbN2v_exp);
 #endif
@@ -108,6 +127,7 @@ void exp_many(const double *x, double *out, int n, BatchMath kind)
 void log_many(const double *x, double *out, int n, BatchMath kind)
 {
 #ifdef SEDIMENT_LIBMVEC
+  if (kind == BatchMath::AVX512 && processor_has_avx512()) return with_avx512(x, out, n, _ZGVeN8v_log);
   if (kind == BatchMath::AVX2 && processor_has_avx2()) return with_avx2(x, out, n, _ZGVdN4v_log);
   if (kind == BatchMath::SSE2) return with_sse2(x, out, n, _ZGVbN2v_log);
 #endif

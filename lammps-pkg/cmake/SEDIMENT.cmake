@@ -11,8 +11,9 @@ endif()
 target_link_libraries(lammps PRIVATE ${HDF5_LIBRARIES})
 target_include_directories(lammps PRIVATE ${HDF5_INCLUDE_DIRS} ${LAMMPS_SOURCE_DIR}/SEDIMENT)
 # No errno from sqrt and friends in the package's own sources (nothing reads it): the per-sphere
-# loops of the drag step then compile to vector square roots.
+# loops of the drag step then compile to vector square roots. No fused multiply-adds: every kind of
+# the drag step's vector arithmetic (SSE2, AVX2, AVX-512) rounds each operation alike.
 if(CMAKE_CXX_COMPILER_ID MATCHES "GNU|Clang")
   file(GLOB SEDIMENT_PACKAGE_SOURCES ${LAMMPS_SOURCE_DIR}/SEDIMENT/*.cpp)
-  set_property(SOURCE ${SEDIMENT_PACKAGE_SOURCES} APPEND PROPERTY COMPILE_OPTIONS -fno-math-errno)
+  set_property(SOURCE ${SEDIMENT_PACKAGE_SOURCES} APPEND PROPERTY COMPILE_OPTIONS -fno-math-errno -ffp-contract=off)
 endif()

@@ -18,8 +18,6 @@ using namespace sediment;
 
 namespace {
 
-const BatchMath kinds[] = {BatchMath::Scalar, BatchMath::SSE2, BatchMath::AVX2};
-
 // Distance in units in the last place between two finite doubles of the same sign.
 int64_t ulps(double a, double b)
 {
@@ -45,7 +43,7 @@ TEST(BatchMath, WithinFourUlpOfTheScalarFunctionsOnEveryKindHere)
   const std::vector<double> exponents = uniform(-745.0, 10.0, 10001, 1);
   std::vector<double> logs_in = uniform(-70.0, 70.0, 10001, 2);
   for (double &x : logs_in) x = std::exp(x);
-  for (const BatchMath kind : kinds) {
+  for (const BatchMath kind : batch_math_kinds) {
     if (!batch_math_available(kind)) continue;
     SCOPED_TRACE(batch_math_name(kind));
     std::vector<double> e(exponents.size()), l(logs_in.size());
@@ -70,7 +68,7 @@ TEST(BatchMath, SpecialValuesAsTheScalarFunctions)
   const double exp_in[] = {0.0, -0.0, inf, -inf, nan, 1000.0, -1000.0};
   const double log_in[] = {0.0, -0.0, inf, -inf, nan, -1.0, 1.0};
   constexpr int n = 7;
-  for (const BatchMath kind : kinds) {
+  for (const BatchMath kind : batch_math_kinds) {
     if (!batch_math_available(kind)) continue;
     SCOPED_TRACE(batch_math_name(kind));
     double e[n], l[n];
@@ -91,7 +89,7 @@ TEST(BatchMath, AValueDoesNotDependOnItsPlaceOrOnTheOthersInTheBatch)
   // What the integrator relies on for results independent of block and rank layout: the same value
   // at any position of a batch of any length gives the same bits, whatever its neighbours are.
   const std::vector<double> x = uniform(-20.0, 2.0, 7, 3);
-  for (const BatchMath kind : kinds) {
+  for (const BatchMath kind : batch_math_kinds) {
     if (!batch_math_available(kind)) continue;
     SCOPED_TRACE(batch_math_name(kind));
     double alone[7];
@@ -142,7 +140,7 @@ TEST(BatchMath, DragCurvesFollowTheCurveOfEachSphere)
   for (const DragLaw law : {DragLaw::Dallavalle, DragLaw::DiFelice, DragLaw::SchillerNaumann}) {
     for (const HindranceBuoyancy buoyancy : {HindranceBuoyancy::Plain, HindranceBuoyancy::Mixture}) {
       const DragModel model(law, water, buoyancy);
-      for (const BatchMath kind : kinds) {
+      for (const BatchMath kind : batch_math_kinds) {
         if (!batch_math_available(kind)) continue;
         std::vector<DragCurve> many(reynolds.size());
         model.curves(reynolds.data(), voidage.data(), many.data(), static_cast<int>(many.size()), kind);
@@ -170,7 +168,7 @@ TEST(BatchMath, DiFeliceCurvesInClearFluidAreDallavallesBitForBit)
   const Fluid water{998.2, 1.002e-3, 0.0};
   const std::vector<double> re = uniform(0.0, 50.0, 200, 7), voidage = uniform(1.0, 1.5, 200, 8);
   const DragModel felice(DragLaw::DiFelice, water), dalla(DragLaw::Dallavalle, water);
-  for (const BatchMath kind : kinds) {
+  for (const BatchMath kind : batch_math_kinds) {
     if (!batch_math_available(kind)) continue;
     std::vector<DragCurve> hindered(re.size()), single(re.size());
     felice.curves(re.data(), voidage.data(), hindered.data(), static_cast<int>(re.size()), kind);

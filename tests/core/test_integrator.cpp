@@ -308,8 +308,6 @@ void expect_same_bits(const BlockResult &a, const BlockResult &b)
   }
 }
 
-const BatchMath every_kind[] = {BatchMath::Scalar, BatchMath::SSE2, BatchMath::AVX2};
-
 }    // namespace
 
 TEST(SmoothBlock, EachSphereStepsAsAloneAndAsTheNewtonStep)
@@ -324,7 +322,7 @@ TEST(SmoothBlock, EachSphereStepsAsAloneAndAsTheNewtonStep)
   for (const DragLaw law : {DragLaw::Dallavalle, DragLaw::DiFelice}) {
     const DragModel model(law, fluid);
     const std::vector<BlockSphere> spheres = block_spheres(model);
-    for (const BatchMath kind : every_kind) {
+    for (const BatchMath kind : batch_math_kinds) {
       if (!batch_math_available(kind)) continue;
       const std::vector<BlockResult> blocks = step_in_blocks(model, spheres, dt, kind, false);
       const std::vector<BlockResult> alone = step_in_blocks(model, spheres, dt, kind, true);
@@ -355,19 +353,20 @@ TEST(SmoothBlock, EachSphereStepsAsAloneAndAsTheNewtonStep)
 
 TEST(SmoothBlock, TheArithmeticIsTheSameOnEveryKind)
 {
-  // The AVX2 step runs the block's arithmetic in 4-wide vectors, the other kinds in the default
-  // build's (2-wide SSE2 on x86-64), a short block's tail one by one; without fused multiply-adds
-  // each operation rounds alike in all of them, so where no vector exponential enters (every rate
-  // below 0.5 takes the scalar series of the phi functions; Dallavalle's law takes none) the kinds
-  // agree bit for bit. Elsewhere glibc's vector exp of each kind may differ from the others by an
-  // ulp, and the steps agree to round-off.
+  // The AVX2 and AVX-512 steps run the block's arithmetic in 4- and 8-wide vectors, the other kinds
+  // in the default build's (2-wide SSE2 on x86-64), a short block's tail one by one; without fused
+  // multiply-adds (AVX-512 has them: -ffp-contract=off keeps them out) each operation rounds alike
+  // in all of them, so where no vector exponential enters (every rate below 0.5 takes the scalar
+  // series of the phi functions; Dallavalle's law takes none) the kinds agree bit for bit. Elsewhere
+  // glibc's vector exp of each kind may differ from the others by an ulp, and the steps agree to
+  // round-off.
   const DragModel model(DragLaw::Dallavalle, {998.2, 1.002e-3, 0.0});
   const std::vector<BlockSphere> spheres = block_spheres(model);
   const std::vector<BlockResult> scalar_small = step_in_blocks(model, spheres, 1e-9, BatchMath::Scalar, false);
   const std::vector<BlockResult> scalar = step_in_blocks(model, spheres, 1e-4, BatchMath::Scalar, false);
   int compared = 0;
-  for (const BatchMath kind : {BatchMath::SSE2, BatchMath::AVX2}) {
-    if (!batch_math_available(kind)) continue;
+  for (const BatchMath kind : batch_math_kinds) {
+    if (kind == BatchMath::Scalar || !batch_math_available(kind)) continue;
     const std::vector<BlockResult> small = step_in_blocks(model, spheres, 1e-9, kind, false);
     const std::vector<BlockResult> normal = step_in_blocks(model, spheres, 1e-4, kind, false);
     for (size_t j = 0; j < spheres.size(); ++j) {

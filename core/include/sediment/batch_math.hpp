@@ -1,19 +1,24 @@
 // SPDX-License-Identifier: GPL-2.0-or-later
 // e^x and ln x of many values at once, for the per-atom loops that need one or more of each per atom
 // and step (the drag step's exponentials, the Di Felice hindrance). On x86-64 with glibc they are the
-// vector functions of glibc's libmvec (4 values per call where the processor has AVX2, else 2 with
-// SSE2), within 4 ulp of std::exp and std::log; elsewhere std::exp and std::log one by one.
+// vector functions of glibc's libmvec (8 values per call where the processor has AVX-512, 4 with
+// AVX2, else 2 with SSE2), within 4 ulp of std::exp and std::log; elsewhere std::exp and std::log
+// one by one.
 // Every value goes through the same function wherever it sits in the batch, so a sphere's result
 // does not depend on which others share its batch (nor on how atoms are spread over MPI ranks).
 #pragma once
 
 namespace sediment {
 
-enum class BatchMath { Scalar, SSE2, AVX2 };
+enum class BatchMath { Scalar, SSE2, AVX2, AVX512 };
+// Every kind, for the tests and benchmarks that compare them.
+inline constexpr BatchMath batch_math_kinds[] = {BatchMath::Scalar, BatchMath::SSE2, BatchMath::AVX2,
+                                                 BatchMath::AVX512};
 
 // Whether this processor runs AVX2 instructions (checked once per process; false off x86-64 GCC/Clang):
 // what every function with an AVX2 path asks.
 bool processor_has_avx2();
+bool processor_has_avx512();    // AVX-512 F, which the AVX512 kind needs
 
 // The fastest kind this build has on this processor (decided once per process), and whether a
 // kind runs here at all (Scalar always does).

@@ -144,6 +144,7 @@ class SmoothBlock {
   // The stages, inlined into the step of each instruction set (integrator.cpp).
   void stages(const DragModel &model, double dt, BatchMath kind);
   void stages_avx2(const DragModel &model, double dt);
+  void stages_avx512(const DragModel &model, double dt);
   void slip();
   void rates(const DragModel &model, double dt, BatchMath kind);
   void advance_all(double dt);
