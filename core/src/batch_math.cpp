@@ -24,14 +24,14 @@ namespace sediment {
 namespace {
 
 #ifdef SEDIMENT_LIBMVEC
-// A short last group is padded with ones (finite for both functions) to a full vector: each value
-// takes the same function wherever it sits.
+// A short last group is padded with ones (finite for both functions) to a full vector, or masked:
+// each value takes the same function wherever it sits.
 __attribute__((target("avx512f"))) void with_avx512(const double *x, double *out, int n, __m512d (*f)(__m512d))
 {
   int k = 0;
   for (; k + 8 <= n; k += 8) _mm512_storeu_pd(out + k, f(_mm512_loadu_pd(x + k)));
   if (k == n) return;
-  // The tail under a mask: the lanes past n are ones, loaded and stored nowhere.
+  // The lanes past n are ones, loaded from and stored to nowhere.
   const __mmask8 tail = static_cast<__mmask8>((1u << (n - k)) - 1u);
   _mm512_mask_storeu_pd(out + k, tail, f(_mm512_mask_loadu_pd(_mm512_set1_pd(1.0), tail, x + k)));
 }

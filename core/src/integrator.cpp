@@ -268,14 +268,14 @@ AlongSlip advance_along(const SphereDrag &drag, double mass, double s, double a_
 
 #if defined(__x86_64__) && defined(__GNUC__)
 // The same stages in 4-wide vectors (the 2-wide SSE2 of the default build takes 1.3-1.4x as long:
-// bench_core_kernels SmoothStepBlocks against SmoothStepBlocksSSE2), and in 8-wide ones. No "fma" in
-// the targets (AVX-512 F does not imply it): no contraction, the same roundings.
+// bench_core_kernels SmoothStepBlocks against SmoothStepBlocksSSE2), and in 8-wide ones. No fused
+// multiply-adds (AVX-512 F has them; -ffp-contract=off keeps the compiler from using them), so the
+// same roundings.
 __attribute__((target("avx2"))) void SmoothBlock::stages_avx2(const DragModel &model, double dt)
 {
   stages(model, dt, BatchMath::AVX2);
 }
-__attribute__((target("avx512f,prefer-vector-width=512"))) void SmoothBlock::stages_avx512(const DragModel &model,
-                                                                                          double dt)
+__attribute__((target("avx512f"))) void SmoothBlock::stages_avx512(const DragModel &model, double dt)
 {
   stages(model, dt, BatchMath::AVX512);
 }
