@@ -30,11 +30,25 @@
 using namespace LAMMPS_NS;
 using namespace FixConst;
 
+// fix nve/sphere's factors of a half step: dtf = dt ftm2v / 2 for the forces and dtf / I* for the
+// torques (I* = 2/5, a solid sphere's inertia over m r^2), as it computes them. Taken once per half
+// step: the compiler may not hoist the division out of the loop over the atoms (it could trap, and
+// the group's test guards it), which had made a third division per atom.
+struct HalfKick {
+  double dtf, dtfrotate;
+};
+
+static inline HalfKick half_kick(double dt, double ftm2v)
+{
+  const double dtf = 0.5 * dt * ftm2v;
+  return {dtf, dtf / sediment::solid_sphere_inertia};
+}
+
 // The rotational half of fix nve/sphere's kick (below), which is also the rotation of a sphere in a
 // fluid without a rotational drag. Returns the torque's weight, dtf / I.
-static inline double nve_sphere_spin(double *omega, const double *torque, double radius, double rmass, double dtf)
+static inline double nve_sphere_spin(double *omega, const double *torque, double radius, double rmass, HalfKick kick)
 {
-  const double dtirotate = dtf / sediment::solid_sphere_inertia / (radius * radius * rmass);
+  const double dtirotate = kick.dtfrotate / (radius * radius * rmass);
   omega[0] += dtirotate * torque[0];
   omega[1] += dtirotate * torque[1];
   omega[2] += dtirotate * torque[2];
@@ -42,17 +56,17 @@ static inline double nve_sphere_spin(double *omega, const double *torque, double
 }
 
 // The kick of fix nve/sphere, written as it does, so that a scene without fluid is bitwise the
-// same as with fix nve/sphere. dtf = dt ftm2v / 2. Returns the new velocity: read back from v, it
-// would wait for the stores just made.
+// same as with fix nve/sphere. Returns the new velocity: read back from v, it would wait for the
+// stores just made.
 static inline std::array<double, 3> nve_sphere_kick(double *v, double *omega, const double *f, const double *torque,
-                                                    double radius, double rmass, double dtf)
+                                                    double radius, double rmass, HalfKick kick)
 {
-  const double dtfm = dtf / rmass;
+  const double dtfm = kick.dtf / rmass;
   const std::array<double, 3> kicked = {v[0] + dtfm * f[0], v[1] + dtfm * f[1], v[2] + dtfm * f[2]};
   v[0] = kicked[0];
   v[1] = kicked[1];
   v[2] = kicked[2];
-  nve_sphere_spin(omega, torque, radius, rmass, dtf);
+  nve_sphere_spin(omega, torque, radius, rmass, kick);
   return kicked;
 }
 
@@ -75,17 +89,28 @@ static inline double state_sum(const double x[3], const double v[3])
   return (x[0] + x[1] + x[2]) + (v[0] + v[1] + v[2]);
 }
 
-// The first half of fix nve/sphere's step: kick, then drift over the whole step. Returns the
-// state_sum of the new position and velocity, for the check of a finite state.
+// The first half of fix nve/sphere's step: kick, then drift over the whole step. Returns the sum of
+// the new position's components, for the check of a finite state: the position is x + dt v, so a
+// non-finite velocity makes it non-finite too, and summing the velocity as well would add nothing.
 static inline double nve_sphere_kick_drift(double *x, double *v, double *omega, const double *f,
-                                           const double *torque, double radius, double rmass, double dtf, double dt)
+                                           const double *torque, double radius, double rmass, HalfKick kick, double dt)
 {
-  const std::array<double, 3> kicked = nve_sphere_kick(v, omega, f, torque, radius, rmass, dtf);
+  const std::array<double, 3> kicked = nve_sphere_kick(v, omega, f, torque, radius, rmass, kick);
   const double new_x[3] = {x[0] + dt * kicked[0], x[1] + dt * kicked[1], x[2] + dt * kicked[2]};
   x[0] = new_x[0];
   x[1] = new_x[1];
   x[2] = new_x[2];
-  return state_sum(new_x, kicked.data());
+  return new_x[0] + new_x[1] + new_x[2];
+}
+
+// Runs loop(std::true_type{}) with a floor and loop(std::false_type{}) without, so that a loop over
+// the atoms is compiled both ways and tests for the floor only where there is one.
+template <class Loop> static inline void with_floor_or_not(int floor_axis, Loop loop)
+{
+  if (floor_axis >= 0)
+    loop(std::true_type{});
+  else
+    loop(std::false_type{});
 }
 
 FixNVESphereFluid::FixNVESphereFluid(LAMMPS *lmp, int narg, char **arg) :
@@ -193,7 +218,7 @@ template <FixNVESphereFluid::HalfStep path, class Lookup> void FixNVESphereFluid
   const double floor_at = floor_level;
   const double dt = update->dt;
   const double ftm2v = force->ftm2v;
-  const double dtf = 0.5 * dt * ftm2v;
+  const HalfKick kick = half_kick(dt, ftm2v);
   static const double no_flow[3] = {0.0, 0.0, 0.0};
 
   // What follows the drag step of atom i: position, rotation, the weights for the second half
@@ -213,7 +238,7 @@ template <FixNVESphereFluid::HalfStep path, class Lookup> void FixNVESphereFluid
     if (corr.state == sediment::SlipState::HeldAtJump) counts[AT_JUMP] += 1.0;
 
     if (spin_rate == 0.0) {    // no rotational drag: fix nve/sphere's kick, in fewer operations
-      w[SPIN] = nve_sphere_spin(omega[i], torque[i], radius[i], rmass[i], dtf);
+      w[SPIN] = nve_sphere_spin(omega[i], torque[i], radius[i], rmass[i], kick);
     } else {
       const double per_inertia = ftm2v / sediment::sphere_inertia(rmass[i], radius[i]);
       const double alpha[3] = {torque[i][0] * per_inertia, torque[i][1] * per_inertia, torque[i][2] * per_inertia};
@@ -270,7 +295,7 @@ template <FixNVESphereFluid::HalfStep path, class Lookup> void FixNVESphereFluid
     w[IN_FLUID] = sphere.model ? 1.0 : 0.0;
     if (!sphere.model) {
       counts[OUTSIDE] += 1.0;
-      state += nve_sphere_kick_drift(x[i], v[i], omega[i], f[i], torque[i], radius[i], rmass[i], dtf, dt);
+      state += nve_sphere_kick_drift(x[i], v[i], omega[i], f[i], torque[i], radius[i], rmass[i], kick, dt);
       if (floor_dim >= 0) settle_on_floor(x[i], v[i], omega[i], radius[i], floor_dim, floor_at);
       continue;
     }
@@ -332,15 +357,18 @@ void FixNVESphereFluid::initial_integrate(int /*vflag*/)
     const int floor_dim = floor_axis;
     const double floor_at = floor_level;
     const double dt = update->dt;
-    const double dtf = 0.5 * dt * force->ftm2v;
+    const HalfKick kick = half_kick(dt, force->ftm2v);
     int outside = 0;    // local sums: a store into the fix would alias the atom arrays
     double state = 0.0;
-    for (int i = 0; i < nlocal; ++i)
-      if (mask[i] & groupbit) {
-        state += nve_sphere_kick_drift(x[i], v[i], omega[i], f[i], torque[i], radius[i], rmass[i], dtf, dt);
-        if (floor_dim >= 0) settle_on_floor(x[i], v[i], omega[i], radius[i], floor_dim, floor_at);
-        ++outside;
-      }
+    with_floor_or_not(floor_dim, [&](auto with_floor) {
+      for (int i = 0; i < nlocal; ++i)
+        if (mask[i] & groupbit) {
+          state += nve_sphere_kick_drift(x[i], v[i], omega[i], f[i], torque[i], radius[i], rmass[i], kick, dt);
+          if constexpr (decltype(with_floor)::value)
+            settle_on_floor(x[i], v[i], omega[i], radius[i], floor_dim, floor_at);
+          ++outside;
+        }
+    });
     counts[OUTSIDE] = outside;
     check_finite(state);
     return;
@@ -391,23 +419,26 @@ void FixNVESphereFluid::final_integrate()
   const double floor_at = floor_level;
   const double ftm2v = force->ftm2v;
 
-  const double dtf = 0.5 * update->dt * ftm2v;
+  const HalfKick kick = half_kick(update->dt, ftm2v);
   if (drags.empty()) {
-    for (int i = 0; i < nlocal; ++i)
-      if (mask[i] & groupbit) {
-        nve_sphere_kick(v[i], omega[i], f[i], torque[i], radius[i], rmass[i], dtf);
-        if (floor_dim >= 0) settle_on_floor(x[i], v[i], omega[i], radius[i], floor_dim, floor_at);
-      }
+    with_floor_or_not(floor_dim, [&](auto with_floor) {
+      for (int i = 0; i < nlocal; ++i)
+        if (mask[i] & groupbit) {
+          nve_sphere_kick(v[i], omega[i], f[i], torque[i], radius[i], rmass[i], kick);
+          if constexpr (decltype(with_floor)::value)
+            settle_on_floor(x[i], v[i], omega[i], radius[i], floor_dim, floor_at);
+        }
+    });
     return;
   }
 
   // The loop compiled with and without the floor (its test in the loop cost 4 instructions of 80 per atom).
-  auto second_half = [&](auto with_floor) {
+  with_floor_or_not(floor_dim, [&](auto with_floor) {
     for (int i = 0; i < nlocal; ++i) {
       if (!(mask[i] & groupbit)) continue;
       const double *w = weights[i];
       if (w[IN_FLUID] == 0.0) {
-        nve_sphere_kick(v[i], omega[i], f[i], torque[i], radius[i], rmass[i], dtf);
+        nve_sphere_kick(v[i], omega[i], f[i], torque[i], radius[i], rmass[i], kick);
       } else {
         // The weights are per unit mass: the step is linear in the force, so f takes the place of a = f / m.
         // The direction is read only when the weights differ: the first half wrote it only then.
@@ -420,11 +451,7 @@ void FixNVESphereFluid::final_integrate()
       if constexpr (decltype(with_floor)::value)
         settle_on_floor(x[i], v[i], omega[i], radius[i], floor_dim, floor_at);
     }
-  };
-  if (floor_dim >= 0)
-    second_half(std::true_type{});
-  else
-    second_half(std::false_type{});
+  });
 }
 
 void FixNVESphereFluid::check_finite(double state) const
