@@ -354,6 +354,22 @@ def floating(np_ranks: int):
     assert abs(z - z_eq) < 1e-6 * d and abs(out.samples[-1, 2]) < 1e-9
 
 
+@check
+def neutral_buoyancy(np_ranks: int):
+    # A sphere as dense as the fluid displaces exactly the mass LAMMPS gave it (set density), so
+    # gravity and buoyancy cancel to the bit and it stays where it was released, under either
+    # integrator and a linear or a nonlinear law (no slip: no drag).
+    cases = [(3e-5, 998.2, "stokes", "nve/sphere/fluid"), (1e-4, 998.2, "dallavalle", "nve/sphere/fluid"),
+             (7.3e-4, 1234.5, "schiller-naumann", "nve/sphere"), (2.1e-3, 1000.0, "stokes", "nve/sphere")]
+    for d, rho, law, integrator in cases:
+        out = run_deck("single_sphere.lmp", {"d": d, "rho_p": rho, "rho_f": rho, "law": law,
+                                             "integrator": integrator, "dt": 1e-3, "steps": 200, "every": 200},
+                       np_ranks)
+        z, vz = out.samples[-1, 1], out.samples[-1, 2]
+        report(f"neutrally buoyant d={d:g} rho={rho:g} {law} {integrator}: z {z:g}, vz {vz:g} after 200 steps")
+        assert z == 0.0 and vz == 0.0
+
+
 # ---- integrator -----------------------------------------------------------------------------------
 @check
 def integrator_order(np_ranks: int):

@@ -6,7 +6,13 @@ namespace sediment {
 
 constexpr double pi = 3.14159265358979323846;
 
-inline double sphere_volume(double d) { return pi * d * d * d / 6.0; }
+// 4 pi / 3 r^3 in the order LAMMPS takes a sphere's mass from its density (set density, read_data),
+// so that a sphere as dense as the fluid displaces exactly its own mass; and no division per sphere.
+inline double sphere_volume(double d)
+{
+  const double r = 0.5 * d;
+  return 4.0 * pi / 3.0 * r * r * r;
+}
 inline double sphere_area(double d) { return pi * d * d / 4.0; }
 
 // Moment of inertia of a solid sphere, I = 2/5 m r^2; the factor is LAMMPS's fix nve/sphere's.
