@@ -137,13 +137,16 @@ void phi_functions(benchmark::State &state, bool blocks)
 void Phis(benchmark::State &state) { phi_functions(state, false); }
 void PhisMany(benchmark::State &state) { phi_functions(state, true); }
 
-// The drag step of a smooth law (Dallavalle, 30 um quartz in water, slips around the terminal speed
-// of 0.74 mm/s, the step 1e-4 s): a block of one sphere at a time (smooth_step_initial), or blocks of
-// SmoothBlock::capacity (as fix nve/sphere/fluid steps them), on the fastest kind here, on AVX2, or
-// on SSE2 (the default build's 2-wide arithmetic and exponentials).
-void smooth_step(benchmark::State &state, bool blocks, sediment::BatchMath kind = sediment::batch_math_kind())
+// The drag step of a nonlinear law (30 um quartz in water, slips around the terminal speed of
+// 0.74 mm/s, the step 1e-4 s): a block of one sphere at a time (nonlinear_step_initial), blocks of
+// DragBlock::capacity (as fix nve/sphere/fluid steps them) on the fastest kind here, on AVX2 or on
+// SSE2 (the default build's 2-wide arithmetic and exponentials), or the step in pieces one sphere at
+// a time (set_valued_step_initial, which a law with a Cd jump or a yield stress took before blocks).
+enum class Stepping { OneByOne, Blocks, InPieces };
+void nonlinear_step(benchmark::State &state, sediment::DragLaw law, sediment::Fluid fluid, Stepping stepping,
+                    sediment::BatchMath kind = sediment::batch_math_kind())
 {
-  const sediment::DragModel model(sediment::DragLaw::Dallavalle, {998.2, 1.002e-3, 0.0});
+  const sediment::DragModel model(law, fluid);
   const double diameter = 2 * radius, inverse_mass = 1.0 / (2650 * sediment::pi / 6 * diameter * diameter * diameter);
   const double dt = 1e-4, flow[3] = {0.0, 0.0, 0.0};
   std::mt19937_64 random(5);
@@ -157,34 +160,59 @@ void smooth_step(benchmark::State &state, bool blocks, sediment::BatchMath kind 
   sediment::SphereDrag drag;
   drag.model = &model;
   drag.diameter = diameter;
-  sediment::SmoothBlock block;
-  block.set_flow(flow);
+  sediment::DragBlock block;
+  block.set_law(model, flow);
   for (auto _ : state) {
     auto u = v;    // the same start each time
-    if (blocks) {
-      for (int start = 0; start < spheres; start += sediment::SmoothBlock::capacity) {
-        const int end = std::min(spheres, start + sediment::SmoothBlock::capacity);
+    if (stepping == Stepping::Blocks) {
+      for (int start = 0; start < spheres; start += sediment::DragBlock::capacity) {
+        const int end = std::min(spheres, start + sediment::DragBlock::capacity);
         for (int i = start; i < end; ++i) block.add(drag, inverse_mass, a[i].data(), u[i].data());
-        block.step(model, dt, kind);
+        block.step(dt, kind);
         for (int i = start; i < end; ++i) {
           block.velocity(i - start, u[i].data());
           block.displacement(i - start, dx[i].data());
         }
         block.clear();
       }
+    } else if (stepping == Stepping::OneByOne) {
+      for (int i = 0; i < spheres; ++i)
+        sediment::nonlinear_step_initial(drag, inverse_mass, a[i].data(), flow, dt, u[i].data(), dx[i].data());
     } else {
       for (int i = 0; i < spheres; ++i)
-        sediment::smooth_step_initial(drag, inverse_mass, a[i].data(), flow, dt, u[i].data(), dx[i].data());
+        sediment::set_valued_step_initial(drag, 1.0 / inverse_mass, a[i].data(), flow, dt, u[i].data(), dx[i].data());
     }
     benchmark::DoNotOptimize(u.data());
     benchmark::DoNotOptimize(dx.data());
   }
   state.SetItemsProcessed(state.iterations() * spheres);
 }
-void SmoothStepOneByOne(benchmark::State &state) { smooth_step(state, false); }
-void SmoothStepBlocks(benchmark::State &state) { smooth_step(state, true); }
-void SmoothStepBlocksAVX2(benchmark::State &state) { smooth_step(state, true, sediment::BatchMath::AVX2); }
-void SmoothStepBlocksSSE2(benchmark::State &state) { smooth_step(state, true, sediment::BatchMath::SSE2); }
+constexpr sediment::Fluid water{998.2, 1.002e-3, 0.0};
+// A yield stress whose static drag holds up about half the immersed weight (benchmarks/in.cost's bingham scene).
+constexpr sediment::Fluid bingham{998.2, 1.002e-3, 0.01};
+void SmoothStepOneByOne(benchmark::State &state) { nonlinear_step(state, sediment::DragLaw::Dallavalle, water, Stepping::OneByOne); }
+void SmoothStepBlocks(benchmark::State &state) { nonlinear_step(state, sediment::DragLaw::Dallavalle, water, Stepping::Blocks); }
+void SmoothStepBlocksAVX2(benchmark::State &state)
+{
+  nonlinear_step(state, sediment::DragLaw::Dallavalle, water, Stepping::Blocks, sediment::BatchMath::AVX2);
+}
+void SmoothStepBlocksSSE2(benchmark::State &state)
+{
+  nonlinear_step(state, sediment::DragLaw::Dallavalle, water, Stepping::Blocks, sediment::BatchMath::SSE2);
+}
+void SchillerNaumannInPieces(benchmark::State &state)
+{
+  nonlinear_step(state, sediment::DragLaw::SchillerNaumann, water, Stepping::InPieces);
+}
+void SchillerNaumannBlocks(benchmark::State &state)
+{
+  nonlinear_step(state, sediment::DragLaw::SchillerNaumann, water, Stepping::Blocks);
+}
+void ZhangLiBinghamInPieces(benchmark::State &state)
+{
+  nonlinear_step(state, sediment::DragLaw::ZhangLi, bingham, Stepping::InPieces);
+}
+void ZhangLiBinghamBlocks(benchmark::State &state) { nonlinear_step(state, sediment::DragLaw::ZhangLi, bingham, Stepping::Blocks); }
 
 BENCHMARK(LayerDeposit);
 BENCHMARK(LayerInterpolation);
@@ -198,6 +226,10 @@ BENCHMARK(SmoothStepOneByOne);
 BENCHMARK(SmoothStepBlocks);
 BENCHMARK(SmoothStepBlocksAVX2);
 BENCHMARK(SmoothStepBlocksSSE2);
+BENCHMARK(SchillerNaumannInPieces);
+BENCHMARK(SchillerNaumannBlocks);
+BENCHMARK(ZhangLiBinghamInPieces);
+BENCHMARK(ZhangLiBinghamBlocks);
 
 }    // namespace
 

@@ -55,10 +55,16 @@ double drag_coefficient(DragLaw law, double re) { return drag_curve(law, re).g /
 
 DragModel::DragModel(DragLaw law, const Fluid &fluid, HindranceBuoyancy buoyancy) :
     law_(law), hindrance_offset_(buoyancy == HindranceBuoyancy::Plain ? 1.0 : 0.0), fluid_(fluid),
-    density_per_viscosity_(fluid.viscosity > 0.0 ? fluid.density / fluid.viscosity : 0.0), smooth_(false)
+    density_per_viscosity_(fluid.viscosity > 0.0 ? fluid.density / fluid.viscosity : 0.0),
+    yield_per_viscosity_(fluid.viscosity > 0.0 ? fluid.yield_stress / fluid.viscosity : 0.0), smooth_(false)
 {
-  std::array<ForceJump, max_jumps> unused;
-  smooth_ = fluid_.yield_stress <= 0.0 && jumps(1.0, unused) == 0;
+  if (law_ == DragLaw::ZhangLi) {
+    switches_.reynolds[switches_.count++] = zhang_li_low;
+    switches_.reynolds[switches_.count++] = zhang_li_high;
+  } else if (law_ == DragLaw::SchillerNaumann) {
+    switches_.reynolds[switches_.count++] = schiller_naumann_switch;
+  }
+  smooth_ = fluid_.yield_stress <= 0.0 && switches_.count == 0;
 }
 
 double DragModel::viscous_scale(double d, double speed) const
@@ -82,8 +88,7 @@ double DragModel::speed_at_reynolds(double d, double re) const
 
 double DragModel::force_at(double d, double speed, double g, DragScale scale) const
 {
-  const double yield = pi * pi * d * d / 4.0 * fluid_.yield_stress;
-  return scale.wetted * yield + scale.area * 0.5 * sphere_area(d) * viscous_scale(d, speed) * g;
+  return yield_force(d, scale) + scale.area * 0.5 * sphere_area(d) * viscous_scale(d, speed) * g;
 }
 
 double DragModel::force(double d, double speed, DragScale scale) const
@@ -120,22 +125,15 @@ DragModel::ForceSlope DragModel::force_and_tangent(double d, double speed, DragS
 
 int DragModel::jumps(double d, std::array<ForceJump, max_jumps> &out, DragScale scale) const
 {
-  double switches[max_jumps];
-  int n = 0;
-  if (law_ == DragLaw::ZhangLi) {
-    switches[n++] = zhang_li_low;
-    switches[n++] = zhang_li_high;
-  } else if (law_ == DragLaw::SchillerNaumann) {
-    switches[n++] = schiller_naumann_switch;
-  }
   const double inf = std::numeric_limits<double>::infinity();
-  for (int k = 0; k < n; ++k) {
-    const double speed = speed_at_reynolds(d, switches[k]);
-    const double g_below = drag_curve(law_, std::nextafter(switches[k], 0.0)).g;
-    const double g_above = drag_curve(law_, std::nextafter(switches[k], inf)).g;
+  for (int k = 0; k < switches_.count; ++k) {
+    const double re = switches_.reynolds[k];
+    const double speed = speed_at_reynolds(d, re);
+    const double g_below = drag_curve(law_, std::nextafter(re, 0.0)).g;
+    const double g_above = drag_curve(law_, std::nextafter(re, inf)).g;
     out[k] = {speed, force_at(d, speed, g_below, scale), force_at(d, speed, g_above, scale)};
   }
-  return n;
+  return switches_.count;
 }
 
 double relaxation_time(const DragModel &model, double d, double particle_density)

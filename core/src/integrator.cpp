@@ -201,7 +201,7 @@ AlongSlip advance_along(const SphereDrag &drag, double mass, double s, double a_
 
 }    // namespace
 
-[[gnu::always_inline]] inline void SmoothBlock::slip()
+[[gnu::always_inline]] inline void DragBlock::slip()
 {
   for (int n = 0; n < size_; ++n) {
     const double w[3] = {v_[0][n] - u_[0], v_[1][n] - u_[1], v_[2][n] - u_[2]};
@@ -225,19 +225,39 @@ AlongSlip advance_along(const SphereDrag &drag, double mass, double s, double a_
   }
 }
 
-[[gnu::always_inline]] inline void SmoothBlock::rates(const DragModel &model, double dt, BatchMath kind)
+// The rates from one evaluation of the law. Without a yield stress F = k s G(K s): F' = k (G + Re G'),
+// F / s = k G and c = a_par + k s Re G', with no division. Under one, F = F_y + k (s + s_y) G(Re'),
+// Re' = K s^2 / (s + s_y): F' = k (G + Re' G' (2 s_y + s) / s) and c = a_par - F / m + F' s / m; a
+// sphere at rest (s = 0) takes the step in pieces, which replaces what its division by s gives here.
+template <bool yield> [[gnu::always_inline]] inline void DragBlock::rates(const DragModel &model, double dt, BatchMath kind)
 {
-  model.single_curves(reynolds_, curve_, size_);
+  if constexpr (yield)
+    for (int n = 0; n < size_; ++n) {
+      yield_speed_[n] = model.yield_speed(diameter_[n]);
+      yield_accel_[n] = model.yield_force(diameter_[n], {area_[n], wetted_[n], voidage_[n]}) * inverse_mass_[n];
+      const double s = speed_[n];
+      reynolds_[n] = reynolds_per_speed_[n] * s * s / (s + yield_speed_[n]);
+    }
+  model.single_curves(reynolds_, curve_, size_, kind);
   model.hinder(reynolds_, voidage_, curve_, size_, kind);
   for (int n = 0; n < size_; ++n) {
     const double k = rate_per_g_[n];
-    c_[n] = a_par_[n] + speed_[n] * k * curve_[n].re_dg;
-    z_[0][n] = k * (curve_[n].g + curve_[n].re_dg) * dt;
-    z_[1][n] = k * curve_[n].g * dt;
+    const double g = curve_[n].g, re_dg = curve_[n].re_dg;
+    if constexpr (yield) {
+      const double s = speed_[n], sy = yield_speed_[n];
+      const double inverse = 1.0 / s;
+      c_[n] = a_par_[n] - yield_accel_[n] - k * g * sy + k * re_dg * (2.0 * sy + s);
+      z_[0][n] = k * (g + re_dg * (2.0 * sy + s) * inverse) * dt;
+      z_[1][n] = (yield_accel_[n] + k * g * (s + sy)) * inverse * dt;
+    } else {
+      c_[n] = a_par_[n] + speed_[n] * k * re_dg;
+      z_[0][n] = k * (g + re_dg) * dt;
+      z_[1][n] = k * g * dt;
+    }
   }
 }
 
-[[gnu::always_inline]] inline void SmoothBlock::advance_all(double dt)
+[[gnu::always_inline]] inline void DragBlock::advance_all(double dt)
 {
   for (int n = 0; n < size_; ++n) {
     // Along the slip: the slip's exact advance under ds/dt = c - k s; across it, the linear step.
@@ -252,18 +272,91 @@ AlongSlip advance_along(const SphereDrag &drag, double mass, double s, double a_
     for (int k = 0; k < 3; ++k) {
       const double a_perp = a_[k][n] - a_par_[n] * dir_[k][n];
       dx_[k][n] = u_[k] * dt + slip.distance * dir_[k][n] + across_drift * a_perp;
-      v_[k][n] = u_[k] + along_now * dir_[k][n] + across_now * a_perp;
+      mid_v_[k][n] = u_[k] + along_now * dir_[k][n] + across_now * a_perp;
     }
   }
 }
 
-[[gnu::always_inline]] inline void SmoothBlock::stages(const DragModel &model, double dt, BatchMath kind)
+// Which spheres' one-piece step meets a set-valued point of the law, where set_valued_step_initial
+// would stop and go on in another piece: a jump's Reynolds number between the start's and the end's
+// (Re' grows with s; within a relative margin, which also takes a start that sits on a jump), or,
+// under a yield stress, a start at rest or an end below zero speed (the slip would stop). The margin
+// (1e-9) is wider than what set_valued_step_initial counts as sitting on a jump (1e-12 of the speed,
+// at most 2e-12 of Re'), so a sphere steps in one piece only where it would step in one piece there.
+template <bool yield>
+[[gnu::always_inline]] inline void DragBlock::find_set_valued_points(const DragModel &model, double dt)
+{
+  // Each test one loop over the block, which GCC vectorises (with the law's switches inside, the
+  // loop stayed scalar and took a third of the block's time under Zhang-Li's law).
+  constexpr double margin = 1e-9;
+  double end_speed[capacity], low[capacity], high[capacity];    // low, high: the Re' the step passes, with the margin
+  for (int n = 0; n < size_; ++n)    // as advance_all found it (kept there, it cost the smooth laws a store)
+    end_speed[n] = advance(Phi{decay_[0][n], phi1_[0][n], phi2_[0][n]}, speed_[n], c_[n], dt).speed;
+  if constexpr (yield) {
+    for (int n = 0; n < size_; ++n) {
+      const double s0 = speed_[n], s1 = end_speed[n];
+      const double re_end = reynolds_per_speed_[n] * s1 * s1 / (s1 + yield_speed_[n]);
+      low[n] = std::min(reynolds_[n], re_end) * (1.0 - margin);
+      high[n] = std::max(reynolds_[n], re_end) * (1.0 + margin);
+      meets_point_[n] = (!(s0 > 0.0)) | (s1 < 0.0);
+    }
+  } else {
+    for (int n = 0; n < size_; ++n) {
+      const double re_end = reynolds_per_speed_[n] * end_speed[n];
+      low[n] = std::min(reynolds_[n], re_end) * (1.0 - margin);
+      high[n] = std::max(reynolds_[n], re_end) * (1.0 + margin);
+      meets_point_[n] = 0;
+    }
+  }
+  const DragModel::Switches &switches = model.switches();
+  for (int j = 0; j < switches.count; ++j) {
+    const double re = switches.reynolds[j];
+    for (int n = 0; n < size_; ++n) meets_point_[n] |= (re >= low[n]) & (re <= high[n]);
+  }
+  std::int64_t any = 0;
+  for (int n = 0; n < size_; ++n) any |= meets_point_[n];
+  any_meets_point_ = any;
+}
+
+// The stages, compiled apart for a fluid with a yield stress (with both in one body, the Newtonian
+// step ran 3 instructions more per sphere: cachegrind of benchmarks/in.cost's nonlinear scene).
+template <bool yield>
+[[gnu::always_inline]] inline void DragBlock::stages_of(const DragModel &model, double dt, BatchMath kind)
 {
   slip();
-  rates(model, dt, kind);
+  rates<yield>(model, dt, kind);
   fill_phis(z_[0], decay_[0], phi1_[0], phi2_[0], size_, kind);
   fill_phis(z_[1], decay_[1], phi1_[1], phi2_[1], size_, kind);
   advance_all(dt);
+  if (!model.smooth()) find_set_valued_points<yield>(model, dt);
+}
+
+[[gnu::always_inline]] inline void DragBlock::stages(const DragModel &model, double dt, BatchMath kind)
+{
+  if (model.fluid().yield_stress > 0.0)
+    stages_of<true>(model, dt, kind);
+  else
+    stages_of<false>(model, dt, kind);
+}
+
+// The spheres whose one-piece step met a set-valued point, stepped again from their start in pieces.
+void DragBlock::step_in_pieces(const DragModel &model, double dt)
+{
+  for (int n = 0; n < size_; ++n) {
+    if (!meets_point_[n]) continue;
+    const SphereDrag drag{&model, diameter_[n], {area_[n], wetted_[n], voidage_[n]}};
+    const double a[3] = {a_[0][n], a_[1][n], a_[2][n]};
+    double v[3] = {v_[0][n], v_[1][n], v_[2][n]}, dx[3];
+    const StepCorrection corr = set_valued_step_initial(drag, 1.0 / inverse_mass_[n], a, u_, dt, v, dx);
+    for (int k = 0; k < 3; ++k) {
+      mid_v_[k][n] = v[k];
+      dx_[k][n] = dx[k];
+      dir_[k][n] = corr.dir[k];
+    }
+    along_[n] = corr.along;
+    across_[n] = corr.across;
+    state_[n] = corr.state;
+  }
 }
 
 #if defined(__x86_64__) && defined(__GNUC__)
@@ -271,36 +364,39 @@ AlongSlip advance_along(const SphereDrag &drag, double mass, double s, double a_
 // bench_core_kernels SmoothStepBlocks against SmoothStepBlocksSSE2), and in 8-wide ones. No fused
 // multiply-adds (AVX-512 F has them; -ffp-contract=off keeps the compiler from using them), so the
 // same roundings.
-__attribute__((target("avx2"))) void SmoothBlock::stages_avx2(const DragModel &model, double dt)
+__attribute__((target("avx2"))) void DragBlock::stages_avx2(const DragModel &model, double dt)
 {
   stages(model, dt, BatchMath::AVX2);
 }
-__attribute__((target("avx512f"))) void SmoothBlock::stages_avx512(const DragModel &model, double dt)
+__attribute__((target("avx512f"))) void DragBlock::stages_avx512(const DragModel &model, double dt)
 {
   stages(model, dt, BatchMath::AVX512);
 }
 #else
-void SmoothBlock::stages_avx2(const DragModel &model, double dt) { stages(model, dt, BatchMath::Scalar); }
-void SmoothBlock::stages_avx512(const DragModel &model, double dt) { stages(model, dt, BatchMath::Scalar); }
+void DragBlock::stages_avx2(const DragModel &model, double dt) { stages(model, dt, BatchMath::Scalar); }
+void DragBlock::stages_avx512(const DragModel &model, double dt) { stages(model, dt, BatchMath::Scalar); }
 #endif
 
-void SmoothBlock::step(const DragModel &model, double dt, BatchMath kind)
+void DragBlock::step(double dt, BatchMath kind)
 {
+  const DragModel &model = *model_;
   if (kind == BatchMath::AVX512 && batch_math_available(kind))
     stages_avx512(model, dt);
   else if (kind == BatchMath::AVX2 && batch_math_available(kind))
     stages_avx2(model, dt);
   else
     stages(model, dt, kind);
+  in_pieces_ = keeps_for_pieces_ && any_meets_point_;
+  if (in_pieces_) step_in_pieces(model, dt);
 }
 
-StepCorrection smooth_step_initial(const SphereDrag &drag, double inverse_mass, const double a[3],
-                                   const double u[3], double dt, double v[3], double dx[3])
+StepCorrection nonlinear_step_initial(const SphereDrag &drag, double inverse_mass, const double a[3],
+                                      const double u[3], double dt, double v[3], double dx[3])
 {
-  SmoothBlock block;
-  block.set_flow(u);
+  DragBlock block;
+  block.set_law(*drag.model, u);
   block.add(drag, inverse_mass, a, v);
-  block.step(*drag.model, dt);
+  block.step(dt);
   block.velocity(0, v);
   block.displacement(0, dx);
   return block.correction(0);

@@ -47,8 +47,9 @@ class FixFluidDrag : public Fix {
   // has no rotational drag: then immersed_drag(i) is sphere_drag(i) for the atoms of the group, and
   // an integrator may skip the per-atom region, surface and rotation look-ups.
   bool uniform() const;
-  // True when the law is smooth (no yield stress, no Cd jump) and not linear in the slip.
-  bool smooth_nonlinear() const { return model->smooth() && !(linear_per_diameter() > 0.0); }
+  // True when the drag of a wholly immersed sphere is not linear in the slip (any law but Stokes in a
+  // Newtonian fluid).
+  bool nonlinear() const { return !(linear_per_diameter() > 0.0); }
   // c when the drag of a wholly immersed sphere of diameter d is F = c d w, else 0.
   double linear_per_diameter() const { return model->linear_coefficient(1.0); }
   const sediment::DragModel *drag_model() const { return model.get(); }

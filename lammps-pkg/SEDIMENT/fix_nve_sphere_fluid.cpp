@@ -177,8 +177,12 @@ void FixNVESphereFluid::setup(int /*vflag*/)
   // Linear only with a uniform drag: its spheres are wholly immersed, so F = c d w.
   linear_per_diameter = uniform ? uniform->linear_per_diameter() : 0.0;
   half_step = linear_per_diameter > 0.0 ? HalfStep::Linear : HalfStep::General;
-  for (FixFluidDrag *drag : drags)
-    if (drag->smooth_nonlinear()) half_step = HalfStep::Blocked;
+  bool nonlinear = false, set_valued = false;
+  for (FixFluidDrag *drag : drags) {
+    nonlinear |= drag->nonlinear();
+    set_valued |= !drag->drag_model()->smooth();
+  }
+  if (nonlinear) half_step = set_valued ? HalfStep::Blocked : HalfStep::Smooth;
 }
 
 // A perfectly inelastic floor without a bed: a sphere reaching it stops with its lowest point on
@@ -256,26 +260,35 @@ template <FixNVESphereFluid::HalfStep path, class Lookup> void FixNVESphereFluid
     return state;
   };
 
-  // Atoms under a smooth nonlinear law wait in a block of one law (sediment::SmoothBlock), which
-  // steps them together, each stage one vector loop over the block; then each is finished here.
+  // Atoms under a nonlinear law wait in a block of one law (sediment::DragBlock), which steps them
+  // together, each stage one vector loop over the block; then each is finished here.
   struct Waiting {
     int i;
     double spin_rate;
     double per_mass;
   };
-  sediment::SmoothBlock block;
-  Waiting waiting[sediment::SmoothBlock::capacity];
-  const sediment::DragModel *block_model = nullptr;
+  sediment::DragBlock block;
+  Waiting waiting[sediment::DragBlock::capacity];
   auto step_block = [&]() {
-    block.step(*block_model, dt);
+    block.step(dt);
     double state = 0.0;
-    for (int n = 0; n < block.size(); ++n) {
-      const Waiting &b = waiting[n];
-      double dx[3];
-      block.velocity(n, v[b.i]);
-      block.displacement(n, dx);
-      state += finish(b.i, block.correction(n), dx, b.spin_rate, b.per_mass);
-    }
+    // Compiled with and without spheres stepped in pieces: without, every sphere is free, and finish
+    // counts no stuck or held sphere.
+    auto finish_all = [&](auto in_pieces) {
+      for (int n = 0; n < block.size(); ++n) {
+        const Waiting &b = waiting[n];
+        double dx[3];
+        block.velocity(n, v[b.i]);
+        block.displacement(n, dx);
+        sediment::StepCorrection corr = block.correction(n);
+        if constexpr (!decltype(in_pieces)::value) corr.state = sediment::SlipState::Free;
+        state += finish(b.i, corr, dx, b.spin_rate, b.per_mass);
+      }
+    };
+    if (block.stepped_in_pieces())
+      finish_all(std::true_type{});
+    else
+      finish_all(std::false_type{});
     block.clear();
     return state;
   };
@@ -321,27 +334,33 @@ template <FixNVESphereFluid::HalfStep path, class Lookup> void FixNVESphereFluid
                       dx, spin_rate, per_mass);
       continue;
     }
-    if (path == HalfStep::Blocked && sediment::step_kind(sphere) == sediment::StepKind::Smooth) {
-      if (sphere.model != block_model) {    // a block per law, and so per fluid/drag fix and flow
-        if (block.size() > 0) state += step_block();
-        block_model = sphere.model;
-        block.set_flow(flow);
+    if constexpr (path == HalfStep::Smooth || path == HalfStep::Blocked) {
+      if (path == HalfStep::Smooth ? sediment::step_kind(sphere) == sediment::StepKind::Smooth
+                                   : sediment::steps_in_block(sphere, v[i], flow)) {
+        if (sphere.model != block.law()) {    // a block per law, and so per fluid/drag fix and flow
+          if (block.size() > 0) state += step_block();
+          block.set_law(*sphere.model, flow);
+        }
+        const int n = path == HalfStep::Smooth ? block.add_smooth(sphere, per_mass, a, v[i])
+                                                : block.add(sphere, per_mass, a, v[i]);
+        waiting[n] = {i, spin_rate, per_mass};
+        if (block.full()) state += step_block();
+        continue;
       }
-      waiting[block.add(sphere, per_mass, a, v[i])] = {i, spin_rate, per_mass};
-      if (block.full()) state += step_block();
-      continue;
     }
     state += finish(i, sediment::drag_step_initial(sphere, per_mass, a, flow, dt, v[i], dx, &w[DRAG_MEMO]), dx,
                     spin_rate, per_mass);
   }
-  if (path == HalfStep::Blocked && block.size() > 0) state += step_block();
+  if ((path == HalfStep::Smooth || path == HalfStep::Blocked) && block.size() > 0) state += step_block();
   check_finite(state);
 }
 
 template <class Lookup> void FixNVESphereFluid::step_first_half(Lookup lookup)
 {
   // Linear is taken by initial_integrate with its own look-up.
-  if (half_step == HalfStep::Blocked)
+  if (half_step == HalfStep::Smooth)
+    first_half<HalfStep::Smooth>(lookup);
+  else if (half_step == HalfStep::Blocked)
     first_half<HalfStep::Blocked>(lookup);
   else
     first_half<HalfStep::General>(lookup);

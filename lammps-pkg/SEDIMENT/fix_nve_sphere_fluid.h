@@ -56,12 +56,13 @@ class FixNVESphereFluid : public Fix {
   // Set in setup() when there is one fluid/drag and it is uniform() (every atom of its group wholly
   // immersed, no rotational drag): the step then skips the per-atom region and surface look-ups.
   class FixFluidDrag *uniform;
-  // How the first half steps the spheres in a fluid, decided in setup(): General (any law, one
-  // sphere at a time), Blocked (some fluid/drag has a smooth nonlinear law: its spheres are stepped
-  // in blocks, sediment::SmoothBlock) or Linear (the uniform drag is linear in the slip, F = c d w:
-  // c is taken once per run, and the step is sediment::linear_step_initial with no per-sphere
-  // choice of law).
-  enum class HalfStep { General, Blocked, Linear };
+  // How the first half steps the spheres in a fluid, decided in setup(): General (linear laws, one
+  // sphere at a time), Blocked (some fluid/drag has a nonlinear law: its spheres are stepped in
+  // blocks, sediment::DragBlock), Smooth (Blocked, with every law smooth: no block prepares a step in
+  // pieces, and no sphere is asked whether it needs one) or Linear (the uniform drag is linear in the
+  // slip, F = c d w: c is taken once per run, and the step is sediment::linear_step_initial with no
+  // per-sphere choice of law).
+  enum class HalfStep { General, Blocked, Smooth, Linear };
   HalfStep half_step;
   double linear_per_diameter;    // c of the Linear step
   // The first half of the step for every atom of the group, with the drag found by lookup(i, sphere,

@@ -11,6 +11,7 @@
 #include <functional>
 #include <limits>
 #include <array>
+#include <utility>
 #include <vector>
 
 using namespace sediment;
@@ -272,20 +273,20 @@ struct BlockResult {
   StepCorrection corr;
 };
 
-// The spheres stepped in blocks of SmoothBlock::capacity, the first block starting one sphere in (so
+// The spheres stepped in blocks of DragBlock::capacity, the first block starting one sphere in (so
 // every place of a block is taken), or each in a block of its own.
 std::vector<BlockResult> step_in_blocks(const DragModel &model, const std::vector<BlockSphere> &spheres, double dt,
                                         BatchMath kind, bool alone)
 {
-  const int n = static_cast<int>(spheres.size()), size = alone ? 1 : SmoothBlock::capacity;
+  const int n = static_cast<int>(spheres.size()), size = alone ? 1 : DragBlock::capacity;
   std::vector<BlockResult> out(spheres.size());
-  SmoothBlock block;
-  block.set_flow(block_flow);
+  DragBlock block;
+  block.set_law(model, block_flow);
   for (int start = alone ? 0 : 1; start < n + (alone ? 0 : 1); start += size) {
     std::vector<int> members;
     for (int j = start; j < std::min(n + (alone ? 0 : 1), start + size); ++j) members.push_back(j % n);
     for (int j : members) block.add(spheres[j].drag, spheres[j].inverse_mass, spheres[j].a, spheres[j].v);
-    block.step(model, dt, kind);
+    block.step(dt, kind);
     for (size_t m = 0; m < members.size(); ++m) {
       BlockResult &r = out[members[m]];
       block.velocity(static_cast<int>(m), r.v.data());
@@ -310,10 +311,10 @@ void expect_same_bits(const BlockResult &a, const BlockResult &b)
 
 }    // namespace
 
-TEST(SmoothBlock, EachSphereStepsAsAloneAndAsTheNewtonStep)
+TEST(DragBlock, EachSphereStepsAsAloneAndAsTheNewtonStep)
 {
   // Under Dallavalle's law and under Di Felice's, on every kind of this processor: in a block each
-  // sphere steps bit for bit as in a block of one (smooth_step_initial, on the default kind),
+  // sphere steps bit for bit as in a block of one (nonlinear_step_initial, on the default kind),
   // wherever it sits and whoever its neighbours are, and as the piecewise Newton step of a law with
   // set-valued points (set_valued_step_initial: its own arithmetic, scalar exponentials; for a
   // smooth law one piece).
@@ -332,7 +333,7 @@ TEST(SmoothBlock, EachSphereStepsAsAloneAndAsTheNewtonStep)
         expect_same_bits(blocks[j], alone[j]);
         if (kind == batch_math_kind()) {
           BlockResult initial{{sp.v[0], sp.v[1], sp.v[2]}, {}, {}};
-          initial.corr = smooth_step_initial(sp.drag, sp.inverse_mass, sp.a, block_flow, dt, initial.v.data(), initial.dx.data());
+          initial.corr = nonlinear_step_initial(sp.drag, sp.inverse_mass, sp.a, block_flow, dt, initial.v.data(), initial.dx.data());
           expect_same_bits(blocks[j], initial);
         }
         double v_newton[3] = {sp.v[0], sp.v[1], sp.v[2]}, dx_newton[3];
@@ -351,7 +352,104 @@ TEST(SmoothBlock, EachSphereStepsAsAloneAndAsTheNewtonStep)
   }
 }
 
-TEST(SmoothBlock, TheArithmeticIsTheSameOnEveryKind)
+namespace {
+
+// Spheres placed where a law's step meets its set-valued points: slips just below, on and just above
+// each jump speed (along and against a drive that carries them across it, or with none), and, under a
+// yield stress, spheres at rest held by it or breaking free, and spheres moving slowly against the
+// drive, which stop within the step.
+std::vector<BlockSphere> set_valued_spheres(const DragModel &model)
+{
+  std::vector<BlockSphere> spheres = block_spheres(model);
+  for (double d : {3e-5, 3e-4}) {
+    const double inverse_mass = 1.0 / (2650.0 * sphere_volume(d));
+    std::array<ForceJump, DragModel::max_jumps> jumps;
+    const int count = model.jumps(d, jumps);
+    for (int j = 0; j < count; ++j)
+      for (double factor : {0.999, 1.0 - 1e-13, 1.0, 1.0 + 1e-13, 1.001})
+        for (double drive : {-60.0, 0.0, 60.0}) {
+          // Slip along -z: a drive of -60 m/s^2 speeds it up, one of +60 slows it down.
+          BlockSphere sp{{&model, d, {1.0, 1.0, 1.0}}, inverse_mass, {0.0, 0.0, drive}, {}};
+          const double speed = jumps[j].speed * factor;
+          for (int k = 0; k < 3; ++k) sp.v[k] = block_flow[k] - (k == 2 ? speed : 0.0);
+          spheres.push_back(sp);
+          // A drive inside the jump: the speed is held there.
+          sp.a[2] = -0.5 * (jumps[j].force_below + jumps[j].force_above) * inverse_mass;
+          spheres.push_back(sp);
+        }
+    const double holds = model.static_force(d) * inverse_mass;    // the largest drive the yield stress holds
+    if (holds > 0.0)
+      for (double factor : {0.5, 0.999, 1.001, 3.0}) {
+        BlockSphere at_rest{{&model, d, {1.0, 1.0, 1.0}}, inverse_mass, {0.0, 0.6 * holds * factor, -0.8 * holds * factor},
+                            {block_flow[0], block_flow[1], block_flow[2]}};
+        spheres.push_back(at_rest);
+        BlockSphere slow = at_rest;    // moving up against a drive down: stops within 1e-4 s, or not
+        slow.v[2] += 1e-4 * holds * factor;
+        spheres.push_back(slow);
+      }
+  }
+  return spheres;
+}
+
+}    // namespace
+
+TEST(DragBlock, LawsWithSetValuedPointsStepAsInPieces)
+{
+  // A block takes the one-piece Newton step of every sphere and steps again, in pieces
+  // (set_valued_step_initial), those whose step meets a jump or the yield point: each sphere then ends
+  // as in set_valued_step_initial, bit for bit when stepped in pieces and to round-off otherwise (one
+  // piece, the same arithmetic in another order), and as in a block of its own.
+  const Fluid water{998.2, 1.002e-3, 0.0}, paste{998.2, 1.002e-3, 0.01}, clay{1280.0, 0.0131, 30.5};
+  const std::pair<DragLaw, Fluid> laws[] = {
+      {DragLaw::SchillerNaumann, water}, {DragLaw::ZhangLi, water},       {DragLaw::ZhangLi, paste},
+      {DragLaw::ZhangLi, clay},          {DragLaw::ZhangLiSmooth, paste}, {DragLaw::Stokes, paste}};
+  const double dt = 1e-4;
+  int stuck = 0, held = 0, one_piece = 0;
+  for (const auto &[law, fluid] : laws) {
+    const DragModel model(law, fluid);
+    ASSERT_FALSE(model.smooth());
+    const std::vector<BlockSphere> spheres = set_valued_spheres(model);
+    for (const BatchMath kind : batch_math_kinds) {
+      if (!batch_math_available(kind)) continue;
+      const std::vector<BlockResult> blocks = step_in_blocks(model, spheres, dt, kind, false);
+      const std::vector<BlockResult> alone = step_in_blocks(model, spheres, dt, kind, true);
+      for (size_t j = 0; j < spheres.size(); ++j) {
+        const BlockSphere &sp = spheres[j];
+        SCOPED_TRACE(testing::Message() << drag_law_name(law) << " tau_y " << fluid.yield_stress << " "
+                                        << batch_math_name(kind) << " sphere " << j);
+        expect_same_bits(blocks[j], alone[j]);
+        EXPECT_EQ(blocks[j].corr.state, alone[j].corr.state);
+        BlockResult pieces{{sp.v[0], sp.v[1], sp.v[2]}, {}, {}};
+        pieces.corr = set_valued_step_initial(sp.drag, 1.0 / sp.inverse_mass, sp.a, block_flow, dt, pieces.v.data(),
+                                              pieces.dx.data());
+        EXPECT_EQ(blocks[j].corr.state, pieces.corr.state);
+        const double scale = std::abs(sp.v[0]) + std::abs(sp.v[1]) + std::abs(sp.v[2]) +
+                             dt * (std::abs(sp.a[0]) + std::abs(sp.a[1]) + std::abs(sp.a[2]));
+        const bool same_bits = blocks[j].v == pieces.v && blocks[j].dx == pieces.dx;
+        if (!same_bits) {    // one piece: the same step to round-off
+          ++one_piece;
+          EXPECT_EQ(pieces.corr.state, SlipState::Free);
+          EXPECT_NEAR(blocks[j].corr.along, pieces.corr.along, 1e-12 * pieces.corr.along);
+          EXPECT_NEAR(blocks[j].corr.across, pieces.corr.across, 1e-12 * pieces.corr.across);
+          for (int c = 0; c < 3; ++c) {
+            EXPECT_NEAR(blocks[j].v[c], pieces.v[c], 1e-12 * scale);
+            EXPECT_NEAR(blocks[j].dx[c], pieces.dx[c], 1e-12 * scale * dt);
+          }
+        }
+        if (kind == batch_math_kind()) {
+          stuck += pieces.corr.state == SlipState::Stuck;
+          held += pieces.corr.state == SlipState::HeldAtJump;
+        }
+      }
+    }
+  }
+  // The scenes reach every kind of step.
+  EXPECT_GT(stuck, 10);
+  EXPECT_GT(held, 10);
+  EXPECT_GT(one_piece, 100);
+}
+
+TEST(DragBlock, TheArithmeticIsTheSameOnEveryKind)
 {
   // The AVX2 and AVX-512 steps run the block's arithmetic in 4- and 8-wide vectors, the other kinds
   // in the default build's (2-wide SSE2 on x86-64), a short block's tail one by one; without fused

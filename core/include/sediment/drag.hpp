@@ -51,6 +51,18 @@ constexpr double schiller_naumann_switch = 1000.0;
 constexpr double zhang_li_low = 1.0;
 constexpr double zhang_li_high = 150.0;
 
+// Schiller-Naumann's Cd Re given power = Re^0.687 (used below the switch only): a batch takes the
+// powers from exp_many and log_many, one sphere from std::pow.
+constexpr double schiller_naumann_exponent = 0.687;
+inline DragCurve schiller_naumann_curve(double re, double power)
+{
+  if (re <= schiller_naumann_switch) {
+    const double p = 0.15 * power;
+    return {24.0 * (1.0 + p), 24.0 * schiller_naumann_exponent * p};
+  }
+  return {0.44 * re, 0.44 * re};
+}
+
 // Inline: the integrator's per-atom loops evaluate it with the law fixed for the whole run.
 inline DragCurve drag_curve(DragLaw law, double re)
 {
@@ -58,11 +70,7 @@ inline DragCurve drag_curve(DragLaw law, double re)
     case DragLaw::Stokes:
       return {24.0, 0.0};
     case DragLaw::SchillerNaumann:
-      if (re <= schiller_naumann_switch) {
-        const double p = 0.15 * std::pow(re, 0.687);
-        return {24.0 * (1.0 + p), 24.0 * 0.687 * p};
-      }
-      return {0.44 * re, 0.44 * re};
+      return schiller_naumann_curve(re, re <= schiller_naumann_switch ? std::pow(re, schiller_naumann_exponent) : 0.0);
     case DragLaw::Dallavalle:
     case DragLaw::DiFelice: {    // the single-sphere curve; hindrance is applied per sphere
       // Cd = (0.63 + 4.8 / sqrt(Re))^2  =>  Cd Re = (0.63 sqrt(Re) + 4.8)^2
@@ -142,10 +150,20 @@ class DragModel {
   // True when F(s) is single-valued and continuous: no yield stress and no Cd jump, so a step
   // needs no event handling (Stokes, Dallavalle, Di Felice, zhang-li/smooth in a Newtonian fluid).
   bool smooth() const { return smooth_; }
-  // A smooth law is F(s) = k s G(K s) with k = s_A pi eta d / 8 and Re = K s, K = rho d / eta:
-  // the step takes its rates from k G and k (G + Re G') without dividing by the slip.
+  // Every law is F(s) = F_y + k (s + s_y) G(Re'), Re' = K s^2 / (s + s_y), with k = s_A pi eta d / 8,
+  // K = rho d / eta, the yield force F_y = s_w (pi d / 2)^2 tau_y and the yield speed s_y = tau_y d / eta
+  // (both 0 in a Newtonian fluid, where Re = K s): a step takes its rates from k, G and Re G' without
+  // dividing by the slip where there is no yield stress.
   double smooth_drag_per_speed(double d, DragScale scale) const { return scale.area * pi / 8.0 * fluid_.viscosity * d; }
   double smooth_reynolds_per_speed(double d) const { return density_per_viscosity_ * d; }
+  double yield_force(double d, DragScale scale) const { return scale.wetted * (pi * pi * d * d / 4.0 * fluid_.yield_stress); }
+  double yield_speed(double d) const { return yield_per_viscosity_ * d; }
+  // The Reynolds numbers Re' at which Cd jumps (where a step may have to stop: jumps()), in increasing order.
+  struct Switches {
+    int count = 0;
+    double reynolds[max_jumps] = {0.0, 0.0};
+  };
+  const Switches &switches() const { return switches_; }
   // Cd Re' of the law at this sphere, with the Di Felice hindrance when it applies.
   DragCurve curve(double re, double voidage) const
   {
@@ -160,24 +178,47 @@ class DragModel {
   void curves(const double *re, const double *voidage, DragCurve *out, int n,
               BatchMath kind = batch_math_kind()) const
   {
-    single_curves(re, out, n);
+    single_curves(re, out, n, kind);
     hinder(re, voidage, out, n, kind);
   }
   // The two parts of curves(). The single-sphere curves inline, for a caller's loop compiled for
-  // its own instruction set; the law is fixed outside the loop, so the common smooth law's loop is
-  // vectorised (with the switch inside, each sphere took an indirect jump and stayed scalar).
-  void single_curves(const double *re, DragCurve *out, int n) const
+  // its own instruction set; the law is fixed outside the loop, so each law's loop is vectorised
+  // (with the switch inside, each sphere took an indirect jump and stayed scalar), and
+  // Schiller-Naumann's powers come from exp_many and log_many of this kind.
+  [[gnu::always_inline]] void single_curves(const double *re, DragCurve *out, int n, BatchMath kind) const
   {
-    if (law_ == DragLaw::Dallavalle || law_ == DragLaw::DiFelice) {
-      for (int k = 0; k < n; ++k) out[k] = drag_curve(DragLaw::Dallavalle, re[k]);
-    } else {
-      for (int k = 0; k < n; ++k) out[k] = drag_curve(law_, re[k]);
+    switch (law_) {
+      case DragLaw::Dallavalle:
+      case DragLaw::DiFelice:
+        for (int k = 0; k < n; ++k) out[k] = drag_curve(DragLaw::Dallavalle, re[k]);
+        return;
+      case DragLaw::SchillerNaumann: {
+        constexpr int chunk = 64;
+        double power[chunk];
+        for (int start = 0; start < n; start += chunk) {
+          const int m = std::min(n - start, chunk);
+          log_many(re + start, power, m, kind);    // Re = 0: ln 0 = -inf, and e^-inf = 0 = 0^0.687
+          for (int j = 0; j < m; ++j) power[j] *= schiller_naumann_exponent;
+          exp_many(power, power, m, kind);
+          for (int j = 0; j < m; ++j) out[start + j] = schiller_naumann_curve(re[start + j], power[j]);
+        }
+        return;
+      }
+      case DragLaw::ZhangLi:
+        for (int k = 0; k < n; ++k) out[k] = drag_curve(DragLaw::ZhangLi, re[k]);
+        return;
+      case DragLaw::ZhangLiSmooth:
+        for (int k = 0; k < n; ++k) out[k] = drag_curve(DragLaw::ZhangLiSmooth, re[k]);
+        return;
+      case DragLaw::Stokes:
+        for (int k = 0; k < n; ++k) out[k] = drag_curve(DragLaw::Stokes, re[k]);
+        return;
     }
   }
   // Di Felice's hindrance applied to single-sphere curves (nothing under another law), each stage one
   // loop over a chunk of spheres with no gather of the hindered ones: an unhindered sphere (eps >= 1)
   // takes ln 1 = 0 and e^-0 = 1, so its curve comes out unchanged, bit for bit. Inline, so that the
-  // loops run in the vectors of the caller's instruction set (SmoothBlock's AVX2 step).
+  // loops run in the vectors of the caller's instruction set (DragBlock's AVX2 step).
   [[gnu::always_inline]] void hinder(const double *re, const double *voidage, DragCurve *out, int n,
                                      BatchMath kind) const
   {
@@ -240,6 +281,8 @@ class DragModel {
   double hindrance_offset_;    // 1: eps^-(chi+1), 0: eps^-chi
   Fluid fluid_;
   double density_per_viscosity_;    // rho / eta (0 without viscosity)
+  double yield_per_viscosity_;      // tau_y / eta (0 without viscosity)
+  Switches switches_;
   bool smooth_;
 };
 

@@ -19,7 +19,9 @@
 #include "sediment/batch_math.hpp"
 #include "sediment/drag.hpp"
 
+#include <cassert>
 #include <cmath>
+#include <cstdint>
 
 namespace sediment {
 
@@ -83,29 +85,79 @@ inline Segment advance(const Phi &p, double s0, double c, double t)
   return {s0 * p.decay + c * t * p.phi1, s0 * t * p.phi1 + c * t * t * p.phi2};
 }
 
-// The step of a smooth law (DragModel::smooth(): no yield, no Cd jump) for a block of spheres under
-// one law, held as a structure of arrays: each stage (slip and direction, the law's curve, the rates,
-// their exponentials, the advance) is one loop over the block of independent spheres, which the
-// compiler turns into vector instructions and the processor overlaps, instead of one long chain of
-// square roots, divisions and exponentials per sphere. One evaluation of the law gives the Newton
-// rate along the slip, k (G + Re G') / m, and the secant rate across it, k G / m (F = k s G(Re),
-// Re = K s). The arithmetic of each sphere does not depend on the block it is in, nor on where.
+// drag_step_initial for a law with set-valued points (a yield stress or a Cd jump): Newton
+// linearisation, advanced piecewise between the points (out of line).
+StepCorrection set_valued_step_initial(const SphereDrag &drag, double mass, const double a[3],
+                                       const double u[3], double dt, double v[3], double dx[3]);
+
+// The step of a nonlinear law for a block of spheres under one law, held as a structure of arrays:
+// each stage (slip and direction, the law's curve, the rates, their exponentials, the advance) is
+// one loop over the block of independent spheres, which the compiler turns into vector instructions
+// and the processor overlaps, instead of one long chain of square roots, divisions and exponentials
+// per sphere. One evaluation of the law gives the Newton rate along the slip, F'(s) / m, and the
+// secant rate across it, F(s) / (s m), from k, G and Re G' (DragModel::smooth_drag_per_speed).
+// A law with set-valued points (a Cd jump, a yield stress) takes the same one-piece step, which is
+// the first piece of set_valued_step_initial; a sphere whose step meets such a point (its Reynolds
+// number reaches or sits on a jump, it starts at rest or would stop under the yield stress) is then
+// stepped again alone, in pieces, from its state at the start. Rare in a settling scene: the
+// Reynolds numbers of the grains stay on one branch of the law. So the arithmetic of each sphere
+// does not depend on the block it is in, nor on where.
 // The spheres of a block share their law and the fluid's velocity (one fluid/drag fix).
-class SmoothBlock {
+class DragBlock {
  public:
   static constexpr int capacity = 32;
 
   int size() const { return size_; }
   bool full() const { return size_ == capacity; }
   void clear() { size_ = 0; }
-  // The velocity u of the fluid around every sphere of the block; set while the block is empty.
-  void set_flow(const double u[3])
+  // The law of every sphere of the block (a nonlinear one) and the velocity u of the fluid around
+  // them; set while the block is empty.
+  void set_law(const DragModel &model, const double u[3])
   {
+    model_ = &model;
+    keeps_for_pieces_ = !model.smooth();
     for (int k = 0; k < 3; ++k) u_[k] = u[k];
   }
-  // Adds a sphere (drag.model smooth and nonlinear, the block's law) with its velocity v, the
-  // non-drag acceleration a_n and 1 / m; returns its place in the block.
+  const DragModel *law() const { return model_; }
+  // Adds a sphere (drag.model the block's law) with its velocity v, the non-drag acceleration a_n and
+  // 1 / m; returns its place in the block.
   int add(const SphereDrag &drag, double inverse_mass, const double a[3], const double v[3])
+  {
+    const int n = add_for_one_piece(drag, inverse_mass, a, v);
+    if (keeps_for_pieces_) keep_for_pieces(n, drag, inverse_mass);
+    return n;
+  }
+  // add() for a block whose law is smooth (law()->smooth()), which keeps nothing for a step in pieces:
+  // a caller that knows it saves the test per sphere.
+  int add_smooth(const SphereDrag &drag, double inverse_mass, const double a[3], const double v[3])
+  {
+    assert(!keeps_for_pieces_);
+    return add_for_one_piece(drag, inverse_mass, a, v);
+  }
+  // Steps every sphere of the block over dt. The kind sets the exponentials and logarithms
+  // (exp_many) and, with AVX2 or AVX-512, the block's arithmetic runs in 4- or 8-wide vectors: the
+  // same operations without fused multiply-adds, rounded as in the default build (the vector exp and
+  // log of each kind may differ in the last bit).
+  void step(double dt, BatchMath kind = batch_math_kind());
+  // After step(): the mid-step velocity, the displacement and the weights of a_{n+1} of sphere n.
+  void velocity(int n, double v[3]) const { copy3(mid_v_, n, v); }
+  void displacement(int n, double dx[3]) const { copy3(dx_, n, dx); }
+  StepCorrection correction(int n) const
+  {
+    StepCorrection corr;
+    corr.along = along_[n];
+    corr.across = across_[n];
+    copy3(dir_, n, corr.dir);
+    if (in_pieces_ && meets_point_[n]) corr.state = state_[n];
+    return corr;
+  }
+  // Whether some sphere of the last step was stepped in pieces: else every correction's state is Free,
+  // and a caller may take it so (correction(n) tests each sphere).
+  bool stepped_in_pieces() const { return in_pieces_; }
+
+ private:
+  // What the one-piece step needs of a sphere.
+  int add_for_one_piece(const SphereDrag &drag, double inverse_mass, const double a[3], const double v[3])
   {
     const int n = size_++;
     for (int k = 0; k < 3; ++k) {
@@ -117,43 +169,42 @@ class SmoothBlock {
     voidage_[n] = drag.scale.voidage;
     return n;
   }
-  // Steps every sphere of the block over dt under `model`, the law of all of them. The kind sets the
-  // exponentials and logarithms (exp_many) and, with AVX2, the block's arithmetic runs in 4-wide
-  // vectors: the same operations without fused multiply-adds, rounded as in the default build (the
-  // vector exp and log of each kind may differ in the last bit).
-  void step(const DragModel &model, double dt, BatchMath kind = batch_math_kind());
-  // After step(): the mid-step velocity, the displacement and the weights of a_{n+1} of sphere n.
-  void velocity(int n, double v[3]) const { copy3(v_, n, v); }
-  void displacement(int n, double dx[3]) const { copy3(dx_, n, dx); }
-  StepCorrection correction(int n) const
-  {
-    StepCorrection corr;
-    corr.along = along_[n];
-    corr.across = across_[n];
-    copy3(dir_, n, corr.dir);
-    return corr;
-  }
-
- private:
   static void copy3(const double (&from)[3][capacity], int n, double to[3])
   {
     to[0] = from[0][n];
     to[1] = from[1][n];
     to[2] = from[2][n];
   }
+  // What the step in pieces and the yield terms of the rates need of a sphere under a law with
+  // set-valued points, besides its start (v_, a_).
+  void keep_for_pieces(int n, const SphereDrag &drag, double inverse_mass)
+  {
+    diameter_[n] = drag.diameter;
+    area_[n] = drag.scale.area;
+    wetted_[n] = drag.scale.wetted;
+    inverse_mass_[n] = inverse_mass;
+  }
   // The stages, inlined into the step of each instruction set (integrator.cpp).
   void stages(const DragModel &model, double dt, BatchMath kind);
   void stages_avx2(const DragModel &model, double dt);
   void stages_avx512(const DragModel &model, double dt);
+  template <bool yield> void stages_of(const DragModel &model, double dt, BatchMath kind);
   void slip();
-  void rates(const DragModel &model, double dt, BatchMath kind);
+  template <bool yield> void rates(const DragModel &model, double dt, BatchMath kind);
   void advance_all(double dt);
+  template <bool yield> void find_set_valued_points(const DragModel &model, double dt);
+  void step_in_pieces(const DragModel &model, double dt);
 
+  const DragModel *model_ = nullptr;
+  bool keeps_for_pieces_ = false;    // the law has set-valued points
   int size_ = 0;
+  // The last step's law has set-valued points, and some sphere's step met one (meets_point_, state_).
+  bool in_pieces_ = false;
+  std::int64_t any_meets_point_ = 0;
   double u_[3] = {0.0, 0.0, 0.0};    // the flow
-  // Per sphere, component first: velocity (the mid-step velocity after step()), a_n, direction of the
-  // slip, displacement.
-  double v_[3][capacity], a_[3][capacity], dir_[3][capacity], dx_[3][capacity];
+  // Per sphere, component first: velocity at the start and at mid-step (after step()), a_n, direction
+  // of the slip, displacement.
+  double v_[3][capacity], mid_v_[3][capacity], a_[3][capacity], dir_[3][capacity], dx_[3][capacity];
   double reynolds_per_speed_[capacity], rate_per_g_[capacity], voidage_[capacity];    // K, k / m, eps
   double speed_[capacity], a_par_[capacity], reynolds_[capacity];
   DragCurve curve_[capacity];
@@ -161,16 +212,19 @@ class SmoothBlock {
   double z_[2][capacity];                                    // rates x dt along and across the slip
   double decay_[2][capacity], phi1_[2][capacity], phi2_[2][capacity];
   double along_[capacity], across_[capacity];
+  // Under a law with set-valued points (keep_for_pieces): the sphere's drag; under a yield stress, s_y
+  // and F_y / m (see DragModel::smooth_drag_per_speed); whether its step meets a set-valued point (64
+  // bits, as a lane of doubles, for the vector loop that finds it) and then the state its step in
+  // pieces ends in.
+  double diameter_[capacity], area_[capacity], wetted_[capacity], inverse_mass_[capacity];
+  double yield_speed_[capacity], yield_accel_[capacity];
+  std::int64_t meets_point_[capacity];
+  SlipState state_[capacity];
 };
 
-// The step of a smooth law for one sphere (a block of one).
-StepCorrection smooth_step_initial(const SphereDrag &drag, double inverse_mass, const double a[3],
-                                   const double u[3], double dt, double v[3], double dx[3]);
-
-// drag_step_initial for a law with set-valued points (a yield stress or a Cd jump): Newton
-// linearisation, advanced piecewise between the points (out of line).
-StepCorrection set_valued_step_initial(const SphereDrag &drag, double mass, const double a[3],
-                                       const double u[3], double dt, double v[3], double dx[3]);
+// The step of a nonlinear law for one sphere (a block of one).
+StepCorrection nonlinear_step_initial(const SphereDrag &drag, double inverse_mass, const double a[3],
+                                      const double u[3], double dt, double v[3], double dx[3]);
 
 // Which step a sphere's drag takes.
 enum class StepKind { Free, Linear, Smooth, SetValued };
@@ -183,6 +237,18 @@ inline StepKind step_kind(const SphereDrag &drag)
   if (!drag_acts(drag)) return StepKind::Free;
   if (drag.model->linear_coefficient(drag.diameter, drag.scale) > 0.0) return StepKind::Linear;
   return drag.model->smooth() ? StepKind::Smooth : StepKind::SetValued;
+}
+// A sphere at rest in a fluid with a yield stress mostly stays stuck: the step in pieces decides that
+// at once, where a block would first take its one-piece step and then step it again in pieces.
+inline bool at_rest_under_yield(const SphereDrag &drag, const double v[3], const double u[3])
+{
+  return drag.model->fluid().yield_stress > 0.0 && v[0] == u[0] && v[1] == u[1] && v[2] == u[2];
+}
+// Whether a DragBlock steps this sphere.
+inline bool steps_in_block(const SphereDrag &drag, const double v[3], const double u[3])
+{
+  const StepKind kind = step_kind(drag);
+  return kind == StepKind::Smooth || (kind == StepKind::SetValued && !at_rest_under_yield(drag, v, u));
 }
 
 // Drag linear in the slip, F = c w: the step with equal rates along and across the slip and no
@@ -224,8 +290,8 @@ inline StepCorrection drag_step_initial(const SphereDrag &drag, double inverse_m
   // The law's linear coefficient taken once: it also tells the kind of step (step_kind).
   const double linear = drag.model->linear_coefficient(drag.diameter, drag.scale);
   if (!(linear > 0.0)) {
-    if (drag.model->smooth()) return smooth_step_initial(drag, inverse_mass, a, u, dt, v, dx);
-    return set_valued_step_initial(drag, 1.0 / inverse_mass, a, u, dt, v, dx);
+    if (at_rest_under_yield(drag, v, u)) return set_valued_step_initial(drag, 1.0 / inverse_mass, a, u, dt, v, dx);
+    return nonlinear_step_initial(drag, inverse_mass, a, u, dt, v, dx);
   }
   const double z = linear * inverse_mass * dt;
   return linear_step_initial(memo ? phis(z, memo) : phis(z), a, u, dt, v, dx);
