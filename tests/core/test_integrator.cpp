@@ -307,6 +307,25 @@ void expect_same_bits(const BlockResult &a, const BlockResult &b)
     EXPECT_EQ(a.dx[c], b.dx[c]);
     EXPECT_EQ(a.corr.dir[c], b.corr.dir[c]);
   }
+  EXPECT_EQ(a.corr.state, b.corr.state);
+}
+
+// On every kind of this processor, the spheres stepped in blocks end bit for bit as each in a block of
+// its own (wherever it sits, whoever its neighbours are); check(kind, sphere, result) then checks each
+// sphere's result in blocks.
+template <class Check>
+void expect_blocks_step_as_alone(const DragModel &model, const std::vector<BlockSphere> &spheres, double dt, Check check)
+{
+  for (const BatchMath kind : batch_math_kinds) {
+    if (!batch_math_available(kind)) continue;
+    const std::vector<BlockResult> blocks = step_in_blocks(model, spheres, dt, kind, false);
+    const std::vector<BlockResult> alone = step_in_blocks(model, spheres, dt, kind, true);
+    for (size_t j = 0; j < spheres.size(); ++j) {
+      SCOPED_TRACE(testing::Message() << batch_math_name(kind) << " sphere " << j);
+      expect_same_bits(blocks[j], alone[j]);
+      check(kind, spheres[j], blocks[j]);
+    }
+  }
 }
 
 }    // namespace
@@ -321,34 +340,27 @@ TEST(DragBlock, EachSphereStepsAsAloneAndAsTheNewtonStep)
   const Fluid fluid{998.2, 1.002e-3, 0.0};
   const double dt = 1e-4;
   for (const DragLaw law : {DragLaw::Dallavalle, DragLaw::DiFelice}) {
+    SCOPED_TRACE(drag_law_name(law));
     const DragModel model(law, fluid);
-    const std::vector<BlockSphere> spheres = block_spheres(model);
-    for (const BatchMath kind : batch_math_kinds) {
-      if (!batch_math_available(kind)) continue;
-      const std::vector<BlockResult> blocks = step_in_blocks(model, spheres, dt, kind, false);
-      const std::vector<BlockResult> alone = step_in_blocks(model, spheres, dt, kind, true);
-      for (size_t j = 0; j < spheres.size(); ++j) {
-        const BlockSphere &sp = spheres[j];
-        SCOPED_TRACE(testing::Message() << drag_law_name(law) << " " << batch_math_name(kind) << " sphere " << j);
-        expect_same_bits(blocks[j], alone[j]);
-        if (kind == batch_math_kind()) {
-          BlockResult initial{{sp.v[0], sp.v[1], sp.v[2]}, {}, {}};
-          initial.corr = nonlinear_step_initial(sp.drag, sp.inverse_mass, sp.a, block_flow, dt, initial.v.data(), initial.dx.data());
-          expect_same_bits(blocks[j], initial);
-        }
-        double v_newton[3] = {sp.v[0], sp.v[1], sp.v[2]}, dx_newton[3];
-        const StepCorrection newton =
-            set_valued_step_initial(sp.drag, 1.0 / sp.inverse_mass, sp.a, block_flow, dt, v_newton, dx_newton);
-        EXPECT_NEAR(blocks[j].corr.along, newton.along, 1e-12 * newton.along);
-        EXPECT_NEAR(blocks[j].corr.across, newton.across, 1e-12 * newton.across);
-        const double scale = std::abs(sp.v[0]) + std::abs(sp.v[1]) + std::abs(sp.v[2]) + dt * 6.0;
-        for (int c = 0; c < 3; ++c) {
-          EXPECT_NEAR(blocks[j].v[c], v_newton[c], 1e-12 * scale);
-          EXPECT_NEAR(blocks[j].dx[c], dx_newton[c], 1e-12 * scale * dt);
-          EXPECT_NEAR(blocks[j].corr.dir[c], newton.dir[c], 1e-15);
-        }
+    expect_blocks_step_as_alone(model, block_spheres(model), dt, [&](BatchMath kind, const BlockSphere &sp,
+                                                                     const BlockResult &block) {
+      if (kind == batch_math_kind()) {
+        BlockResult initial{{sp.v[0], sp.v[1], sp.v[2]}, {}, {}};
+        initial.corr = nonlinear_step_initial(sp.drag, sp.inverse_mass, sp.a, block_flow, dt, initial.v.data(), initial.dx.data());
+        expect_same_bits(block, initial);
       }
-    }
+      double v_newton[3] = {sp.v[0], sp.v[1], sp.v[2]}, dx_newton[3];
+      const StepCorrection newton =
+          set_valued_step_initial(sp.drag, 1.0 / sp.inverse_mass, sp.a, block_flow, dt, v_newton, dx_newton);
+      EXPECT_NEAR(block.corr.along, newton.along, 1e-12 * newton.along);
+      EXPECT_NEAR(block.corr.across, newton.across, 1e-12 * newton.across);
+      const double scale = std::abs(sp.v[0]) + std::abs(sp.v[1]) + std::abs(sp.v[2]) + dt * 6.0;
+      for (int c = 0; c < 3; ++c) {
+        EXPECT_NEAR(block.v[c], v_newton[c], 1e-12 * scale);
+        EXPECT_NEAR(block.dx[c], dx_newton[c], 1e-12 * scale * dt);
+        EXPECT_NEAR(block.corr.dir[c], newton.dir[c], 1e-15);
+      }
+    });
   }
 }
 
@@ -406,42 +418,32 @@ TEST(DragBlock, LawsWithSetValuedPointsStepAsInPieces)
   const double dt = 1e-4;
   int stuck = 0, held = 0, one_piece = 0;
   for (const auto &[law, fluid] : laws) {
+    SCOPED_TRACE(testing::Message() << drag_law_name(law) << " tau_y " << fluid.yield_stress);
     const DragModel model(law, fluid);
     ASSERT_FALSE(model.smooth());
-    const std::vector<BlockSphere> spheres = set_valued_spheres(model);
-    for (const BatchMath kind : batch_math_kinds) {
-      if (!batch_math_available(kind)) continue;
-      const std::vector<BlockResult> blocks = step_in_blocks(model, spheres, dt, kind, false);
-      const std::vector<BlockResult> alone = step_in_blocks(model, spheres, dt, kind, true);
-      for (size_t j = 0; j < spheres.size(); ++j) {
-        const BlockSphere &sp = spheres[j];
-        SCOPED_TRACE(testing::Message() << drag_law_name(law) << " tau_y " << fluid.yield_stress << " "
-                                        << batch_math_name(kind) << " sphere " << j);
-        expect_same_bits(blocks[j], alone[j]);
-        EXPECT_EQ(blocks[j].corr.state, alone[j].corr.state);
-        BlockResult pieces{{sp.v[0], sp.v[1], sp.v[2]}, {}, {}};
-        pieces.corr = set_valued_step_initial(sp.drag, 1.0 / sp.inverse_mass, sp.a, block_flow, dt, pieces.v.data(),
-                                              pieces.dx.data());
-        EXPECT_EQ(blocks[j].corr.state, pieces.corr.state);
-        const double scale = std::abs(sp.v[0]) + std::abs(sp.v[1]) + std::abs(sp.v[2]) +
-                             dt * (std::abs(sp.a[0]) + std::abs(sp.a[1]) + std::abs(sp.a[2]));
-        const bool same_bits = blocks[j].v == pieces.v && blocks[j].dx == pieces.dx;
-        if (!same_bits) {    // one piece: the same step to round-off
-          ++one_piece;
-          EXPECT_EQ(pieces.corr.state, SlipState::Free);
-          EXPECT_NEAR(blocks[j].corr.along, pieces.corr.along, 1e-12 * pieces.corr.along);
-          EXPECT_NEAR(blocks[j].corr.across, pieces.corr.across, 1e-12 * pieces.corr.across);
-          for (int c = 0; c < 3; ++c) {
-            EXPECT_NEAR(blocks[j].v[c], pieces.v[c], 1e-12 * scale);
-            EXPECT_NEAR(blocks[j].dx[c], pieces.dx[c], 1e-12 * scale * dt);
-          }
-        }
-        if (kind == batch_math_kind()) {
-          stuck += pieces.corr.state == SlipState::Stuck;
-          held += pieces.corr.state == SlipState::HeldAtJump;
+    expect_blocks_step_as_alone(model, set_valued_spheres(model), dt, [&](BatchMath kind, const BlockSphere &sp,
+                                                                          const BlockResult &block) {
+      BlockResult pieces{{sp.v[0], sp.v[1], sp.v[2]}, {}, {}};
+      pieces.corr = set_valued_step_initial(sp.drag, 1.0 / sp.inverse_mass, sp.a, block_flow, dt, pieces.v.data(),
+                                            pieces.dx.data());
+      EXPECT_EQ(block.corr.state, pieces.corr.state);
+      const double scale = std::abs(sp.v[0]) + std::abs(sp.v[1]) + std::abs(sp.v[2]) +
+                           dt * (std::abs(sp.a[0]) + std::abs(sp.a[1]) + std::abs(sp.a[2]));
+      if (block.v != pieces.v || block.dx != pieces.dx) {    // one piece: the same step to round-off
+        ++one_piece;
+        EXPECT_EQ(pieces.corr.state, SlipState::Free);
+        EXPECT_NEAR(block.corr.along, pieces.corr.along, 1e-12 * pieces.corr.along);
+        EXPECT_NEAR(block.corr.across, pieces.corr.across, 1e-12 * pieces.corr.across);
+        for (int c = 0; c < 3; ++c) {
+          EXPECT_NEAR(block.v[c], pieces.v[c], 1e-12 * scale);
+          EXPECT_NEAR(block.dx[c], pieces.dx[c], 1e-12 * scale * dt);
         }
       }
-    }
+      if (kind == batch_math_kind()) {
+        stuck += pieces.corr.state == SlipState::Stuck;
+        held += pieces.corr.state == SlipState::HeldAtJump;
+      }
+    });
   }
   // The scenes reach every kind of step.
   EXPECT_GT(stuck, 10);
