@@ -267,6 +267,7 @@ template <FixNVESphereFluid::HalfStep path, class Lookup> void FixNVESphereFluid
     double spin_rate;
     double per_mass;
   };
+  constexpr bool blocks = path == HalfStep::Smooth || path == HalfStep::Blocked;
   sediment::DragBlock block;
   Waiting waiting[sediment::DragBlock::capacity];
   auto step_block = [&]() {
@@ -334,7 +335,7 @@ template <FixNVESphereFluid::HalfStep path, class Lookup> void FixNVESphereFluid
                       dx, spin_rate, per_mass);
       continue;
     }
-    if constexpr (path == HalfStep::Smooth || path == HalfStep::Blocked) {
+    if constexpr (blocks) {
       if (path == HalfStep::Smooth ? sediment::step_kind(sphere) == sediment::StepKind::Smooth
                                    : sediment::steps_in_block(sphere, v[i], flow)) {
         if (sphere.model != block.law()) {    // a block per law, and so per fluid/drag fix and flow
@@ -351,7 +352,7 @@ template <FixNVESphereFluid::HalfStep path, class Lookup> void FixNVESphereFluid
     state += finish(i, sediment::drag_step_initial(sphere, per_mass, a, flow, dt, v[i], dx, &w[DRAG_MEMO]), dx,
                     spin_rate, per_mass);
   }
-  if ((path == HalfStep::Smooth || path == HalfStep::Blocked) && block.size() > 0) state += step_block();
+  if (blocks && block.size() > 0) state += step_block();
   check_finite(state);
 }
 

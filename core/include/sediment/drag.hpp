@@ -190,8 +190,13 @@ class DragModel {
     switch (law_) {
       case DragLaw::Dallavalle:
       case DragLaw::DiFelice:
-        for (int k = 0; k < n; ++k) out[k] = drag_curve(DragLaw::Dallavalle, re[k]);
-        return;
+        return curves_of<DragLaw::Dallavalle>(re, out, n);
+      case DragLaw::ZhangLi:
+        return curves_of<DragLaw::ZhangLi>(re, out, n);
+      case DragLaw::ZhangLiSmooth:
+        return curves_of<DragLaw::ZhangLiSmooth>(re, out, n);
+      case DragLaw::Stokes:
+        return curves_of<DragLaw::Stokes>(re, out, n);
       case DragLaw::SchillerNaumann: {
         constexpr int chunk = 64;
         double power[chunk];
@@ -204,15 +209,6 @@ class DragModel {
         }
         return;
       }
-      case DragLaw::ZhangLi:
-        for (int k = 0; k < n; ++k) out[k] = drag_curve(DragLaw::ZhangLi, re[k]);
-        return;
-      case DragLaw::ZhangLiSmooth:
-        for (int k = 0; k < n; ++k) out[k] = drag_curve(DragLaw::ZhangLiSmooth, re[k]);
-        return;
-      case DragLaw::Stokes:
-        for (int k = 0; k < n; ++k) out[k] = drag_curve(DragLaw::Stokes, re[k]);
-        return;
     }
   }
   // Di Felice's hindrance applied to single-sphere curves (nothing under another law), each stage one
@@ -264,6 +260,11 @@ class DragModel {
   int jumps(double d, std::array<ForceJump, max_jumps> &out, DragScale scale = {}) const;
 
  private:
+  // single_curves' loop for one law, fixed at compile time.
+  template <DragLaw law> [[gnu::always_inline]] static void curves_of(const double *re, DragCurve *out, int n)
+  {
+    for (int k = 0; k < n; ++k) out[k] = drag_curve(law, re[k]);
+  }
   bool hindered(double voidage) const { return law_ == DragLaw::DiFelice && !(voidage >= 1.0); }
   // G eps^-(chi(Re) + offset), factor = eps^-(chi + offset): the exponent depends on Re, so the
   // slope has a second term.

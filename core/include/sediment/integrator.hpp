@@ -198,7 +198,9 @@ class DragBlock {
   const DragModel *model_ = nullptr;
   bool keeps_for_pieces_ = false;    // the law has set-valued points
   int size_ = 0;
-  // The last step's law has set-valued points, and some sphere's step met one (meets_point_, state_).
+  // The last step's law has set-valued points, and some sphere's step met one (meets_point_, state_):
+  // keeps_for_pieces_ && any_meets_point_, kept as one flag because correction() reads it per sphere
+  // (derived there, the finish loop ran one instruction more per sphere: cachegrind, nonlinear scene).
   bool in_pieces_ = false;
   std::int64_t any_meets_point_ = 0;
   double u_[3] = {0.0, 0.0, 0.0};    // the flow
