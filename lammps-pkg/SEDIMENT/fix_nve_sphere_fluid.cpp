@@ -103,6 +103,29 @@ static inline double nve_sphere_kick_drift(double *x, double *v, double *omega, 
   return new_x[0] + new_x[1] + new_x[2];
 }
 
+// The exponentials of a linear drag F = c d w for a sphere of diameter d and 1 / m, z = c d dt / m
+// (the same product in both halves of the step), remembered for the last z of a loop over the atoms:
+// every sphere of a monodisperse group shares it, and the atom's own memo (a polydisperse group) is
+// then not touched.
+class LinearDecay {
+ public:
+  LinearDecay(double per_diameter, double dt) : per_diameter_(per_diameter), dt_(dt) {}
+  const sediment::Phi &phis(double diameter, double per_mass, double memo[sediment::PHI_MEMO_SIZE])
+  {
+    const double z = per_diameter_ * diameter * per_mass * dt_;
+    if (z != z_) {
+      phis_ = sediment::phis(z, memo);
+      z_ = z;
+    }
+    return phis_;
+  }
+
+ private:
+  double per_diameter_, dt_;
+  double z_ = std::numeric_limits<double>::quiet_NaN();
+  sediment::Phi phis_{};
+};
+
 // Runs loop(std::true_type{}) with a floor and loop(std::false_type{}) without, so that a loop over
 // the atoms is compiled both ways and tests for the floor only where there is one.
 template <class Loop> static inline void with_floor_or_not(int floor_axis, Loop loop)
@@ -176,7 +199,10 @@ void FixNVESphereFluid::setup(int /*vflag*/)
   uniform = drags.size() == 1 && drags.front()->uniform() ? drags.front() : nullptr;
   // Linear only with a uniform drag: its spheres are wholly immersed, so F = c d w.
   linear_per_diameter = uniform ? uniform->linear_per_diameter() : 0.0;
-  half_step = linear_per_diameter > 0.0 ? HalfStep::Linear : HalfStep::General;
+  if (linear_per_diameter > 0.0)
+    half_step = floor_axis < 0 ? HalfStep::Linear : HalfStep::LinearOnFloor;
+  else
+    half_step = HalfStep::General;
   bool nonlinear = false, set_valued = false;
   for (FixFluidDrag *drag : drags) {
     nonlinear |= drag->nonlinear();
@@ -224,6 +250,9 @@ template <FixNVESphereFluid::HalfStep path, class Lookup> void FixNVESphereFluid
   const double ftm2v = force->ftm2v;
   const HalfKick kick = half_kick(dt, ftm2v);
   static const double no_flow[3] = {0.0, 0.0, 0.0};
+  constexpr bool linear = path == HalfStep::Linear || path == HalfStep::LinearOnFloor;
+  constexpr bool keeps_weights = path != HalfStep::Linear;    // else final_integrate takes them anew
+  LinearDecay linear_decay(linear_per_diameter, dt);
 
   // What follows the drag step of atom i: position, rotation, the weights for the second half
   // (taken per unit mass and moment of inertia, so the second half divides by neither). Returns
@@ -232,7 +261,6 @@ template <FixNVESphereFluid::HalfStep path, class Lookup> void FixNVESphereFluid
   // loop reload them from the stack for every atom.
   auto finish = [=](int i, const sediment::StepCorrection &corr, const double dx[3], double spin_rate,
                     double per_mass) {
-    double *w = weights[i];
     const double new_x[3] = {x[i][0] + dx[0], x[i][1] + dx[1], x[i][2] + dx[2]};
     x[i][0] = new_x[0];
     x[i][1] = new_x[1];
@@ -241,20 +269,25 @@ template <FixNVESphereFluid::HalfStep path, class Lookup> void FixNVESphereFluid
     if (corr.state == sediment::SlipState::Stuck) counts[STUCK] += 1.0;
     if (corr.state == sediment::SlipState::HeldAtJump) counts[AT_JUMP] += 1.0;
 
+    double spin;
     if (spin_rate == 0.0) {    // no rotational drag: fix nve/sphere's kick, in fewer operations
-      w[SPIN] = nve_sphere_spin(omega[i], torque[i], radius[i], rmass[i], kick);
+      spin = nve_sphere_spin(omega[i], torque[i], radius[i], rmass[i], kick);
     } else {
       const double per_inertia = ftm2v / sediment::sphere_inertia(rmass[i], radius[i]);
       const double alpha[3] = {torque[i][0] * per_inertia, torque[i][1] * per_inertia, torque[i][2] * per_inertia};
-      w[SPIN] = sediment::rotation_step_initial(spin_rate, alpha, dt, omega[i], spin_memos[i]) * per_inertia;
+      spin = sediment::rotation_step_initial(spin_rate, alpha, dt, omega[i], spin_memos[i]) * per_inertia;
     }
-    w[ALONG] = corr.along * per_mass;
-    w[ACROSS] = corr.across * per_mass;
-    if (corr.along != corr.across) {    // the direction matters to the second half only then
-      w[DRAG_MEMO] = std::numeric_limits<double>::quiet_NaN();    // it takes the memo's place
-      w[DIRX] = corr.dir[0];
-      w[DIRY] = corr.dir[1];
-      w[DIRZ] = corr.dir[2];
+    if constexpr (keeps_weights) {
+      double *w = weights[i];
+      w[SPIN] = spin;
+      w[ALONG] = corr.along * per_mass;
+      w[ACROSS] = corr.across * per_mass;
+      if (corr.along != corr.across) {    // the direction matters to the second half only then
+        w[DRAG_MEMO] = std::numeric_limits<double>::quiet_NaN();    // it takes the memo's place
+        w[DIRX] = corr.dir[0];
+        w[DIRY] = corr.dir[1];
+        w[DIRZ] = corr.dir[2];
+      }
     }
     if (floor_dim >= 0) settle_on_floor(x[i], v[i], omega[i], radius[i], floor_dim, floor_at);
     return state;
@@ -306,7 +339,7 @@ template <FixNVESphereFluid::HalfStep path, class Lookup> void FixNVESphereFluid
     lookup(i, sphere, flow, spin_rate);
 
     double *w = weights[i];
-    w[IN_FLUID] = sphere.model ? 1.0 : 0.0;
+    if constexpr (keeps_weights) w[IN_FLUID] = sphere.model ? 1.0 : 0.0;
     if (!sphere.model) {
       counts[OUTSIDE] += 1.0;
       state += nve_sphere_kick_drift(x[i], v[i], omega[i], f[i], torque[i], radius[i], rmass[i], kick, dt);
@@ -317,7 +350,7 @@ template <FixNVESphereFluid::HalfStep path, class Lookup> void FixNVESphereFluid
     // A sphere resting on the floor whose step would end where it starts (rests_on_floor) is skipped;
     // a set-valued law would count it as stuck, so it takes its step.
     if (floor_dim >= 0 && rests_on_floor(x[i], v[i], f[i], radius[i], flow, floor_dim, floor_at) &&
-        (path == HalfStep::Linear || sediment::step_kind(sphere) != sediment::StepKind::SetValued)) {
+        (linear || sediment::step_kind(sphere) != sediment::StepKind::SetValued)) {
       w[ALONG] = w[ACROSS] = w[SPIN] = 0.0;
       state += state_sum(x[i], v[i]);    // its position along the floor is not among what the test reads
       settle_on_floor(x[i], v[i], omega[i], radius[i], floor_dim, floor_at);    // where it is, its rotation stopped
@@ -329,10 +362,9 @@ template <FixNVESphereFluid::HalfStep path, class Lookup> void FixNVESphereFluid
     const double per_mass = ftm2v / rmass[i];
     const double a[3] = {f[i][0] * per_mass, f[i][1] * per_mass, f[i][2] * per_mass};
     double dx[3];
-    if constexpr (path == HalfStep::Linear) {    // sphere.diameter * c, as the law's linear_coefficient
-      const double z = linear_per_diameter * sphere.diameter * per_mass * dt;
-      state += finish(i, sediment::linear_step_initial(sediment::phis(z, &w[DRAG_MEMO]), a, flow, dt, v[i], dx),
-                      dx, spin_rate, per_mass);
+    if constexpr (linear) {    // sphere.diameter * c, as the law's linear_coefficient
+      const sediment::Phi &p = linear_decay.phis(sphere.diameter, per_mass, &w[DRAG_MEMO]);
+      state += finish(i, sediment::linear_step_initial(p, a, flow, dt, v[i], dx), dx, spin_rate, per_mass);
       continue;
     }
     if constexpr (blocks) {
@@ -398,15 +430,20 @@ void FixNVESphereFluid::initial_integrate(int /*vflag*/)
     const int *mask = atom->mask;
     const int drag_bit = drag->groupbit;
     const double *flow = drag->fluid_fix()->velocity();
-    if (half_step == HalfStep::Linear) {    // a linear law has no local fraction: the diameter is all it needs
+    if (half_step == HalfStep::Linear || half_step == HalfStep::LinearOnFloor) {
+      // A linear law has no local fraction: the diameter is all it needs.
       const double *radius = atom->radius;
       const sediment::DragModel *model = drag->drag_model();
-      first_half<HalfStep::Linear>([=](int i, sediment::SphereDrag &sphere, const double *&u, double &) {
+      auto lookup = [=](int i, sediment::SphereDrag &sphere, const double *&u, double &) {
         if (!(mask[i] & drag_bit)) return;
         sphere.model = model;
         sphere.diameter = 2.0 * radius[i];
         u = flow;
-      });
+      };
+      if (half_step == HalfStep::Linear)
+        first_half<HalfStep::Linear>(lookup);
+      else
+        first_half<HalfStep::LinearOnFloor>(lookup);
       return;
     }
     const FixFluidDrag::Immersed immersed = drag->immersed();
@@ -449,6 +486,28 @@ void FixNVESphereFluid::final_integrate()
             settle_on_floor(x[i], v[i], omega[i], radius[i], floor_dim, floor_at);
         }
     });
+    return;
+  }
+
+  if (half_step == HalfStep::Linear) {
+    // The weights as the first half took them (linear_step_initial's dt phi2 / m along and across,
+    // fix nve/sphere's for the torque), bit for bit, from the atom's diameter and mass: reading them
+    // from the weights row cost more than fix nve/sphere's two divisions (perf, drag scene of
+    // benchmarks/in.cost: the row's 64 bytes written and read again per atom and step).
+    const double dt = update->dt;
+    const int drag_bit = uniform->groupbit;
+    LinearDecay linear_decay(linear_per_diameter, dt);
+    for (int i = 0; i < nlocal; ++i) {
+      if (!(mask[i] & groupbit)) continue;
+      if (!(mask[i] & drag_bit)) {
+        nve_sphere_kick(v[i], omega[i], f[i], torque[i], radius[i], rmass[i], kick);
+        continue;
+      }
+      const double per_mass = ftm2v / rmass[i];
+      const double along = dt * linear_decay.phis(2.0 * radius[i], per_mass, &weights[i][DRAG_MEMO]).phi2 * per_mass;
+      sediment::add_weighted_acceleration(along, along, nullptr, f[i], v[i]);
+      nve_sphere_spin(omega[i], torque[i], radius[i], rmass[i], kick);
+    }
     return;
   }
 

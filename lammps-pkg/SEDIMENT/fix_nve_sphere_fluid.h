@@ -46,7 +46,7 @@ class FixNVESphereFluid : public Fix {
   // fluid (outside, the step is fix nve/sphere's, operation for operation) and the exponentials of
   // the last step's linear drag (sediment::phis memo). When the weights differ (a nonlinear law,
   // which has no memo) the memo's last three places hold the slip direction instead, and its z is
-  // emptied.
+  // emptied. The Linear step (below) uses the memo only.
   enum { ALONG, ACROSS, SPIN, IN_FLUID, DRAG_MEMO, DIRX = DRAG_MEMO + 1, DIRY, DIRZ,
          NCOLS = DRAG_MEMO + sediment::PHI_MEMO_SIZE };
   double **weights;
@@ -59,10 +59,12 @@ class FixNVESphereFluid : public Fix {
   // How the first half steps the spheres in a fluid, decided in setup(): General (linear laws, one
   // sphere at a time), Blocked (some fluid/drag has a nonlinear law: its spheres are stepped in
   // blocks, sediment::DragBlock), Smooth (Blocked, with every law smooth: no block prepares a step in
-  // pieces, and no sphere is asked whether it needs one) or Linear (the uniform drag is linear in the
-  // slip, F = c d w: c is taken once per run, and the step is sediment::linear_step_initial with no
-  // per-sphere choice of law).
-  enum class HalfStep { General, Blocked, Smooth, Linear };
+  // pieces, and no sphere is asked whether it needs one), LinearOnFloor (the uniform drag is linear in
+  // the slip, F = c d w: c is taken once per run, and the step is sediment::linear_step_initial with
+  // no per-sphere choice of law) or Linear (LinearOnFloor without a floor: the weights then depend on
+  // the sphere's diameter and mass only, and the second half takes them anew, with fix nve/sphere's
+  // two divisions, instead of from the weights row, which is neither written nor read).
+  enum class HalfStep { General, Blocked, Smooth, LinearOnFloor, Linear };
   HalfStep half_step;
   double linear_per_diameter;    // c of the Linear step
   // The first half of the step for every atom of the group, with the drag found by lookup(i, sphere,
