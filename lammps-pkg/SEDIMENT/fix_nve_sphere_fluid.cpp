@@ -137,7 +137,7 @@ template <class Loop> static inline void with_floor_or_not(int floor_axis, Loop 
 }
 
 FixNVESphereFluid::FixNVESphereFluid(LAMMPS *lmp, int narg, char **arg) :
-    Fix(lmp, narg, arg), weights(nullptr), spin_memos(nullptr), nmax_weights(0), uniform(nullptr),
+    Fix(lmp, narg, arg), weights(nullptr), kept(nullptr), spin_memos(nullptr), nmax_rows(0), uniform(nullptr),
     half_step(HalfStep::General), linear_per_diameter(0.0), floor_axis(-1), floor_level(0.0)
 {
   StyleArgs args(lmp, FLERR, "Fix nve/sphere/fluid", narg, arg, 3);
@@ -162,7 +162,7 @@ FixNVESphereFluid::FixNVESphereFluid(LAMMPS *lmp, int narg, char **arg) :
   size_vector = NCOUNTS;
   global_freq = 1;
   extvector = 1;
-  maxexchange = NCOLS + sediment::PHI_MEMO_SIZE;
+  maxexchange = NWEIGHTS + NKEPT + sediment::PHI_MEMO_SIZE;
 
   grow_arrays(atom->nmax);
   atom->add_callback(Atom::GROW);
@@ -172,6 +172,7 @@ FixNVESphereFluid::~FixNVESphereFluid()
 {
   atom->delete_callback(id, Atom::GROW);
   memory->destroy(weights);
+  memory->destroy(kept);
   memory->destroy(spin_memos);
 }
 
@@ -241,7 +242,8 @@ static inline bool rests_on_floor(const double *x, const double *v, const double
   return true;
 }
 
-template <FixNVESphereFluid::HalfStep path, class Lookup> void FixNVESphereFluid::first_half(Lookup lookup)
+template <FixNVESphereFluid::HalfStep path, bool is_uniform, class Lookup>
+void FixNVESphereFluid::first_half(Lookup lookup)
 {
   const auto [x, v, f, omega, torque, radius, rmass, mask, nlocal] = sphere_arrays(atom);
   const int floor_dim = floor_axis;    // locals: the stores into the atom arrays cannot change them
@@ -252,6 +254,7 @@ template <FixNVESphereFluid::HalfStep path, class Lookup> void FixNVESphereFluid
   static const double no_flow[3] = {0.0, 0.0, 0.0};
   constexpr bool linear = path == HalfStep::Linear || path == HalfStep::LinearOnFloor;
   constexpr bool keeps_weights = path != HalfStep::Linear;    // else final_integrate takes them anew
+  constexpr bool keeps_all = !is_uniform;    // the atom's being in a fluid and the torque's weight too
   LinearDecay linear_decay(linear_per_diameter, dt);
 
   // What follows the drag step of atom i: position, rotation, the weights for the second half
@@ -277,13 +280,12 @@ template <FixNVESphereFluid::HalfStep path, class Lookup> void FixNVESphereFluid
       const double alpha[3] = {torque[i][0] * per_inertia, torque[i][1] * per_inertia, torque[i][2] * per_inertia};
       spin = sediment::rotation_step_initial(spin_rate, alpha, dt, omega[i], spin_memos[i]) * per_inertia;
     }
+    if constexpr (keeps_all) kept[i][SPIN] = spin;
     if constexpr (keeps_weights) {
       double *w = weights[i];
-      w[SPIN] = spin;
       w[ALONG] = corr.along * per_mass;
       w[ACROSS] = corr.across * per_mass;
       if (corr.along != corr.across) {    // the direction matters to the second half only then
-        w[DRAG_MEMO] = std::numeric_limits<double>::quiet_NaN();    // it takes the memo's place
         w[DIRX] = corr.dir[0];
         w[DIRY] = corr.dir[1];
         w[DIRZ] = corr.dir[2];
@@ -338,8 +340,7 @@ template <FixNVESphereFluid::HalfStep path, class Lookup> void FixNVESphereFluid
     double spin_rate = 0.0;
     lookup(i, sphere, flow, spin_rate);
 
-    double *w = weights[i];
-    if constexpr (keeps_weights) w[IN_FLUID] = sphere.model ? 1.0 : 0.0;
+    if constexpr (keeps_all) kept[i][IN_FLUID] = sphere.model ? 1.0 : 0.0;
     if (!sphere.model) {
       counts[OUTSIDE] += 1.0;
       state += nve_sphere_kick_drift(x[i], v[i], omega[i], f[i], torque[i], radius[i], rmass[i], kick, dt);
@@ -351,7 +352,10 @@ template <FixNVESphereFluid::HalfStep path, class Lookup> void FixNVESphereFluid
     // a set-valued law would count it as stuck, so it takes its step.
     if (floor_dim >= 0 && rests_on_floor(x[i], v[i], f[i], radius[i], flow, floor_dim, floor_at) &&
         (linear || sediment::step_kind(sphere) != sediment::StepKind::SetValued)) {
-      w[ALONG] = w[ACROSS] = w[SPIN] = 0.0;
+      // Held: no weights, and no torque's either (a uniform step's second half gives it fix nve/sphere's,
+      // and settle_on_floor takes the rotation away again, as the sphere's velocity stays 0).
+      weights[i][ALONG] = weights[i][ACROSS] = 0.0;
+      if constexpr (keeps_all) kept[i][SPIN] = 0.0;
       state += state_sum(x[i], v[i]);    // its position along the floor is not among what the test reads
       settle_on_floor(x[i], v[i], omega[i], radius[i], floor_dim, floor_at);    // where it is, its rotation stopped
       continue;
@@ -363,7 +367,7 @@ template <FixNVESphereFluid::HalfStep path, class Lookup> void FixNVESphereFluid
     const double a[3] = {f[i][0] * per_mass, f[i][1] * per_mass, f[i][2] * per_mass};
     double dx[3];
     if constexpr (linear) {    // sphere.diameter * c, as the law's linear_coefficient
-      const sediment::Phi &p = linear_decay.phis(sphere.diameter, per_mass, &w[DRAG_MEMO]);
+      const sediment::Phi &p = linear_decay.phis(sphere.diameter, per_mass, &kept[i][DRAG_MEMO]);
       state += finish(i, sediment::linear_step_initial(p, a, flow, dt, v[i], dx), dx, spin_rate, per_mass);
       continue;
     }
@@ -381,22 +385,22 @@ template <FixNVESphereFluid::HalfStep path, class Lookup> void FixNVESphereFluid
         continue;
       }
     }
-    state += finish(i, sediment::drag_step_initial(sphere, per_mass, a, flow, dt, v[i], dx, &w[DRAG_MEMO]), dx,
-                    spin_rate, per_mass);
+    state += finish(i, sediment::drag_step_initial(sphere, per_mass, a, flow, dt, v[i], dx, &kept[i][DRAG_MEMO]),
+                    dx, spin_rate, per_mass);
   }
   if (blocks && block.size() > 0) state += step_block();
   check_finite(state);
 }
 
-template <class Lookup> void FixNVESphereFluid::step_first_half(Lookup lookup)
+template <bool is_uniform, class Lookup> void FixNVESphereFluid::step_first_half(Lookup lookup)
 {
   // Linear is taken by initial_integrate with its own look-up.
   if (half_step == HalfStep::Smooth)
-    first_half<HalfStep::Smooth>(lookup);
+    first_half<HalfStep::Smooth, is_uniform>(lookup);
   else if (half_step == HalfStep::Blocked)
-    first_half<HalfStep::Blocked>(lookup);
+    first_half<HalfStep::Blocked, is_uniform>(lookup);
   else
-    first_half<HalfStep::General>(lookup);
+    first_half<HalfStep::General, is_uniform>(lookup);
 }
 
 void FixNVESphereFluid::initial_integrate(int /*vflag*/)
@@ -441,13 +445,13 @@ void FixNVESphereFluid::initial_integrate(int /*vflag*/)
         u = flow;
       };
       if (half_step == HalfStep::Linear)
-        first_half<HalfStep::Linear>(lookup);
+        first_half<HalfStep::Linear, true>(lookup);
       else
-        first_half<HalfStep::LinearOnFloor>(lookup);
+        first_half<HalfStep::LinearOnFloor, true>(lookup);
       return;
     }
     const FixFluidDrag::Immersed immersed = drag->immersed();
-    step_first_half([=](int i, sediment::SphereDrag &sphere, const double *&u, double &) {
+    step_first_half<true>([=](int i, sediment::SphereDrag &sphere, const double *&u, double &) {
       if (!(mask[i] & drag_bit)) return;
       sphere = immersed.drag(i);
       u = flow;
@@ -455,7 +459,7 @@ void FixNVESphereFluid::initial_integrate(int /*vflag*/)
     });
     return;
   }
-  step_first_half([&](int i, sediment::SphereDrag &sphere, const double *&u, double &spin_rate) {
+  step_first_half<false>([&](int i, sediment::SphereDrag &sphere, const double *&u, double &spin_rate) {
     for (FixFluidDrag *drag : drags) {
       const sediment::SphereDrag candidate = drag->sphere_drag(i);
       if (!candidate.model) continue;
@@ -492,8 +496,8 @@ void FixNVESphereFluid::final_integrate()
   if (half_step == HalfStep::Linear) {
     // The weights as the first half took them (linear_step_initial's dt phi2 / m along and across,
     // fix nve/sphere's for the torque), bit for bit, from the atom's diameter and mass: reading them
-    // from the weights row cost more than fix nve/sphere's two divisions (perf, drag scene of
-    // benchmarks/in.cost: the row's 64 bytes written and read again per atom and step).
+    // from a row cost more than fix nve/sphere's two divisions (perf, drag scene of
+    // benchmarks/in.cost: a row of 64 bytes written and read again per atom and step).
     const double dt = update->dt;
     const int drag_bit = uniform->groupbit;
     LinearDecay linear_decay(linear_per_diameter, dt);
@@ -504,32 +508,46 @@ void FixNVESphereFluid::final_integrate()
         continue;
       }
       const double per_mass = ftm2v / rmass[i];
-      const double along = dt * linear_decay.phis(2.0 * radius[i], per_mass, &weights[i][DRAG_MEMO]).phi2 * per_mass;
+      const double along = dt * linear_decay.phis(2.0 * radius[i], per_mass, &kept[i][DRAG_MEMO]).phi2 * per_mass;
       sediment::add_weighted_acceleration(along, along, nullptr, f[i], v[i]);
       nve_sphere_spin(omega[i], torque[i], radius[i], rmass[i], kick);
     }
     return;
   }
 
-  // The loop compiled with and without the floor (its test in the loop cost 4 instructions of 80 per atom).
-  with_floor_or_not(floor_dim, [&](auto with_floor) {
+  // The loop compiled with and without the floor (its test in the loop cost 4 instructions of 80 per
+  // atom), and for a uniform step (the atoms in a fluid are the drag's group, the torque's weight is
+  // fix nve/sphere's) apart from the general one, which kept both.
+  auto second_half = [&](auto with_floor, auto is_uniform) {
+    const int drag_bit = uniform ? uniform->groupbit : 0;
     for (int i = 0; i < nlocal; ++i) {
       if (!(mask[i] & groupbit)) continue;
-      const double *w = weights[i];
-      if (w[IN_FLUID] == 0.0) {
+      if (is_uniform ? !(mask[i] & drag_bit) : kept[i][IN_FLUID] == 0.0) {
         nve_sphere_kick(v[i], omega[i], f[i], torque[i], radius[i], rmass[i], kick);
       } else {
         // The weights are per unit mass: the step is linear in the force, so f takes the place of a = f / m.
         // The direction is read only when the weights differ: the first half wrote it only then.
-        const double spin = w[SPIN];    // read once: the stores into v and omega could alias w
-        sediment::add_weighted_acceleration(w[ALONG], w[ACROSS], &w[DIRX], f[i], v[i]);
-        omega[i][0] += spin * torque[i][0];
-        omega[i][1] += spin * torque[i][1];
-        omega[i][2] += spin * torque[i][2];
+        const double *w = weights[i];
+        if constexpr (is_uniform) {
+          sediment::add_weighted_acceleration(w[ALONG], w[ACROSS], &w[DIRX], f[i], v[i]);
+          nve_sphere_spin(omega[i], torque[i], radius[i], rmass[i], kick);
+        } else {
+          const double spin = kept[i][SPIN];    // read first: the stores into v could alias it
+          sediment::add_weighted_acceleration(w[ALONG], w[ACROSS], &w[DIRX], f[i], v[i]);
+          omega[i][0] += spin * torque[i][0];
+          omega[i][1] += spin * torque[i][1];
+          omega[i][2] += spin * torque[i][2];
+        }
       }
       if constexpr (decltype(with_floor)::value)
         settle_on_floor(x[i], v[i], omega[i], radius[i], floor_dim, floor_at);
     }
+  };
+  with_floor_or_not(floor_dim, [&](auto with_floor) {
+    if (uniform)
+      second_half(with_floor, std::true_type{});
+    else
+      second_half(with_floor, std::false_type{});
   });
 }
 
@@ -562,35 +580,44 @@ double FixNVESphereFluid::compute_vector(int n)
 
 void FixNVESphereFluid::grow_arrays(int nmax)
 {
-  memory->grow(weights, nmax, NCOLS, "nve/sphere/fluid:weights");
+  memory->grow(weights, nmax, NWEIGHTS, "nve/sphere/fluid:weights");
+  memory->grow(kept, nmax, NKEPT, "nve/sphere/fluid:kept");
   memory->grow(spin_memos, nmax, sediment::PHI_MEMO_SIZE, "nve/sphere/fluid:spin_memos");
   // Empty memos for the new rows (a memo is used only when its z matches).
-  for (int i = nmax_weights; i < nmax; ++i)
-    weights[i][DRAG_MEMO] = spin_memos[i][0] = std::numeric_limits<double>::quiet_NaN();
-  nmax_weights = nmax;
+  for (int i = nmax_rows; i < nmax; ++i)
+    kept[i][DRAG_MEMO] = spin_memos[i][0] = std::numeric_limits<double>::quiet_NaN();
+  nmax_rows = nmax;
+}
+
+// The per-atom rows in the order they travel in an exchange: {array, columns}.
+std::array<std::pair<double **, int>, 3> FixNVESphereFluid::rows() const
+{
+  return {{{weights, NWEIGHTS}, {kept, NKEPT}, {spin_memos, sediment::PHI_MEMO_SIZE}}};
 }
 
 void FixNVESphereFluid::copy_arrays(int i, int j, int /*delflag*/)
 {
-  std::copy(weights[i], weights[i] + NCOLS, weights[j]);
-  std::copy(spin_memos[i], spin_memos[i] + sediment::PHI_MEMO_SIZE, spin_memos[j]);
+  for (auto [array, columns] : rows()) std::copy(array[i], array[i] + columns, array[j]);
 }
 
 int FixNVESphereFluid::pack_exchange(int i, double *buf)
 {
-  std::copy(weights[i], weights[i] + NCOLS, buf);
-  std::copy(spin_memos[i], spin_memos[i] + sediment::PHI_MEMO_SIZE, buf + NCOLS);
-  return NCOLS + sediment::PHI_MEMO_SIZE;
+  int m = 0;
+  for (auto [array, columns] : rows()) m = std::copy(array[i], array[i] + columns, buf + m) - buf;
+  return m;
 }
 
 int FixNVESphereFluid::unpack_exchange(int nlocal, double *buf)
 {
-  std::copy(buf, buf + NCOLS, weights[nlocal]);
-  std::copy(buf + NCOLS, buf + NCOLS + sediment::PHI_MEMO_SIZE, spin_memos[nlocal]);
-  return NCOLS + sediment::PHI_MEMO_SIZE;
+  int m = 0;
+  for (auto [array, columns] : rows()) {
+    std::copy(buf + m, buf + m + columns, array[nlocal]);
+    m += columns;
+  }
+  return m;
 }
 
 double FixNVESphereFluid::memory_usage()
 {
-  return static_cast<double>(atom->nmax) * (NCOLS + sediment::PHI_MEMO_SIZE) * sizeof(double);
+  return static_cast<double>(atom->nmax) * (NWEIGHTS + NKEPT + sediment::PHI_MEMO_SIZE) * sizeof(double);
 }

@@ -18,6 +18,8 @@ FixStyle(nve/sphere/fluid,FixNVESphereFluid);
 
 #include "sediment/integrator.hpp"
 
+#include <array>
+#include <utility>
 #include <vector>
 
 namespace LAMMPS_NS {
@@ -40,21 +42,27 @@ class FixNVESphereFluid : public Fix {
   double memory_usage() override;
 
  private:
-  // Per atom, from the first half of the step to the second, in a row of 8 doubles (one 64-byte
-  // cache line, as LAMMPS aligns its arrays): the weights of the new force along and across the slip
-  // (per unit mass), the weight of the new torque (per moment of inertia), whether the atom was in a
-  // fluid (outside, the step is fix nve/sphere's, operation for operation) and the exponentials of
-  // the last step's linear drag (sediment::phis memo). When the weights differ (a nonlinear law,
-  // which has no memo) the memo's last three places hold the slip direction instead, and its z is
-  // emptied. The Linear step (below) uses the memo only.
-  enum { ALONG, ACROSS, SPIN, IN_FLUID, DRAG_MEMO, DIRX = DRAG_MEMO + 1, DIRY, DIRZ,
-         NCOLS = DRAG_MEMO + sediment::PHI_MEMO_SIZE };
+  // Per atom, from the first half of the step to the second: the weights of the new force along and
+  // across the slip (per unit mass) and the slip's direction (read only when the weights differ), in
+  // a row of 5 doubles. The second half of a nonlinear law reads nothing else: the row's 40 bytes
+  // written and read again per atom and step are what its memory traffic adds to fix nve/sphere's.
+  enum { ALONG, ACROSS, DIRX, DIRY, DIRZ, NWEIGHTS };
   double **weights;
+  // Per atom, what else the step keeps when it is not uniform (below): whether the atom was in a
+  // fluid (outside, the step is fix nve/sphere's, operation for operation) and the weight of the new
+  // torque (per moment of inertia); and for every step the exponentials of the last step's linear
+  // drag (sediment::phis memo). A uniform step takes the first two anew in the second half (the drag
+  // fix's group bit; fix nve/sphere's division for the torque), and its memo is touched only when
+  // the atom before had another rate (polydisperse spheres).
+  enum { IN_FLUID, SPIN, DRAG_MEMO, NKEPT = DRAG_MEMO + sediment::PHI_MEMO_SIZE };
+  double **kept;
   double **spin_memos;    // the memo of the rotational drag, apart: touched only when there is one
-  int nmax_weights;    // rows of weights and spin_memos with initialised memos
+  int nmax_rows;    // rows of weights, kept and spin_memos with initialised memos
+  std::array<std::pair<double **, int>, 3> rows() const;
   std::vector<class FixFluidDrag *> drags;
   // Set in setup() when there is one fluid/drag and it is uniform() (every atom of its group wholly
-  // immersed, no rotational drag): the step then skips the per-atom region and surface look-ups.
+  // immersed, no rotational drag): the step then skips the per-atom region and surface look-ups, and
+  // the atoms in a fluid are those of the fix's group.
   class FixFluidDrag *uniform;
   // How the first half steps the spheres in a fluid, decided in setup(): General (linear laws, one
   // sphere at a time), Blocked (some fluid/drag has a nonlinear law: its spheres are stepped in
@@ -69,9 +77,10 @@ class FixNVESphereFluid : public Fix {
   double linear_per_diameter;    // c of the Linear step
   // The first half of the step for every atom of the group, with the drag found by lookup(i, sphere,
   // flow, spin_rate) (one loop, compiled for each look-up and way of stepping: step_first_half picks
-  // General or Blocked, initial_integrate takes Linear with a look-up of the diameter only).
-  template <HalfStep path, class Lookup> void first_half(Lookup lookup);
-  template <class Lookup> void step_first_half(Lookup lookup);
+  // General, Blocked or Smooth, initial_integrate takes Linear with a look-up of the diameter only);
+  // is_uniform: the look-up is the uniform drag's, and the step keeps only the weights.
+  template <HalfStep path, bool is_uniform, class Lookup> void first_half(Lookup lookup);
+  template <bool is_uniform, class Lookup> void step_first_half(Lookup lookup);
 
   int floor_axis;         // -1: no floor
   double floor_level;     // spheres stop with their lowest point here
