@@ -281,16 +281,7 @@ void FixNVESphereFluid::first_half(Lookup lookup)
       spin = sediment::rotation_step_initial(spin_rate, alpha, dt, omega[i], spin_memos[i]) * per_inertia;
     }
     if constexpr (keeps_all) kept[i][SPIN] = spin;
-    if constexpr (keeps_weights) {
-      double *w = weights[i];
-      w[ALONG] = corr.along * per_mass;
-      w[ACROSS] = corr.across * per_mass;
-      if (corr.along != corr.across) {    // the direction matters to the second half only then
-        w[DIRX] = corr.dir[0];
-        w[DIRY] = corr.dir[1];
-        w[DIRZ] = corr.dir[2];
-      }
-    }
+    if constexpr (keeps_weights) sediment::pack_weights(corr, per_mass, weights[i]);
     if (floor_dim >= 0) settle_on_floor(x[i], v[i], omega[i], radius[i], floor_dim, floor_at);
     return state;
   };
@@ -354,7 +345,7 @@ void FixNVESphereFluid::first_half(Lookup lookup)
         (linear || sediment::step_kind(sphere) != sediment::StepKind::SetValued)) {
       // Held: no weights, and no torque's either (a uniform step's second half gives it fix nve/sphere's,
       // and settle_on_floor takes the rotation away again, as the sphere's velocity stays 0).
-      weights[i][ALONG] = weights[i][ACROSS] = 0.0;
+      std::fill(weights[i], weights[i] + NWEIGHTS, 0.0);
       if constexpr (keeps_all) kept[i][SPIN] = 0.0;
       state += state_sum(x[i], v[i]);    // its position along the floor is not among what the test reads
       settle_on_floor(x[i], v[i], omega[i], radius[i], floor_dim, floor_at);    // where it is, its rotation stopped
@@ -526,14 +517,12 @@ void FixNVESphereFluid::final_integrate()
         nve_sphere_kick(v[i], omega[i], f[i], torque[i], radius[i], rmass[i], kick);
       } else {
         // The weights are per unit mass: the step is linear in the force, so f takes the place of a = f / m.
-        // The direction is read only when the weights differ: the first half wrote it only then.
-        const double *w = weights[i];
         if constexpr (is_uniform) {
-          sediment::add_weighted_acceleration(w[ALONG], w[ACROSS], &w[DIRX], f[i], v[i]);
+          sediment::add_packed_weighted_acceleration(weights[i], f[i], v[i]);
           nve_sphere_spin(omega[i], torque[i], radius[i], rmass[i], kick);
         } else {
           const double spin = kept[i][SPIN];    // read first: the stores into v could alias it
-          sediment::add_weighted_acceleration(w[ALONG], w[ACROSS], &w[DIRX], f[i], v[i]);
+          sediment::add_packed_weighted_acceleration(weights[i], f[i], v[i]);
           omega[i][0] += spin * torque[i][0];
           omega[i][1] += spin * torque[i][1];
           omega[i][2] += spin * torque[i][2];

@@ -43,10 +43,11 @@ class FixNVESphereFluid : public Fix {
 
  private:
   // Per atom, from the first half of the step to the second: the weights of the new force along and
-  // across the slip (per unit mass) and the slip's direction (read only when the weights differ), in
-  // a row of 5 doubles. The second half of a nonlinear law reads nothing else: the row's 40 bytes
-  // written and read again per atom and step are what its memory traffic adds to fix nve/sphere's.
-  enum { ALONG, ACROSS, DIRX, DIRY, DIRZ, NWEIGHTS };
+  // across the slip (per unit mass) and the slip's direction, packed in 4 doubles
+  // (sediment::pack_weights). The second half of a nonlinear law reads nothing else: the row's 32
+  // bytes written and read again per atom and step are what its memory traffic adds to fix
+  // nve/sphere's.
+  enum { NWEIGHTS = sediment::PACKED_WEIGHTS_SIZE };
   double **weights;
   // Per atom, what else the step keeps when it is not uniform (below): whether the atom was in a
   // fluid (outside, the step is fix nve/sphere's, operation for operation) and the weight of the new

@@ -548,6 +548,41 @@ TEST(Integrator, PhiMemoGivesTheSameStepAndFollowsTheRate)
   EXPECT_EQ(memo[0], next);
 }
 
+// The packed weights an integrator keeps per sphere between the halves add what the weights add,
+// to rounding, for either sign of along - across and of the force's projection on the slip, and
+// exactly for isotropic weights; a held sphere (both weights 0) gets nothing.
+TEST(Integrator, PackedWeightsAddTheWeightedAcceleration)
+{
+  const double s = 1.0 / std::sqrt(3.0);
+  const double dir[3] = {s, -s, s};
+  const double scale = 7.5e12;    // 1 / m of a 30 um grain
+  for (const auto [along, across] : std::vector<std::pair<double, double>>{
+           {2e-5, 5e-5}, {5e-5, 2e-5}, {5e-5, 5e-5}, {0.0, 0.0}, {3e-5, 0.0}, {0.0, 3e-5}}) {
+    for (const double sign : {1.0, -1.0}) {
+      const double a[3] = {sign * 0.3, -sign * 2.0, sign * 9.81};    // a . dir of either sign
+      StepCorrection corr;
+      corr.along = along;
+      corr.across = across;
+      std::copy(dir, dir + 3, corr.dir);
+      const double v0[3] = {1e-3, -2e-3, 4e-3};
+      double direct[3], packed_v[3], packed[PACKED_WEIGHTS_SIZE];
+      std::copy(v0, v0 + 3, direct);
+      std::copy(v0, v0 + 3, packed_v);
+      add_weighted_acceleration(along * scale, across * scale, dir, a, direct);
+      pack_weights(corr, scale, packed);
+      add_packed_weighted_acceleration(packed, a, packed_v);
+      for (int k = 0; k < 3; ++k) {
+        const double added = direct[k] - v0[k];
+        if (along == across)
+          EXPECT_EQ(packed_v[k], direct[k]) << along << " " << k;
+        else    // a few ulp of the largest term added
+          EXPECT_NEAR(packed_v[k] - v0[k], added, 1e-14 * std::max(along, across) * scale * 10.0)
+              << along << " " << across << " " << sign << " " << k;
+      }
+    }
+  }
+}
+
 // A sphere on a linear spring under Stokes drag, advanced by the drag step with the spring force
 // explicit (as LAMMPS computes contact forces between the halves): largest |x| over many steps.
 static double spring_amplitude(double omega, double rate, double dt, int steps)
