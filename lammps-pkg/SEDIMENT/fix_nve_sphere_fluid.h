@@ -44,9 +44,9 @@ class FixNVESphereFluid : public Fix {
  private:
   // Per atom, from the first half of the step to the second: the weights of the new force along and
   // across the slip (per unit mass) and the slip's direction, packed in 4 doubles
-  // (sediment::pack_weights). The second half of a nonlinear law reads nothing else: the row's 32
+  // (sediment::pack_weights). The second half of a uniform step reads nothing else: the row's 32
   // bytes written and read again per atom and step are what its memory traffic adds to fix
-  // nve/sphere's.
+  // nve/sphere's (the Linear step has none).
   enum { NWEIGHTS = sediment::PACKED_WEIGHTS_SIZE };
   double **weights;
   // Per atom, what else the step keeps when it is not uniform (below): whether the atom was in a
@@ -63,7 +63,7 @@ class FixNVESphereFluid : public Fix {
   std::vector<class FixFluidDrag *> drags;
   // Set in setup() when there is one fluid/drag and it is uniform() (every atom of its group wholly
   // immersed, no rotational drag): the step then skips the per-atom region and surface look-ups, and
-  // the atoms in a fluid are those of the fix's group.
+  // the atoms in a fluid are those of the drag fix's group.
   class FixFluidDrag *uniform;
   // How the first half steps the spheres in a fluid, decided in setup(): General (linear laws, one
   // sphere at a time), Blocked (some fluid/drag has a nonlinear law: its spheres are stepped in
