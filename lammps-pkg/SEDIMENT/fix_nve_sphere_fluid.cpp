@@ -137,7 +137,7 @@ template <class Loop> static inline void with_floor_or_not(int floor_axis, Loop 
 }
 
 FixNVESphereFluid::FixNVESphereFluid(LAMMPS *lmp, int narg, char **arg) :
-    Fix(lmp, narg, arg), weights(nullptr), kept(nullptr), spin_memos(nullptr), nmax_rows(0), uniform(nullptr),
+    Fix(lmp, narg, arg), weights(nullptr), general(nullptr), drag_memos(nullptr), spin_memos(nullptr), nmax_rows(0), uniform(nullptr),
     half_step(HalfStep::General), linear_per_diameter(0.0), floor_axis(-1), floor_level(0.0)
 {
   StyleArgs args(lmp, FLERR, "Fix nve/sphere/fluid", narg, arg, 3);
@@ -162,7 +162,7 @@ FixNVESphereFluid::FixNVESphereFluid(LAMMPS *lmp, int narg, char **arg) :
   size_vector = NCOUNTS;
   global_freq = 1;
   extvector = 1;
-  maxexchange = NWEIGHTS + NKEPT + sediment::PHI_MEMO_SIZE;
+  maxexchange = NWEIGHTS + NGENERAL + 2 * sediment::PHI_MEMO_SIZE;
 
   grow_arrays(atom->nmax);
   atom->add_callback(Atom::GROW);
@@ -172,7 +172,8 @@ FixNVESphereFluid::~FixNVESphereFluid()
 {
   atom->delete_callback(id, Atom::GROW);
   memory->destroy(weights);
-  memory->destroy(kept);
+  memory->destroy(general);
+  memory->destroy(drag_memos);
   memory->destroy(spin_memos);
 }
 
@@ -280,7 +281,7 @@ void FixNVESphereFluid::first_half(Lookup lookup)
       const double alpha[3] = {torque[i][0] * per_inertia, torque[i][1] * per_inertia, torque[i][2] * per_inertia};
       spin = sediment::rotation_step_initial(spin_rate, alpha, dt, omega[i], spin_memos[i]) * per_inertia;
     }
-    if constexpr (keeps_all) kept[i][SPIN] = spin;
+    if constexpr (keeps_all) general[i][SPIN] = spin;
     if constexpr (keeps_weights) sediment::pack_weights(corr, per_mass, weights[i]);
     if (floor_dim >= 0) settle_on_floor(x[i], v[i], omega[i], radius[i], floor_dim, floor_at);
     return state;
@@ -331,7 +332,7 @@ void FixNVESphereFluid::first_half(Lookup lookup)
     double spin_rate = 0.0;
     lookup(i, sphere, flow, spin_rate);
 
-    if constexpr (keeps_all) kept[i][IN_FLUID] = sphere.model ? 1.0 : 0.0;
+    if constexpr (keeps_all) general[i][IN_FLUID] = sphere.model ? 1.0 : 0.0;
     if (!sphere.model) {
       counts[OUTSIDE] += 1.0;
       state += nve_sphere_kick_drift(x[i], v[i], omega[i], f[i], torque[i], radius[i], rmass[i], kick, dt);
@@ -346,7 +347,7 @@ void FixNVESphereFluid::first_half(Lookup lookup)
       // Held: no weights, and no torque's either (a uniform step's second half gives it fix nve/sphere's,
       // and settle_on_floor takes the rotation away again, as the sphere's velocity stays 0).
       std::fill(weights[i], weights[i] + NWEIGHTS, 0.0);
-      if constexpr (keeps_all) kept[i][SPIN] = 0.0;
+      if constexpr (keeps_all) general[i][SPIN] = 0.0;
       state += state_sum(x[i], v[i]);    // its position along the floor is not among what the test reads
       settle_on_floor(x[i], v[i], omega[i], radius[i], floor_dim, floor_at);    // where it is, its rotation stopped
       continue;
@@ -358,7 +359,7 @@ void FixNVESphereFluid::first_half(Lookup lookup)
     const double a[3] = {f[i][0] * per_mass, f[i][1] * per_mass, f[i][2] * per_mass};
     double dx[3];
     if constexpr (linear) {    // sphere.diameter * c, as the law's linear_coefficient
-      const sediment::Phi &p = linear_decay.phis(sphere.diameter, per_mass, &kept[i][DRAG_MEMO]);
+      const sediment::Phi &p = linear_decay.phis(sphere.diameter, per_mass, drag_memos[i]);
       state += finish(i, sediment::linear_step_initial(p, a, flow, dt, v[i], dx), dx, spin_rate, per_mass);
       continue;
     }
@@ -376,7 +377,7 @@ void FixNVESphereFluid::first_half(Lookup lookup)
         continue;
       }
     }
-    state += finish(i, sediment::drag_step_initial(sphere, per_mass, a, flow, dt, v[i], dx, &kept[i][DRAG_MEMO]),
+    state += finish(i, sediment::drag_step_initial(sphere, per_mass, a, flow, dt, v[i], dx, drag_memos[i]),
                     dx, spin_rate, per_mass);
   }
   if (blocks && block.size() > 0) state += step_block();
@@ -499,7 +500,7 @@ void FixNVESphereFluid::final_integrate()
         continue;
       }
       const double per_mass = ftm2v / rmass[i];
-      const double along = dt * linear_decay.phis(2.0 * radius[i], per_mass, &kept[i][DRAG_MEMO]).phi2 * per_mass;
+      const double along = dt * linear_decay.phis(2.0 * radius[i], per_mass, drag_memos[i]).phi2 * per_mass;
       sediment::add_weighted_acceleration(along, along, nullptr, f[i], v[i]);
       nve_sphere_spin(omega[i], torque[i], radius[i], rmass[i], kick);
     }
@@ -513,7 +514,7 @@ void FixNVESphereFluid::final_integrate()
     const int drag_bit = uniform ? uniform->groupbit : 0;
     for (int i = 0; i < nlocal; ++i) {
       if (!(mask[i] & groupbit)) continue;
-      if (is_uniform ? !(mask[i] & drag_bit) : kept[i][IN_FLUID] == 0.0) {
+      if (is_uniform ? !(mask[i] & drag_bit) : general[i][IN_FLUID] == 0.0) {
         nve_sphere_kick(v[i], omega[i], f[i], torque[i], radius[i], rmass[i], kick);
       } else {
         // The weights are per unit mass: the step is linear in the force, so f takes the place of a = f / m.
@@ -521,7 +522,7 @@ void FixNVESphereFluid::final_integrate()
           sediment::add_packed_weighted_acceleration(weights[i], f[i], v[i]);
           nve_sphere_spin(omega[i], torque[i], radius[i], rmass[i], kick);
         } else {
-          const double spin = kept[i][SPIN];    // read first: the stores into v could alias it
+          const double spin = general[i][SPIN];    // read first: the stores into v could alias it
           sediment::add_packed_weighted_acceleration(weights[i], f[i], v[i]);
           omega[i][0] += spin * torque[i][0];
           omega[i][1] += spin * torque[i][1];
@@ -570,18 +571,22 @@ double FixNVESphereFluid::compute_vector(int n)
 void FixNVESphereFluid::grow_arrays(int nmax)
 {
   memory->grow(weights, nmax, NWEIGHTS, "nve/sphere/fluid:weights");
-  memory->grow(kept, nmax, NKEPT, "nve/sphere/fluid:kept");
+  memory->grow(general, nmax, NGENERAL, "nve/sphere/fluid:general");
+  memory->grow(drag_memos, nmax, sediment::PHI_MEMO_SIZE, "nve/sphere/fluid:drag_memos");
   memory->grow(spin_memos, nmax, sediment::PHI_MEMO_SIZE, "nve/sphere/fluid:spin_memos");
   // Empty memos for the new rows (a memo is used only when its z matches).
   for (int i = nmax_rows; i < nmax; ++i)
-    kept[i][DRAG_MEMO] = spin_memos[i][0] = std::numeric_limits<double>::quiet_NaN();
+    drag_memos[i][0] = spin_memos[i][0] = std::numeric_limits<double>::quiet_NaN();
   nmax_rows = nmax;
 }
 
 // The per-atom rows in the order they travel in an exchange: {array, columns}.
-std::array<std::pair<double **, int>, 3> FixNVESphereFluid::rows() const
+std::array<std::pair<double **, int>, 4> FixNVESphereFluid::rows() const
 {
-  return {{{weights, NWEIGHTS}, {kept, NKEPT}, {spin_memos, sediment::PHI_MEMO_SIZE}}};
+  return {{{weights, NWEIGHTS},
+           {general, NGENERAL},
+           {drag_memos, sediment::PHI_MEMO_SIZE},
+           {spin_memos, sediment::PHI_MEMO_SIZE}}};
 }
 
 void FixNVESphereFluid::copy_arrays(int i, int j, int /*delflag*/)
@@ -608,5 +613,5 @@ int FixNVESphereFluid::unpack_exchange(int nlocal, double *buf)
 
 double FixNVESphereFluid::memory_usage()
 {
-  return static_cast<double>(atom->nmax) * (NWEIGHTS + NKEPT + sediment::PHI_MEMO_SIZE) * sizeof(double);
+  return static_cast<double>(atom->nmax) * (NWEIGHTS + NGENERAL + 2 * sediment::PHI_MEMO_SIZE) * sizeof(double);
 }

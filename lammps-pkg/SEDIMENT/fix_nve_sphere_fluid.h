@@ -51,15 +51,18 @@ class FixNVESphereFluid : public Fix {
   double **weights;
   // Per atom, what else the step keeps when it is not uniform (below): whether the atom was in a
   // fluid (outside, the step is fix nve/sphere's, operation for operation) and the weight of the new
-  // torque (per moment of inertia); and for every step the exponentials of the last step's linear
-  // drag (sediment::phis memo). A uniform step takes the first two anew in the second half (the drag
-  // fix's group bit; fix nve/sphere's division for the torque), and its memo is touched only when
-  // the atom before had another rate (polydisperse spheres).
-  enum { IN_FLUID, SPIN, DRAG_MEMO, NKEPT = DRAG_MEMO + sediment::PHI_MEMO_SIZE };
-  double **kept;
-  double **spin_memos;    // the memo of the rotational drag, apart: touched only when there is one
-  int nmax_rows;    // rows of weights, kept and spin_memos with initialised memos
-  std::array<std::pair<double **, int>, 3> rows() const;
+  // torque (per moment of inertia), in a row of 2 doubles that the second half reads with the
+  // weights (together 48 bytes, less than the one row of 64 that held all of it with the memo). A
+  // uniform step takes both anew in the second half: the drag fix's group bit, and fix nve/sphere's
+  // division for the torque.
+  enum { IN_FLUID, SPIN, NGENERAL };
+  double **general;
+  // Per atom, the exponentials of the last step's linear drag and of the last rotational drag
+  // (sediment::phis memos), apart: read in the first half only, and then only where the law is
+  // linear (the Linear step, only when the atom before had another rate) or there is a rotational drag.
+  double **drag_memos, **spin_memos;
+  int nmax_rows;    // rows with initialised memos
+  std::array<std::pair<double **, int>, 4> rows() const;
   std::vector<class FixFluidDrag *> drags;
   // Set in setup() when there is one fluid/drag and it is uniform() (every atom of its group wholly
   // immersed, no rotational drag): the step then skips the per-atom region and surface look-ups, and
