@@ -105,8 +105,8 @@ static inline double nve_sphere_kick_drift(double *x, double *v, double *omega, 
 
 // The exponentials of a linear drag F = c d w for a sphere of diameter d and 1 / m, z = c d dt / m
 // (the same product in both halves of the step), remembered for the last z of a loop over the atoms:
-// every sphere of a monodisperse group shares it, and the atom's own memo (a polydisperse group) is
-// then not touched.
+// every sphere of a monodisperse group shares it, so only a polydisperse group touches the atoms'
+// own memos.
 class LinearDecay {
  public:
   LinearDecay(double per_diameter, double dt) : per_diameter_(per_diameter), dt_(dt) {}
@@ -162,7 +162,7 @@ FixNVESphereFluid::FixNVESphereFluid(LAMMPS *lmp, int narg, char **arg) :
   size_vector = NCOUNTS;
   global_freq = 1;
   extvector = 1;
-  maxexchange = NWEIGHTS + NGENERAL + 2 * sediment::PHI_MEMO_SIZE;
+  maxexchange = doubles_per_atom();
 
   grow_arrays(atom->nmax);
   atom->add_callback(Atom::GROW);
@@ -171,10 +171,7 @@ FixNVESphereFluid::FixNVESphereFluid(LAMMPS *lmp, int narg, char **arg) :
 FixNVESphereFluid::~FixNVESphereFluid()
 {
   atom->delete_callback(id, Atom::GROW);
-  memory->destroy(weights);
-  memory->destroy(general);
-  memory->destroy(drag_memos);
-  memory->destroy(spin_memos);
+  for (const PerAtomArray &row : per_atom_arrays) memory->destroy(this->*row.array);
 }
 
 int FixNVESphereFluid::setmask()
@@ -570,48 +567,57 @@ double FixNVESphereFluid::compute_vector(int n)
 
 void FixNVESphereFluid::grow_arrays(int nmax)
 {
-  memory->grow(weights, nmax, NWEIGHTS, "nve/sphere/fluid:weights");
-  memory->grow(general, nmax, NGENERAL, "nve/sphere/fluid:general");
-  memory->grow(drag_memos, nmax, sediment::PHI_MEMO_SIZE, "nve/sphere/fluid:drag_memos");
-  memory->grow(spin_memos, nmax, sediment::PHI_MEMO_SIZE, "nve/sphere/fluid:spin_memos");
+  for (const PerAtomArray &row : per_atom_arrays) memory->grow(this->*row.array, nmax, row.columns, row.name);
   // Empty memos for the new rows (a memo is used only when its z matches).
   for (int i = nmax_rows; i < nmax; ++i)
     drag_memos[i][0] = spin_memos[i][0] = std::numeric_limits<double>::quiet_NaN();
   nmax_rows = nmax;
 }
 
-// The per-atom rows in the order they travel in an exchange: {array, columns}.
-std::array<std::pair<double **, int>, 4> FixNVESphereFluid::rows() const
+const std::array<FixNVESphereFluid::PerAtomArray, 4> FixNVESphereFluid::per_atom_arrays = {{
+    {&FixNVESphereFluid::weights, NWEIGHTS, "nve/sphere/fluid:weights"},
+    {&FixNVESphereFluid::general, NGENERAL, "nve/sphere/fluid:general"},
+    {&FixNVESphereFluid::drag_memos, sediment::PHI_MEMO_SIZE, "nve/sphere/fluid:drag_memos"},
+    {&FixNVESphereFluid::spin_memos, sediment::PHI_MEMO_SIZE, "nve/sphere/fluid:spin_memos"},
+}};
+
+int FixNVESphereFluid::doubles_per_atom()
 {
-  return {{{weights, NWEIGHTS},
-           {general, NGENERAL},
-           {drag_memos, sediment::PHI_MEMO_SIZE},
-           {spin_memos, sediment::PHI_MEMO_SIZE}}};
+  int n = 0;
+  for (const PerAtomArray &row : per_atom_arrays) n += row.columns;
+  return n;
 }
 
 void FixNVESphereFluid::copy_arrays(int i, int j, int /*delflag*/)
 {
-  for (auto [array, columns] : rows()) std::copy(array[i], array[i] + columns, array[j]);
+  for (const PerAtomArray &row : per_atom_arrays) {
+    double **array = this->*row.array;
+    std::copy(array[i], array[i] + row.columns, array[j]);
+  }
 }
 
 int FixNVESphereFluid::pack_exchange(int i, double *buf)
 {
   int m = 0;
-  for (auto [array, columns] : rows()) m = std::copy(array[i], array[i] + columns, buf + m) - buf;
+  for (const PerAtomArray &row : per_atom_arrays) {
+    const double *from = (this->*row.array)[i];
+    std::copy(from, from + row.columns, buf + m);
+    m += row.columns;
+  }
   return m;
 }
 
 int FixNVESphereFluid::unpack_exchange(int nlocal, double *buf)
 {
   int m = 0;
-  for (auto [array, columns] : rows()) {
-    std::copy(buf + m, buf + m + columns, array[nlocal]);
-    m += columns;
+  for (const PerAtomArray &row : per_atom_arrays) {
+    std::copy(buf + m, buf + m + row.columns, (this->*row.array)[nlocal]);
+    m += row.columns;
   }
   return m;
 }
 
 double FixNVESphereFluid::memory_usage()
 {
-  return static_cast<double>(atom->nmax) * (NWEIGHTS + NGENERAL + 2 * sediment::PHI_MEMO_SIZE) * sizeof(double);
+  return static_cast<double>(atom->nmax) * doubles_per_atom() * sizeof(double);
 }

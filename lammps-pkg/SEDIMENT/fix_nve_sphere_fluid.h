@@ -19,7 +19,6 @@ FixStyle(nve/sphere/fluid,FixNVESphereFluid);
 #include "sediment/integrator.hpp"
 
 #include <array>
-#include <utility>
 #include <vector>
 
 namespace LAMMPS_NS {
@@ -62,7 +61,15 @@ class FixNVESphereFluid : public Fix {
   // linear (the Linear step, only when the atom before had another rate) or there is a rotational drag.
   double **drag_memos, **spin_memos;
   int nmax_rows;    // rows with initialised memos
-  std::array<std::pair<double **, int>, 4> rows() const;
+  // The per-atom arrays above, in the order they travel in an exchange: every allocation, copy,
+  // exchange and memory count goes through this one table.
+  struct PerAtomArray {
+    double **FixNVESphereFluid::*array;
+    int columns;
+    const char *name;
+  };
+  static const std::array<PerAtomArray, 4> per_atom_arrays;
+  static int doubles_per_atom();
   std::vector<class FixFluidDrag *> drags;
   // Set in setup() when there is one fluid/drag and it is uniform() (every atom of its group wholly
   // immersed, no rotational drag): the step then skips the per-atom region and surface look-ups, and
