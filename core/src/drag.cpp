@@ -23,7 +23,30 @@ constexpr LawName law_names[] = {
     {DragLaw::ZhangLi, "zhang-li"},
     {DragLaw::ZhangLiSmooth, "zhang-li/smooth"},
     {DragLaw::DiFelice, "difelice"},
+    {DragLaw::Standard, "standard"},
 };
+
+struct HindranceName {
+  Hindrance hindrance;
+  const char *name;
+};
+
+constexpr HindranceName hindrance_names_table[] = {
+    {Hindrance::None, "none"},
+    {Hindrance::DiFelice, "difelice"},
+    {Hindrance::RichardsonZaki, "richardson-zaki"},
+    {Hindrance::Garside, "garside"},
+};
+
+template <class Table> std::string joined_names(const Table &table)
+{
+  std::string names;
+  for (const auto &entry : table) {
+    if (!names.empty()) names += ", ";
+    names += entry.name;
+  }
+  return names;
+}
 
 }    // namespace
 
@@ -41,20 +64,40 @@ const char *drag_law_name(DragLaw law)
   return "unknown";
 }
 
-std::string drag_law_names()
+std::string drag_law_names() { return joined_names(law_names); }
+
+std::optional<Hindrance> hindrance_from_name(std::string_view name)
 {
-  std::string names;
-  for (const auto &entry : law_names) {
-    if (!names.empty()) names += ", ";
-    names += entry.name;
-  }
-  return names;
+  for (const auto &entry : hindrance_names_table)
+    if (name == entry.name) return entry.hindrance;
+  return std::nullopt;
+}
+
+const char *hindrance_name(Hindrance hindrance)
+{
+  for (const auto &entry : hindrance_names_table)
+    if (hindrance == entry.hindrance) return entry.name;
+  return "unknown";
+}
+
+std::string hindrance_names() { return joined_names(hindrance_names_table); }
+
+bool law_takes_hindrance(DragLaw law, Hindrance hindrance)
+{
+  if (hindrance == Hindrance::None) return true;
+  if (law == DragLaw::DiFelice) return hindrance == Hindrance::DiFelice;
+  if (law == DragLaw::ZhangLi || law == DragLaw::ZhangLiSmooth) return false;
+  return law != DragLaw::SchillerNaumann || hindrance == Hindrance::DiFelice;
 }
 
 double drag_coefficient(DragLaw law, double re) { return drag_curve(law, re).g / re; }
 
-DragModel::DragModel(DragLaw law, const Fluid &fluid, HindranceBuoyancy buoyancy) :
-    law_(law), hindrance_offset_(buoyancy == HindranceBuoyancy::Plain ? 1.0 : 0.0), fluid_(fluid),
+DragModel::DragModel(DragLaw law, const Fluid &fluid, HindranceBuoyancy buoyancy, Hindrance hindrance) :
+    law_(law), single_law_(law == DragLaw::DiFelice ? DragLaw::Dallavalle : law),
+    hindrance_(law == DragLaw::DiFelice ? Hindrance::DiFelice : hindrance),
+    exponent_fit_(hindrance == Hindrance::Garside ? garside_exponent : rowe_exponent),
+    log_scale_(std::log(exponent_fit_.scale)), hindrance_offset_(buoyancy == HindranceBuoyancy::Plain ? 1.0 : 0.0),
+    fluid_(fluid),
     density_per_viscosity_(fluid.viscosity > 0.0 ? fluid.density / fluid.viscosity : 0.0),
     yield_per_viscosity_(fluid.viscosity > 0.0 ? fluid.yield_stress / fluid.viscosity : 0.0), smooth_(false)
 {
@@ -129,8 +172,8 @@ int DragModel::jumps(double d, std::array<ForceJump, max_jumps> &out, DragScale 
   for (int k = 0; k < switches_.count; ++k) {
     const double re = switches_.reynolds[k];
     const double speed = speed_at_reynolds(d, re);
-    const double g_below = drag_curve(law_, std::nextafter(re, 0.0)).g;
-    const double g_above = drag_curve(law_, std::nextafter(re, inf)).g;
+    const double g_below = drag_curve(single_law_, std::nextafter(re, 0.0)).g;
+    const double g_above = drag_curve(single_law_, std::nextafter(re, inf)).g;
     out[k] = {speed, force_at(d, speed, g_below, scale), force_at(d, speed, g_above, scale)};
   }
   return switches_.count;

@@ -238,8 +238,7 @@ template <bool yield> [[gnu::always_inline]] inline void DragBlock::rates(const 
       const double s = speed_[n];
       reynolds_[n] = reynolds_per_speed_[n] * s * s / (s + yield_speed_[n]);
     }
-  model.single_curves(reynolds_, curve_, size_, kind);
-  model.hinder(reynolds_, voidage_, curve_, size_, kind);
+  model.curves(reynolds_, voidage_, curve_, size_, kind);
   for (int n = 0; n < size_; ++n) {
     const double k = rate_per_g_[n];
     const double g = curve_[n].g, re_dg = curve_[n].re_dg;

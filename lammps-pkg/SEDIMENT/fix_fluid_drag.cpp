@@ -31,13 +31,14 @@ static inline double norm(const double *w)
 
 FixFluidDrag::FixFluidDrag(LAMMPS *lmp, int narg, char **arg) :
     Fix(lmp, narg, arg), fluid_id(nullptr), fluid(nullptr), law(sediment::DragLaw::Stokes),
-    hindrance_buoyancy(sediment::HindranceBuoyancy::Plain), concentration_id(nullptr),
+    hindrance_buoyancy(sediment::HindranceBuoyancy::Plain), hindrance(sediment::Hindrance::None),
+    concentration_id(nullptr),
     concentration(nullptr), max_fraction(0.64), rotation(0), implicit_groupbit(0), all_implicit(false)
 {
   if (narg < 6)
     error->all(FLERR, "Fix fluid/drag: expected 'fix ID group fluid/drag FLUID-ID law NAME'");
   fluid_id = utils::strdup(arg[3]);
-  bool has_law = false;
+  bool has_law = false, has_hindrance = false;
   StyleArgs args(lmp, FLERR, "Fix fluid/drag", narg, arg, 4);
   while (args.more()) {
     if (args.is("law")) {
@@ -46,6 +47,13 @@ FixFluidDrag::FixFluidDrag(LAMMPS *lmp, int narg, char **arg) :
       if (!parsed) args.fail("unknown law '{}' (expected one of {})", args.text(1), sediment::drag_law_names());
       law = *parsed;
       has_law = true;
+    } else if (args.is("hindrance")) {
+      args.need(1, "a name");
+      const auto parsed = sediment::hindrance_from_name(args.text(1));
+      if (!parsed)
+        args.fail("unknown hindrance '{}' (expected one of {})", args.text(1), sediment::hindrance_names());
+      hindrance = *parsed;
+      has_hindrance = true;
     } else if (args.is("rotation")) {
       args.need(1, "yes or no");
       rotation = args.yes_no(1);
@@ -62,16 +70,32 @@ FixFluidDrag::FixFluidDrag(LAMMPS *lmp, int narg, char **arg) :
       max_fraction = args.number(1);
       if (!(max_fraction > 0.0 && max_fraction < 1.0)) args.fail("max_fraction must be in (0, 1)");
     } else {
-      args.unknown("law, rotation, concentration, buoyancy or max_fraction");
+      args.unknown("law, hindrance, rotation, concentration, buoyancy or max_fraction");
     }
     args.next(1);
   }
   if (!has_law) error->all(FLERR, "Fix fluid/drag: keyword 'law' is required");
-  if (law == sediment::DragLaw::DiFelice && !concentration_id)
-    error->all(FLERR, "Fix fluid/drag: law difelice needs keyword 'concentration c_ID' (a compute "
-                      "concentration/grid)");
-  if (law != sediment::DragLaw::DiFelice && concentration_id)
-    error->all(FLERR, "Fix fluid/drag: keyword 'concentration' applies to law difelice only");
+  if (law == sediment::DragLaw::DiFelice) {
+    if (has_hindrance)
+      error->all(FLERR, "Fix fluid/drag: law difelice is Dallavalle's drag with Di Felice's hindrance (Bravo "
+                        "et al.); for another hindrance name a law and 'hindrance NAME' (e.g. law dallavalle "
+                        "hindrance richardson-zaki)");
+    hindrance = sediment::Hindrance::DiFelice;
+  }
+  if (!sediment::law_takes_hindrance(law, hindrance))
+    error->all(FLERR, "Fix fluid/drag: law {} takes no hindrance {} ({})", sediment::drag_law_name(law),
+               sediment::hindrance_name(hindrance),
+               law == sediment::DragLaw::SchillerNaumann
+                   ? "its jump in Cd at Re = 1000 would move with each sphere's fraction; use hindrance "
+                     "difelice, or law standard"
+                   : "the hindrances are for the Newtonian laws stokes, schiller-naumann, dallavalle and standard");
+  if (hindrance != sediment::Hindrance::None && !concentration_id)
+    error->all(FLERR, "Fix fluid/drag: {} needs keyword 'concentration c_ID' (a compute concentration/grid)",
+               law == sediment::DragLaw::DiFelice ? "law difelice"
+                                                  : fmt::format("hindrance {}", sediment::hindrance_name(hindrance)));
+  if (hindrance == sediment::Hindrance::None && concentration_id)
+    error->all(FLERR, "Fix fluid/drag: keyword 'concentration' goes with a hindrance (hindrance NAME, or law "
+                      "difelice)");
   if (!atom->radius_flag || !atom->rmass_flag)
     error->all(FLERR, "Fix fluid/drag requires atom attributes radius and rmass (atom_style sphere)");
   if (rotation && (!atom->omega_flag || !atom->torque_flag))
@@ -97,7 +121,7 @@ int FixFluidDrag::setmask()
 void FixFluidDrag::init()
 {
   fluid = FixFluid::find(lmp, fluid_id, "Fix fluid/drag");
-  model = std::make_unique<sediment::DragModel>(law, fluid->properties(), hindrance_buoyancy);
+  model = std::make_unique<sediment::DragModel>(law, fluid->properties(), hindrance_buoyancy, hindrance);
   concentration =
       concentration_id ? ComputeConcentrationGrid::find_fraction(lmp, concentration_id, "Fix fluid/drag") : nullptr;
   implicit_groupbit = 0;

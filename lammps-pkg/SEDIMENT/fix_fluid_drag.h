@@ -79,9 +79,10 @@ class FixFluidDrag : public Fix {
   class FixFluid *fluid;
   sediment::DragLaw law;
   sediment::HindranceBuoyancy hindrance_buoyancy;
+  sediment::Hindrance hindrance;
   std::unique_ptr<sediment::DragModel> model;
   char *concentration_id;
-  class Compute *concentration;    // per-atom local solid fraction (law difelice)
+  class Compute *concentration;    // per-atom local solid fraction (under a hindrance)
   double max_fraction;             // local fractions are capped here
   int rotation;
   int implicit_groupbit;    // atoms advanced by fix nve/sphere/fluid: no explicit drag

@@ -6,6 +6,7 @@
 #include "sediment/geometry.hpp"
 #include "sediment/integrator.hpp"
 #include "sediment/terminal.hpp"
+#include "sediment/water.hpp"
 
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
@@ -39,6 +40,24 @@ DragLaw parse_law(const std::string &name)
   return *law;
 }
 
+Hindrance parse_hindrance(const std::string &name, DragLaw law)
+{
+  const auto hindrance = hindrance_from_name(name);
+  if (!hindrance)
+    throw py::value_error("unknown hindrance '" + name + "' (expected one of " + hindrance_names() + ")");
+  if (!law_takes_hindrance(law, *hindrance))
+    throw py::value_error(std::string("law ") + drag_law_name(law) + " does not take hindrance " + name);
+  return *hindrance;
+}
+
+double checked_temperature(double celsius)
+{
+  if (!(celsius >= water_min_temperature && celsius <= water_max_temperature))
+    throw py::value_error("water temperature must be within 0-40 C (the range of the correlations), not " +
+                          std::to_string(celsius));
+  return celsius;
+}
+
 Fluid make_fluid(double density, double viscosity, double yield_stress)
 {
   if (!(density > 0.0)) throw py::value_error("fluid density must be > 0");
@@ -66,10 +85,15 @@ PYBIND11_MODULE(_core, m)
   m.def("drag_law_names", [] {
     std::vector<std::string> names;
     for (auto law : {DragLaw::Stokes, DragLaw::SchillerNaumann, DragLaw::Dallavalle, DragLaw::ZhangLi,
-                     DragLaw::ZhangLiSmooth, DragLaw::DiFelice})
+                     DragLaw::ZhangLiSmooth, DragLaw::DiFelice, DragLaw::Standard})
       names.emplace_back(drag_law_name(law));
     return names;
   }, "Names of the drag laws.");
+
+  m.def("water_density", [](double celsius) { return water_density(checked_temperature(celsius)); },
+        py::arg("celsius"), "Density of water [kg/m3] at 0-40 C (Tanaka et al. 2001).");
+  m.def("water_viscosity", [](double celsius) { return water_viscosity(checked_temperature(celsius)); },
+        py::arg("celsius"), "Viscosity of water [Pa s] at 0-40 C (Kestin et al. 1978 with IAPWS 2008's 20 C value).");
 
   m.def("drag_coefficient", [](const std::string &law, double re) {
     if (!(re > 0.0)) throw py::value_error("Reynolds number must be > 0");
@@ -78,11 +102,13 @@ PYBIND11_MODULE(_core, m)
 
   py::class_<DragModel>(m, "DragModel", "Resisting-force curve of a sphere under one drag law.")
       .def(py::init([](const std::string &law, double density, double viscosity, double yield_stress,
-                       const std::string &buoyancy) {
-             return DragModel(parse_law(law), make_fluid(density, viscosity, yield_stress), parse_buoyancy(buoyancy));
+                       const std::string &buoyancy, const std::string &hindrance) {
+             const DragLaw parsed = parse_law(law);
+             return DragModel(parsed, make_fluid(density, viscosity, yield_stress), parse_buoyancy(buoyancy),
+                              parse_hindrance(hindrance, parsed));
            }),
            py::arg("law"), py::arg("density"), py::arg("viscosity"), py::arg("yield_stress") = 0.0,
-           py::arg("buoyancy") = "plain")
+           py::arg("buoyancy") = "plain", py::arg("hindrance") = "none")
       .def("reynolds", &DragModel::reynolds, py::arg("d"), py::arg("speed"))
       .def("force", [](const DragModel &model, double d, double speed, double voidage, double area,
                        double wetted) {
@@ -94,7 +120,7 @@ PYBIND11_MODULE(_core, m)
              return model.force(d, speed, scale);
            }, py::arg("d"), py::arg("speed"), py::arg("voidage") = 1.0, py::arg("area") = 1.0,
            py::arg("wetted") = 1.0,
-           "Resisting force magnitude [N] at slip speed > 0 (voidage: local fluid fraction, difelice; "
+           "Resisting force magnitude [N] at slip speed > 0 (voidage: local fluid fraction, under a hindrance; "
            "area, wetted: submerged fractions of a sphere at a free surface, see submergence()).")
       .def("tangent", [](const DragModel &model, double d, double speed, double voidage) {
              return model.tangent(d, speed, voidage_scale(voidage));

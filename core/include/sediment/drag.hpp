@@ -21,16 +21,32 @@
 
 namespace sediment {
 
-enum class DragLaw { Stokes, SchillerNaumann, Dallavalle, ZhangLi, ZhangLiSmooth, DiFelice };
+// The single-sphere laws; DiFelice is Bravo et al.'s model, Dallavalle's curve under Di Felice's
+// hindrance, kept under its own name to reproduce the paper (DragModel splits it into the two).
+enum class DragLaw { Stokes, SchillerNaumann, Dallavalle, ZhangLi, ZhangLiSmooth, DiFelice, Standard };
 
-// Which buoyancy the Di Felice hindrance goes with (docs/physics.md 3.1): plain Archimedes buoyancy
-// (factor eps^-(chi+1)) or buoyancy from the mixture density (factor eps^-chi).
+// How the local solid fraction phi = 1 - eps hinders the drag of any Newtonian law (docs/physics.md 3):
+// - DiFelice: the force times eps^-(chi(Re) + 1) (Di Felice 1994's voidage function);
+// - RichardsonZaki, Garside: the single-sphere force at the speed s eps^-n(Re), so that a uniform
+//   suspension settles at u_t eps^n under any law (n from Rowe's 1987 fit of Richardson & Zaki's data,
+//   4.7 at low Re, or Garside & Al-Dibouni's 1977 fit of theirs, 5.1 at low Re).
+enum class Hindrance { None, DiFelice, RichardsonZaki, Garside };
+
+// Which buoyancy the hindrance goes with (docs/physics.md 3.1): plain Archimedes buoyancy or buoyancy
+// from the mixture density, which already carries a factor eps of the net weight (Di Felice: eps^-chi
+// instead of eps^-(chi+1); the speed-scaled hindrances: the force times eps).
 enum class HindranceBuoyancy { Plain, Mixture };
 
 std::optional<DragLaw> drag_law_from_name(std::string_view name);
 const char *drag_law_name(DragLaw law);
 // The names accepted by drag_law_from_name, separated by ", " (for error messages).
 std::string drag_law_names();
+std::optional<Hindrance> hindrance_from_name(std::string_view name);
+const char *hindrance_name(Hindrance hindrance);
+std::string hindrance_names();
+// Whether a law takes a hindrance of its own choice: the Newtonian single-sphere laws without a jump
+// in Cd (a speed-scaled hindrance would move the jump with each sphere's fraction).
+bool law_takes_hindrance(DragLaw law, Hindrance hindrance);
 
 struct Fluid {
   double density = 0.0;         // rho_f
@@ -63,6 +79,62 @@ inline DragCurve schiller_naumann_curve(double re, double power)
   return {0.44 * re, 0.44 * re};
 }
 
+// The standard drag curve of a sphere: Clift, Grace & Weber's (1978, Table 5.2) recommended
+// correlation, fitted to critically selected measurements, made continuous (docs/physics.md 2.1):
+//   Re < 25.66:       Cd Re / 24 = 1 + 0.1315 Re^(0.82 - 0.05 w),  w = log10 Re  (their piece for
+//                     0.01 < Re <= 20, kept down to Re -> 0, where it tends to Stokes' 24 / Re, and up
+//                     to where it meets the next piece, 0.74 % above theirs at Re = 20 at most)
+//   25.66 <= Re < 260: Cd Re / 24 = 1 + 0.1935 Re^0.6305
+//   Re >= 260:         log10 Cd = a polynomial in w per range, the constant terms moved by at most
+//                     3.3e-4 (0.07 % in Cd) so that each range starts where the last ends.
+// Every piece is one power or exponential: the caller gives ln Re (NaN stays NaN; ln Re below -700,
+// Re = 0 included, is the Stokes limit) and the exponential of standard_curve_argument.
+namespace standard_curve {
+constexpr double low_to_mid = 25.661577155540865;    // where the two lower pieces cross
+constexpr double mid_to_high = 260.0;
+constexpr double log_low_coeff = -2.028748427364318;    // ln 0.1315
+constexpr double log_mid_coeff = -1.6424777665123005;    // ln 0.1935
+constexpr double mid_power = 0.6305;
+struct Range {
+  double upper;    // Reynolds number where the next range starts
+  double c[4];     // log10 Cd = c0 + c1 w + c2 w^2 + c3 w^3
+};
+constexpr Range high[4] = {
+    {1.5e3, {1.6434605163278249, -1.1242, 0.1558, 0.0}},
+    {1.2e4, {-2.4574219625021343, 2.5558, -0.9295, 0.1049}},
+    {4.4e4, {-1.91838447528945, 0.637, -0.0636, 0.0}},
+    {1e300, {-4.3392290555769892, 1.5809, -0.1546, 0.0}},
+};
+inline const Range &range_of(double re)
+{
+  return re < high[0].upper ? high[0] : re < high[1].upper ? high[1] : re < high[2].upper ? high[2] : high[3];
+}
+inline double clamp_log(double log_re) { return log_re < -700.0 ? -700.0 : log_re; }
+// The argument whose exponential the piece of Re needs.
+inline double argument(double re, double log_re)
+{
+  const double w = log_re * (1.0 / ln10);
+  if (re < low_to_mid) return log_low_coeff + (0.82 - 0.05 * w) * log_re;
+  if (re < mid_to_high) return log_mid_coeff + mid_power * log_re;
+  const Range &r = range_of(re);
+  return log_re + ln10 * (r.c[0] + w * (r.c[1] + w * (r.c[2] + w * r.c[3])));
+}
+// Cd Re and Re d(Cd Re)/dRe from Re, ln Re and the exponential of argument().
+inline DragCurve curve(double re, double log_re, double power)
+{
+  const double w = log_re * (1.0 / ln10);
+  if (re < low_to_mid) return {24.0 * (1.0 + power), 24.0 * power * (0.82 - 0.1 * w)};
+  if (re < mid_to_high) return {24.0 * (1.0 + power), 24.0 * mid_power * power};
+  const Range &r = range_of(re);
+  return {power, power * (1.0 + r.c[1] + w * (2.0 * r.c[2] + 3.0 * w * r.c[3]))};
+}
+inline DragCurve curve(double re)
+{
+  const double log_re = clamp_log(std::log(re));
+  return curve(re, log_re, std::exp(argument(re, log_re)));
+}
+}    // namespace standard_curve
+
 // Inline: the integrator's per-atom loops evaluate it with the law fixed for the whole run.
 inline DragCurve drag_curve(DragLaw law, double re)
 {
@@ -71,6 +143,8 @@ inline DragCurve drag_curve(DragLaw law, double re)
       return {24.0, 0.0};
     case DragLaw::SchillerNaumann:
       return schiller_naumann_curve(re, re <= schiller_naumann_switch ? std::pow(re, schiller_naumann_exponent) : 0.0);
+    case DragLaw::Standard:
+      return standard_curve::curve(re);
     case DragLaw::Dallavalle:
     case DragLaw::DiFelice: {    // the single-sphere curve; hindrance is applied per sphere
       // Cd = (0.63 + 4.8 / sqrt(Re))^2  =>  Cd Re = (0.63 sqrt(Re) + 4.8)^2
@@ -126,13 +200,36 @@ inline Exponent di_felice_exponent(double re)
   return di_felice_exponent(t, std::exp(-0.5 * t * t));
 }
 
+// A Richardson-Zaki exponent n(Re) = (low + high K) / (1 + K), K = scale Re^power, smooth between its
+// low- and high-Re limits: Rowe (1987) 4.7 to 2.34, Garside & Al-Dibouni (1977) 5.1 to 2.7.
+struct ExponentFit {
+  double low, high, scale, power;
+};
+constexpr ExponentFit rowe_exponent{4.7, 0.41 / 0.175, 0.175, 0.75};
+constexpr ExponentFit garside_exponent{5.1, 2.7, 0.1, 0.9};
+// n and Re dn/dRe from k = K (scale Re^power).
+inline Exponent richardson_zaki_exponent(const ExponentFit &fit, double k)
+{
+  const double inverse = 1.0 / (1.0 + k);
+  return {(fit.low + fit.high * k) * inverse, (fit.high - fit.low) * fit.power * k * inverse * inverse};
+}
+inline Exponent richardson_zaki_exponent_at(const ExponentFit &fit, double re)
+{
+  return richardson_zaki_exponent(fit, re > 0.0 ? fit.scale * std::pow(re, fit.power) : 0.0);
+}
+
 class DragModel {
  public:
   static constexpr int max_jumps = 2;
 
-  DragModel(DragLaw law, const Fluid &fluid, HindranceBuoyancy buoyancy = HindranceBuoyancy::Plain);
+  // law DiFelice is Dallavalle's curve with the Di Felice hindrance, whatever `hindrance` says;
+  // any other law takes `hindrance` (law_takes_hindrance must hold).
+  DragModel(DragLaw law, const Fluid &fluid, HindranceBuoyancy buoyancy = HindranceBuoyancy::Plain,
+            Hindrance hindrance = Hindrance::None);
 
   DragLaw law() const { return law_; }
+  DragLaw single_law() const { return single_law_; }    // the single-sphere curve (Dallavalle's for DiFelice)
+  Hindrance hindrance() const { return hindrance_; }
   const Fluid &fluid() const { return fluid_; }
 
   double reynolds(double d, double speed) const;
@@ -164,30 +261,38 @@ class DragModel {
     double reynolds[max_jumps] = {0.0, 0.0};
   };
   const Switches &switches() const { return switches_; }
-  // Cd Re' of the law at this sphere, with the Di Felice hindrance when it applies.
+  // Cd Re' of the law at this sphere, with the hindrance when it applies.
   DragCurve curve(double re, double voidage) const
   {
-    const DragCurve single = drag_curve(law_, re);
-    if (!hindered(voidage)) return single;
-    const Exponent chi = di_felice_exponent(re);
+    if (!hindered(voidage)) return drag_curve(single_law_, re);
     const double log_eps = std::log(voidage);
-    return hindered_curve(single, chi, log_eps, std::exp(-(chi.value + hindrance_offset_) * log_eps));
+    if (hindrance_ == Hindrance::DiFelice) {
+      const Exponent chi = di_felice_exponent(re);
+      return hindered_curve(drag_curve(single_law_, re), chi, log_eps,
+                            std::exp(-(chi.value + hindrance_offset_) * log_eps));
+    }
+    const Exponent n = richardson_zaki_exponent_at(exponent_fit_, re);
+    const double stretch = std::exp(-n.value * log_eps);    // eps^-n
+    return stretched_curve(drag_curve(single_law_, stretch * re), n, log_eps, stretch, voidage);
   }
   // curve() of n spheres at once, the hindrance's logarithms and exponentials taken together
-  // (exp_many, log_many, of this kind): within a few ulp of curve().
-  void curves(const double *re, const double *voidage, DragCurve *out, int n,
-              BatchMath kind = batch_math_kind()) const
+  // (exp_many, log_many, of this kind): within a few ulp of curve(). Inline, so that the loops run
+  // in the vectors of the caller's instruction set (DragBlock's AVX2 step).
+  [[gnu::always_inline]] void curves(const double *re, const double *voidage, DragCurve *out, int n,
+                                     BatchMath kind = batch_math_kind()) const
   {
+    if (hindrance_ == Hindrance::RichardsonZaki || hindrance_ == Hindrance::Garside)
+      return stretched_curves(re, voidage, out, n, kind);
     single_curves(re, out, n, kind);
     hinder(re, voidage, out, n, kind);
   }
-  // The two parts of curves(). The single-sphere curves inline, for a caller's loop compiled for
+  // The two parts of curves() under no or Di Felice's hindrance. The single-sphere curves inline, for a caller's loop compiled for
   // its own instruction set; the law is fixed outside the loop, so each law's loop is vectorised
   // (with the switch inside, each sphere took an indirect jump and stayed scalar), and
   // Schiller-Naumann's powers come from exp_many and log_many of this kind.
   [[gnu::always_inline]] void single_curves(const double *re, DragCurve *out, int n, BatchMath kind) const
   {
-    switch (law_) {
+    switch (single_law_) {
       case DragLaw::Dallavalle:
       case DragLaw::DiFelice:
         return curves_of<DragLaw::Dallavalle>(re, out, n);
@@ -209,6 +314,21 @@ class DragModel {
         }
         return;
       }
+      case DragLaw::Standard: {
+        constexpr int chunk = 64;
+        double log_re[chunk], power[chunk];
+        for (int start = 0; start < n; start += chunk) {
+          const int m = std::min(n - start, chunk);
+          log_many(re + start, log_re, m, kind);
+          for (int j = 0; j < m; ++j) {
+            log_re[j] = standard_curve::clamp_log(log_re[j]);
+            power[j] = standard_curve::argument(re[start + j], log_re[j]);
+          }
+          exp_many(power, power, m, kind);
+          for (int j = 0; j < m; ++j) out[start + j] = standard_curve::curve(re[start + j], log_re[j], power[j]);
+        }
+        return;
+      }
     }
   }
   // Di Felice's hindrance applied to single-sphere curves (nothing under another law), each stage one
@@ -218,7 +338,7 @@ class DragModel {
   [[gnu::always_inline]] void hinder(const double *re, const double *voidage, DragCurve *out, int n,
                                      BatchMath kind) const
   {
-    if (law_ != DragLaw::DiFelice) return;
+    if (hindrance_ != Hindrance::DiFelice) return;
     constexpr int chunk = 64;
     double log_re[chunk], log_eps[chunk], t[chunk], gauss[chunk], value[chunk], slope[chunk], factor[chunk];
     for (int start = 0; start < n; start += chunk) {
@@ -248,12 +368,50 @@ class DragModel {
         out[start + j] = hindered_curve(out[start + j], {value[j], slope[j]}, log_eps[j], factor[j]);
     }
   }
+  // The Richardson-Zaki hindrances for n spheres: each chunk's exponents, stretches eps^-n and
+  // stretched Reynolds numbers in loops over the chunk, then the single-sphere curves at those
+  // numbers. An unhindered sphere (eps >= 1) takes ln 1 = 0, a stretch of 1 and its own curve.
+  [[gnu::always_inline]] void stretched_curves(const double *re, const double *voidage, DragCurve *out, int n,
+                                               BatchMath kind) const
+  {
+    constexpr int chunk = 64;
+    double log_eps[chunk], k[chunk], stretch[chunk], stretched_re[chunk], value[chunk], slope[chunk];
+    for (int start = 0; start < n; start += chunk) {
+      const int m = std::min(n - start, chunk);
+      bool any = false;    // a chunk in clear fluid costs its curves alone
+      for (int j = 0; j < m; ++j) any |= hindered(voidage[start + j]);
+      if (!any) {
+        single_curves(re + start, out + start, m, kind);
+        continue;
+      }
+      for (int j = 0; j < m; ++j) {
+        k[j] = re[start + j];                                   // ln 0 = -inf and e^-inf = 0: K = 0 at rest
+        log_eps[j] = std::min(voidage[start + j], 1.0);         // eps >= 1: no hindrance; NaN stays NaN
+      }
+      log_many(k, k, m, kind);
+      log_many(log_eps, log_eps, m, kind);
+      for (int j = 0; j < m; ++j) k[j] = exponent_fit_.power * k[j] + log_scale_;
+      exp_many(k, k, m, kind);
+      for (int j = 0; j < m; ++j) {
+        const Exponent e = richardson_zaki_exponent(exponent_fit_, k[j]);
+        value[j] = e.value;
+        slope[j] = e.re_slope;
+        stretch[j] = -e.value * log_eps[j];
+      }
+      exp_many(stretch, stretch, m, kind);
+      for (int j = 0; j < m; ++j) stretched_re[j] = stretch[j] * re[start + j];
+      single_curves(stretched_re, out + start, m, kind);
+      for (int j = 0; j < m; ++j)
+        out[start + j] = stretched_curve(out[start + j], {value[j], slope[j]}, log_eps[j], stretch[j],
+                                         std::min(voidage[start + j], 1.0));
+    }
+  }
   // F(0+): the largest force a sphere at rest resists (zero for a Newtonian fluid).
   double static_force(double d, DragScale scale = {}) const;
   // c when F(s) = c s exactly (Stokes in a Newtonian fluid), else 0.
   double linear_coefficient(double d, DragScale scale = {}) const
   {
-    if (law_ != DragLaw::Stokes || fluid_.yield_stress > 0.0) return 0.0;
+    if (law_ != DragLaw::Stokes || fluid_.yield_stress > 0.0 || hindrance_ != Hindrance::None) return 0.0;
     return scale.area * 3.0 * pi * fluid_.viscosity * d;
   }
   // Jumps of F in increasing speed; returns how many were written.
@@ -265,12 +423,21 @@ class DragModel {
   {
     for (int k = 0; k < n; ++k) out[k] = drag_curve(law, re[k]);
   }
-  bool hindered(double voidage) const { return law_ == DragLaw::DiFelice && !(voidage >= 1.0); }
+  bool hindered(double voidage) const { return hindrance_ != Hindrance::None && !(voidage >= 1.0); }
   // G eps^-(chi(Re) + offset), factor = eps^-(chi + offset): the exponent depends on Re, so the
   // slope has a second term.
   static DragCurve hindered_curve(DragCurve single, Exponent chi, double log_eps, double factor)
   {
     return {single.g * factor, (single.re_dg - single.g * log_eps * chi.re_slope) * factor};
+  }
+  // G_h(Re) = P G(S Re) with the stretch S = eps^-n(Re) and P = S (plain buoyancy) or S eps (mixture),
+  // from the single curve at S Re: Re G_h' = L G_h + P (1 + L) (S Re) G'(S Re), L = -ln(eps) Re n'(Re).
+  DragCurve stretched_curve(DragCurve at_stretched, Exponent n, double log_eps, double stretch, double voidage) const
+  {
+    const double prefactor = hindrance_offset_ > 0.0 ? stretch : stretch * voidage;
+    const double l = -log_eps * n.re_slope;
+    const double g = prefactor * at_stretched.g;
+    return {g, l * g + prefactor * (1.0 + l) * at_stretched.re_dg};
   }
   double viscous_scale(double d, double speed) const;    // tau_y + eta s / d
   double speed_at_reynolds(double d, double re) const;  // inverse of reynolds()
@@ -279,7 +446,11 @@ class DragModel {
   double slope_at(double d, double speed, DragCurve g, DragScale scale) const;
 
   DragLaw law_;
-  double hindrance_offset_;    // 1: eps^-(chi+1), 0: eps^-chi
+  DragLaw single_law_;
+  Hindrance hindrance_;
+  ExponentFit exponent_fit_;    // of a Richardson-Zaki hindrance
+  double log_scale_;            // ln of its scale
+  double hindrance_offset_;    // 1: plain buoyancy, 0: mixture
   Fluid fluid_;
   double density_per_viscosity_;    // rho / eta (0 without viscosity)
   double yield_per_viscosity_;      // tau_y / eta (0 without viscosity)
