@@ -19,7 +19,7 @@ def test_case_a_terminal_velocity_and_tau():
 
 def test_law_names_and_coefficients():
     assert sediment.drag_law_names() == ["stokes", "schiller-naumann", "dallavalle", "zhang-li", "zhang-li/smooth",
-                                         "difelice"]
+                                         "difelice", "standard"]
     assert sediment.drag_coefficient("schiller-naumann", 10.0) == pytest.approx(2.4 * (1 + 0.15 * 10**0.687))
     assert sediment.drag_coefficient("dallavalle", 4.0) == pytest.approx((0.63 + 2.4) ** 2)
     assert sediment.drag_coefficient("zhang-li", 10.0) == pytest.approx(2.912 + 0.195)
