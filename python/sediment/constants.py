@@ -3,8 +3,9 @@
 from __future__ import annotations
 
 GRAVITY = 9.81                    # m/s2
-WATER_20C_DENSITY = 998.2         # kg/m3
-WATER_20C_VISCOSITY = 1.002e-3    # Pa s
+WATER_20C_DENSITY = 998.2067      # kg/m3 (Tanaka et al. 2001; sediment._core.water_density(20))
+WATER_20C_VISCOSITY = 1.0016e-3   # Pa s (IAPWS 2008; sediment._core.water_viscosity(20))
+LAB_TEMPERATURE = 20.0            # deg C
 SOIL_PARTICLE_DENSITY = 2650.0    # kg/m3, Gs = 2.65: what the 152H hydrometer is calibrated for
 D422_CYLINDER_AREA = 27.8e-4      # m2, ASTM D422 cylinder (inner diameter 5.95 cm)
 D422_CYLINDER_HEIGHT = 0.36       # m, the 1000 mL mark

@@ -52,7 +52,7 @@ def test_slab_is_the_axial_section_in_2d():
 def test_time_steps_double_after_the_largest_grains_have_left():
     scene = plan(read_psd(PSDS / "sample5.csv"), particles=2000, layers=200, t_end=86400.0, courant=1.0)
     stages = scene.stages()
-    v_max = terminal_speed(scene.suspension, scene.classes.diameter.max(), "dallavalle")
+    v_max = terminal_speed(scene.suspension, scene.classes.diameter.max(), "standard")    # the scene's default law
     layer = scene.height / scene.layers
     assert stages[0][0] == pytest.approx(layer / v_max)                 # one layer per step at first
     default = plan(read_psd(PSDS / "sample5.csv"), particles=2000, layers=200, t_end=86400.0)

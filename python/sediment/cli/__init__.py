@@ -7,9 +7,9 @@ import argparse
 import sys
 
 from ..sim.run import RunInterrupted
-from . import calibrate, case_a, paste, plan, readout, run, sample, spheres, sweep, terminal
+from . import budget, calibrate, case_a, paste, plan, readout, run, sample, spheres, sweep, terminal
 
-COMMANDS = (terminal, case_a, sample, plan, run, readout, calibrate, paste, spheres, sweep)
+COMMANDS = (terminal, case_a, sample, plan, run, readout, budget, calibrate, paste, spheres, sweep)
 
 
 def build_parser() -> argparse.ArgumentParser:

@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from .sample import add_test_options, cylinder_of
+from .sample import add_test_options, cylinder_of, suspension_of
 from .types import count, positive, positive_list, setting
 
 
@@ -39,7 +39,7 @@ def add_parser(commands) -> argparse.ArgumentParser:
                         help="measure every effect, also those the screening settled")
     parser.add_argument("--screen-only", action="store_true", help="print the screening and stop (no runs)")
     parser.add_argument("--set", type=setting, action="append", metavar="NAME=VALUE",
-                        help="fix an effect or resolution instead of planning it (e.g. drag=difelice, "
+                        help="fix an effect or resolution instead of planning it (e.g. hindrance=none, "
                         "particles=20000, contacts=no)")
     test = parser.add_argument_group("sedimentation test")
     add_test_options(test)
@@ -49,6 +49,12 @@ def add_parser(commands) -> argparse.ArgumentParser:
                       help="parcel ladder, comma-separated (default 40000,20000,10000,5000; the largest is the reference)")
     test.add_argument("--courant", type=positive_list, default=[1.0, 2.0, 4.0, 8.0],
                       help="Courant ladder, comma-separated (default 1,2,4,8; the smallest is the reference)")
+    test.add_argument("--replicas", type=count, default=3,
+                      help="runs of the reference with independent seeds (default 3): their mean stands for the "
+                      "converged answer and their spread for its sampling error, which every error includes")
+    test.add_argument("--no-models", action="store_true",
+                      help="skip the runs of the other drag models (Bravo et al.'s difelice, Dallavalle's and Schiller "
+                      "& Naumann's curves, Garside's and Di Felice's hindrance) against the reference")
     test.add_argument("--measure-contacts", action="store_true",
                       help="also measure what contacts, and contacts with lubrication, change: a reduced real-grain "
                       "scene (the grains above --contact-cut in a periodic box) run both ways, written to "
@@ -89,16 +95,15 @@ def run(args: argparse.Namespace) -> int:
             raise ValueError("a deck is screened from the numbers its reference run prints: --screen-only needs a PSD")
     else:
         from ..lab.psd import read_psd
-        from ..lab.readout import Suspension
         from ..planner.screening import SedimentationTest
 
         tolerance = args.tolerance or 0.5
         psd = read_psd(args.psd)
-        test = SedimentationTest(psd, Suspension(particle_density=args.particle_density), cylinder_of(args), args.mass,
+        test = SedimentationTest(psd, suspension_of(args), cylinder_of(args), args.mass,
                                  tuple(dict.fromkeys(args.instruments)))
         options = dict(geometry=args.geometry, width=args.width, classes=args.classes, layers=args.layers,
                        t_end=args.t_end)
-        scene = SampleScene(test, options, args.particles, args.courant, tolerance)
+        scene = SampleScene(test, options, args.particles, args.courant, tolerance, args.replicas, not args.no_models)
         name = args.psd.stem
         if args.contact_cut is not None and not args.measure_contacts:
             raise ValueError("--contact-cut sets the reduced scene of --measure-contacts: give both")

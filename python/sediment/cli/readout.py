@@ -10,7 +10,7 @@ import numpy as np
 
 from ..constants import D422_CYLINDER_AREA, D422_CYLINDER_HEIGHT, SOIL_PARTICLE_DENSITY
 from ..lab.readout import SCHEDULES
-from .types import finite, positive
+from .types import finite, positive, temperature
 
 
 def add_parser(commands) -> argparse.ArgumentParser:
@@ -38,10 +38,17 @@ def add_parser(commands) -> argparse.ArgumentParser:
                         metavar=("L2", "VB", "STEM_D", "MASS", "L1_R0", "L1_R50"),
                         help="a measured hydrometer instead of the nominal 152H: bulb length [m], bulb volume "
                         "[m3], stem diameter [m], mass [kg], bulb top to the R = 0 and R = 50 marks [m]")
+    parser.add_argument("--temperature", type=temperature, help="the water temperature the laboratory recorded [C], "
+                        "0-40: the reduction takes the water's viscosity and density at it (default: the layer "
+                        "file's fluid)")
     parser.add_argument("--viscosity", type=positive, help="viscosity for Stokes' law [Pa s] (default: the "
                         "layer file's fluid)")
     parser.add_argument("--cylinder-area", type=positive, default=D422_CYLINDER_AREA,
                         help="for the hydrometer's level rise [m2]")
+    parser.add_argument("--band", type=Path, metavar="BUDGET",
+                        help="budget.json of `sediment budget` for this test: each reading gets the band (low, high) "
+                        "that the physics' uncertainty puts around it (the budget's physical total)")
+    parser.add_argument("--band-sample", metavar="NAME", help="the sample of a budget.json that holds several")
     parser.add_argument("--allow-partial", action="store_true",
                         help="read a layer file whose run did not finish (its frames stop early)")
     parser.add_argument("--out", type=Path, default=Path("out/readout"), help="output folder")
@@ -73,13 +80,19 @@ def run(args: argparse.Namespace) -> int:
                 raise ValueError(message + "; resume or rerun it (sediment run --resume), or pass --allow-partial")
             print("warning: " + message)
         column = Column.from_layers(layers, surface=args.surface)
-        if args.viscosity is not None:    # e.g. the lab's temperature differs from the simulation's
-            column = replace(column, suspension=replace(column.suspension, viscosity=args.viscosity))
+        if args.temperature is not None and args.viscosity is not None:
+            raise ValueError("--temperature sets the viscosity: give one of --temperature and --viscosity")
+        if args.temperature is not None:    # the lab's record, which may differ from the simulation's water
+            water = Suspension.at_temperature(args.temperature, column.suspension.particle_density)
+            column = replace(column, suspension=water)
+        if args.viscosity is not None:
+            column = replace(column, suspension=replace(column.suspension, viscosity=args.viscosity, temperature=None))
         title = f"{args.layers.parent.name}/{args.layers.name}: simulated sedimentation test"
     else:
         if psd is None:
             raise ValueError("give a layer file, or --psd with --stokes-preview for an analytic column")
-        suspension = Suspension(particle_density=args.particle_density)
+        suspension = (Suspension(particle_density=args.particle_density) if args.temperature is None
+                      else Suspension.at_temperature(args.temperature, args.particle_density))
         times = np.concatenate([[0.0], np.geomspace(10.0, 1440 * 60.0, 400)])
         column = settling_column(psd, args.height, times, args.concentration, suspension)
         title = f"{args.psd.name}: Stokes settling preview (no DEM)"
@@ -89,6 +102,15 @@ def run(args: argparse.Namespace) -> int:
                           sphere_depth=args.sphere_depth, pipette_depth=args.pipette_depth,
                           pipette_volume=args.pipette_volume, cylinder_area=args.cylinder_area,
                           hydrometer=hydrometer)
+    if args.band is not None:
+        from ..studies.budget import band_of
+
+        band = band_of(args.band, args.band_sample)
+        report.readings = [replace(r, band=band[r.instrument]) for r in report.readings]
+        report.notes.append("band from the physics' uncertainty (" + str(args.band) + "): " +
+                            ", ".join(f"{r.instrument} +-{r.band:.3g} pp" for r in report.readings))
+    elif args.band_sample is not None:
+        raise ValueError("--band-sample names a sample of --band BUDGET: give both")
     for path in report.save(args.out):
         print(f"wrote {path}")
     print(report.table().text(), end="")

@@ -5,9 +5,9 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from ..constants import SOIL_PARTICLE_DENSITY
-from ..sim.scene import DRAGS
-from .types import count, positive
+from ..constants import LAB_TEMPERATURE, SOIL_PARTICLE_DENSITY
+from ..sim.scene import DRAGS, HINDRANCES
+from .types import count, positive, temperature
 
 
 def add_parser(commands) -> argparse.ArgumentParser:
@@ -22,17 +22,21 @@ def add_parser(commands) -> argparse.ArgumentParser:
     parser.add_argument("--real-grains", action="store_true",
                         help="one atom per real grain at the real concentration (eq. 15 counts, at least one "
                              "per class); needed with --contacts or --lubrication")
-    parser.add_argument("--drag", default="difelice", choices=DRAGS,
-                        help="difelice: Dallavalle's drag hindered by the local concentration (Di Felice; the "
-                        "default), or a single-sphere law without hindrance")
+    parser.add_argument("--drag", default="standard", choices=DRAGS,
+                        help="single-sphere drag: the measured standard drag curve (default), another law, or "
+                        "difelice, Bravo et al.'s model (Dallavalle's curve with Di Felice's hindrance)")
+    parser.add_argument("--hindrance", choices=HINDRANCES,
+                        help="how the local concentration slows the grains: richardson-zaki (default; Rowe's fit "
+                        "of Richardson & Zaki's measured exponent, 4.7 at low Re), garside (Garside & Al-Dibouni, "
+                        "5.1), difelice, none (drag difelice carries its own)")
     parser.add_argument("--contacts", action="store_true", help="Hertz contacts between grains and with the floor")
     parser.add_argument("--lubrication", action="store_true", help="squeeze-film lubrication (with contacts)")
     parser.add_argument("--courant", type=positive, default=4.0,
                         help="layers the fastest grain in suspension may cross per step (default 4: within 0.25 "
                         "points of percent finer of Courant 1 for the five samples of docs/effects.md)")
     parser.add_argument("--plan", type=Path, metavar="REPORT",
-                        help="take the drag, parcels and Courant number that `sediment plan` decided (its "
-                        "report.json) instead of --drag, --particles and --courant")
+                        help="take the drag, hindrance, parcels and Courant number that `sediment plan` decided "
+                        "(its report.json) instead of --drag, --hindrance, --particles and --courant")
     return parser
 
 
@@ -47,10 +51,31 @@ def add_test_options(parser: argparse.ArgumentParser) -> None:
                         "diameters; the slab spans the cylinder)")
     parser.add_argument("--mass", type=positive, default=0.060, help="dry sample mass [kg]")
     parser.add_argument("--particle-density", type=positive, default=SOIL_PARTICLE_DENSITY, help="[kg/m3]")
+    parser.add_argument("--temperature", type=temperature, default=LAB_TEMPERATURE,
+                        help="water temperature [C], 0-40: its density and viscosity (default 20; 1 C moves the "
+                        "viscosity by about 2.5 %%)")
     parser.add_argument("--classes", type=count, default=40, help="log-spaced size classes (eq. 15)")
     parser.add_argument("--layers", type=count, default=400, help="layers of the concentration grid")
     parser.add_argument("--t-end", type=positive, default=86400.0, help="simulated time [s] (default 24 h)")
     parser.add_argument("--seed", type=int, default=1, help="placement seed")
+
+
+def suspension_of(args: argparse.Namespace):
+    """The water at the test's temperature and the grains."""
+    from ..lab.readout import Suspension
+
+    return Suspension.at_temperature(args.temperature, args.particle_density)
+
+
+def effects_of(args: argparse.Namespace, contacts: bool = False, lubrication: bool = False):
+    """The drag law and hindrance the options name (drag difelice carries its own hindrance)."""
+    from ..sim.scene import Effects
+
+    if args.drag == "difelice" and args.hindrance not in (None, "difelice"):
+        raise ValueError("--drag difelice is Dallavalle's curve with Di Felice's hindrance (Bravo et al.): it takes no "
+                         f"--hindrance {args.hindrance}; for that hindrance choose --drag dallavalle or standard")
+    hindrance = args.hindrance or ("difelice" if args.drag == "difelice" else "richardson-zaki")
+    return Effects(args.drag, contacts, lubrication, hindrance)
 
 
 def cylinder_of(args: argparse.Namespace):
@@ -64,8 +89,7 @@ def cylinder_of(args: argparse.Namespace):
 def run(args: argparse.Namespace) -> int:
     """Plans the scene, prints it and writes its data file, deck and PSD tables."""
     from ..lab.psd import read_psd
-    from ..lab.readout import Suspension
-    from ..sim.scene import Effects, describe, plan, write
+    from ..sim.scene import describe, plan, write
 
     if args.plan is not None:
         from ..planner.scenes import decided_options
@@ -78,17 +102,17 @@ def run(args: argparse.Namespace) -> int:
         cylinder = cylinder_of(args)
         here = dict(geometry=args.geometry, width=args.width, classes=args.classes, layers=args.layers,
                     t_end=args.t_end, mass=args.mass, particle_density=args.particle_density,
-                    cylinder_area=cylinder.area, height=cylinder.height)
+                    cylinder_area=cylinder.area, height=cylinder.height, temperature=args.temperature)
         differ = [f"{k} {planned[k]} (here {v})" for k, v in here.items() if k in planned and planned[k] != v]
         if differ:
             print("warning: the plan was made for another test: " + ", ".join(differ))
-        print(f"the plan's decision ({args.plan}): --drag {args.drag} --particles {args.particles} "
-              f"--courant {args.courant:g}")
+        print(f"the plan's decision ({args.plan}): --drag {args.drag} --hindrance {args.hindrance} "
+              f"--particles {args.particles} --courant {args.courant:g}")
 
     scene = plan(read_psd(args.psd), geometry=args.geometry, cylinder=cylinder_of(args), mass=args.mass,
-                 suspension=Suspension(particle_density=args.particle_density), width=args.width,
+                 suspension=suspension_of(args), width=args.width,
                  classes=args.classes, particles=None if args.real_grains else args.particles,
-                 effects=Effects(args.drag, args.contacts, args.lubrication),
+                 effects=effects_of(args, args.contacts, args.lubrication),
                  layers=args.layers, t_end=args.t_end, courant=args.courant, seed=args.seed)
     print(describe(scene))
     for path in write(scene, args.out):

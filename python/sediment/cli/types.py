@@ -33,6 +33,14 @@ def nonnegative(text: str) -> float:
     return value
 
 
+def temperature(text: str) -> float:
+    """A water temperature within the range of the water correlations, 0-40 C."""
+    value = finite(text)
+    if not 0.0 <= value <= 40.0:
+        raise argparse.ArgumentTypeError(f"must be within 0-40 C (the range of the water correlations), got {text}")
+    return value
+
+
 MAX_COUNT = 10**9    # particles, ranks, layers, runs: beyond this no run fits this machine's memory
 
 

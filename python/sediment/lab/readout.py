@@ -15,7 +15,7 @@ import numpy as np
 
 from .. import _core
 from ..results import Table, write_text
-from ..constants import (D422_CYLINDER_AREA, GRAVITY, SOIL_PARTICLE_DENSITY, WATER_20C_DENSITY,
+from ..constants import (D422_CYLINDER_AREA, GRAVITY, LAB_TEMPERATURE, SOIL_PARTICLE_DENSITY, WATER_20C_DENSITY,
                          WATER_20C_VISCOSITY)
 
 R_FACTOR = 1 - 1 / 2.65    # 152H: R = (rho_s - rho_w) / 0.6226 in g/L, calibrated for Gs = 2.65
@@ -29,12 +29,26 @@ SCHEDULES = {              # reading times [min]
 
 @dataclass(frozen=True)
 class Suspension:
-    """The water and the solids of a sedimentation test, and Stokes' law between them."""
+    """The water and the solids of a sedimentation test, and Stokes' law between them. The default is
+    water at 20 C; `at_temperature` gives it at the laboratory's (docs/physics.md 2.2)."""
 
     fluid_density: float = WATER_20C_DENSITY
     viscosity: float = WATER_20C_VISCOSITY
     particle_density: float = SOIL_PARTICLE_DENSITY
     gravity: float = GRAVITY
+    temperature: float | None = LAB_TEMPERATURE    # deg C of the water; None: a fluid given by its properties
+
+    @classmethod
+    def at_temperature(cls, celsius: float, particle_density: float = SOIL_PARTICLE_DENSITY,
+                       gravity: float = GRAVITY) -> "Suspension":
+        """Water at `celsius` (0-40 C) with solids of `particle_density`."""
+        return cls(_core.water_density(celsius), _core.water_viscosity(celsius), particle_density, gravity,
+                   float(celsius))
+
+    def temperature_text(self) -> str:
+        """The water as a deck or report names it."""
+        properties = f"density {self.fluid_density:.7g} kg/m3, viscosity {self.viscosity:.5g} Pa s"
+        return properties if self.temperature is None else f"{self.temperature:g} C ({properties})"
 
     @property
     def specific_gravity(self) -> float:
@@ -93,7 +107,8 @@ class Column:
         keep = depth[1:] > 0                               # layers (partly) below the surface
         edges = np.clip(np.concatenate([depth[:-1][keep][:1], depth[1:][keep]]), 0.0, None)
         fraction = layers.total[:, ::-1][:, keep]
-        suspension = Suspension(attrs["fluid_density"], attrs["fluid_viscosity"], attrs["particle_density"])
+        suspension = Suspension(attrs["fluid_density"], attrs["fluid_viscosity"], attrs["particle_density"],
+                                temperature=None)
         return cls(edges, np.asarray(layers.time, float), fraction, suspension, attrs.get("slab_thickness", 0.0))
 
     @property
@@ -155,13 +170,17 @@ class Readings:
     reading: np.ndarray     # instrument units (152H: g/L; sphere: apparent mass g; pipette: g/L)
     diameter: np.ndarray    # m
     percent_finer: np.ndarray
+    band: float = 0.0       # pp either side that the physics' uncertainty puts around each reading (error budget)
 
     def table(self) -> Table:
-        """Time [min], depth [cm], reading, diameter [um] and percent finer per reading."""
+        """Time [min], depth [cm], reading, diameter [um] and percent finer per reading (with a band: its
+        low and high ends)."""
         unit = {"hydrometer": "R [g/L]", "buoyancy": "m_app [g]", "pipette": "c [g/L]"}[self.instrument]
-        table = Table(["time_min", "depth_cm", unit, "diameter_um", "percent_finer"])
+        banded = ["low", "high"] if self.band > 0 else []
+        table = Table(["time_min", "depth_cm", unit, "diameter_um", "percent_finer", *banded])
         for row in zip(self.time / 60, self.depth * 100, self.reading, self.diameter * 1e6, self.percent_finer):
-            table.add(*map(float, row))
+            ends = [row[-1] - self.band, row[-1] + self.band] if self.band > 0 else []
+            table.add(*map(float, row), *ends)
         return table
 
     def save(self, folder: Path) -> list[Path]:

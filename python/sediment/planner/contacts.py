@@ -112,7 +112,8 @@ def measure_contacts(test: SedimentationTest, setup: ReducedScene, folder: Path,
     mass = test.initial_concentration * share * setup.width ** 2 * setup.height
     scene = plan(coarse, cylinder=Cylinder(setup.width ** 2, setup.height), mass=mass, suspension=s,
                  width=setup.width, classes=setup.classes, particles=None, seed=setup.seed,
-                 effects=Effects("dallavalle", contacts=True, lubrication=setup.lubrication), t_end=1.0)
+                 effects=Effects("standard", contacts=True, lubrication=setup.lubrication, hindrance="none"),
+                 t_end=1.0)
     dt = scene.contact_time_step()
     slowest = float(terminal_speeds(s, np.array([scene.diameter.min()]))[0])
     steps = math.ceil(setup.fall * setup.height / slowest / dt)
@@ -201,7 +202,7 @@ def _deck(scene, dt: float, steps: int) -> str:
         f"fix             grav all gravity {s.gravity:.12g} vector 0 0 -1",
         f"fix             water all fluid density {s.fluid_density:.12g} viscosity {s.viscosity:.12g}",
         "fix             buoy all fluid/buoyancy water",
-        "fix             drag all fluid/drag water law dallavalle",
+        "fix             drag all fluid/drag water law standard",
         *pair_lines(scene),
         "fix             step all nve/sphere/fluid",
         "compute         overlap all contact/overlap",

@@ -2,10 +2,15 @@
 """The effects planner (docs/effects.md): screen every effect, measure what screening cannot settle,
 decide the cheapest setting within the tolerance, verify it with a run, and report.
 
-1. The reference trial runs every knob at its richest value.
+1. The reference trial runs every knob at its richest value, replicated with independent seeds where
+   the scene takes one (a test): the mean of the replicas estimates the converged answer, their spread
+   its sampling error, and every error below is a run's distance from that mean plus twice its
+   standard error. Every other run takes a seed of its own, so that its error includes its own sampling.
 2. Each knob value still in question (an effect the screening left to measure, every rung of a
    resolution ladder) runs as a trial that differs from the reference in that knob alone: its error
-   against the reference and its cost ratio (loop time over the reference's).
+   against the reference and its cost ratio (loop time over the reference's). The scene's other models
+   (a test: the drag laws and hindrances of the literature) run at the reference's resolution and are
+   reported with their change of every reading; they are not candidates.
 3. Every combination of the measured values is priced: predicted error the sum of its knobs' errors
    (each effect moves the observables on its own; errors of separate causes add at worst), predicted
    cost the product of their cost ratios (an effect left out never prices dearer; at equal cost fewer
@@ -20,6 +25,8 @@ import math
 from concurrent.futures import ThreadPoolExecutor, as_completed
 from dataclasses import dataclass, field, replace
 from pathlib import Path
+
+import numpy as np
 
 from .. import figures
 from ..results import Table, write_text
@@ -36,6 +43,7 @@ class Trial:
 
     name: str
     settings: dict
+    seed: int = 1
     outcome: Outcome = field(default_factory=Outcome)
     errors: dict[str, float] = field(default_factory=dict)
     predicted_error: float | None = None
@@ -64,11 +72,39 @@ class Plan:
     candidates: list[tuple[dict, float, float]]    # every priced combination (settings, error, cost)
     command: str = ""
     scene_options: dict = field(default_factory=dict)    # what the scene was, besides the knobs
+    replicas: list[Trial] = field(default_factory=list)     # the reference's runs (the first is `reference`)
+    uncertainty: dict | None = None      # standard error of the reference's mean per observable and reading
+    models: list[Trial] = field(default_factory=list)       # the scene's other models, against the reference
+
+    def sampling_error(self) -> tuple[float, float]:
+        """The largest standard error of the reference's mean and of one run at the reference's resolution
+        over every reading [the scene's unit] (0, 0 without replicas)."""
+        if not self.uncertainty or len(self.replicas) < 2:
+            return 0.0, 0.0
+        mean = max(float(np.max(e)) for e in self.uncertainty.values())
+        return mean, mean * math.sqrt(len(self.replicas))
+
+    def model_table(self) -> Table:
+        """Each other model's change of the readings against the reference, per observable."""
+        names = sorted(self.reference.errors)
+        table = Table(["model", *[f"change_{n}" for n in names], "max_change", "loop_s"],
+                      notes=[f"against the reference ({_describe(self.reference.settings)}), each change raised by "
+                             "twice the standard error of the reference's mean"])
+        for t in self.models:
+            table.add(_describe({k: t.settings[k] for k in ("drag", "hindrance") if k in t.settings}),
+                      *[f"{t.errors.get(n, math.nan):.4g}" for n in names], f"{t.error:.4g}",
+                      f"{t.outcome.loop_seconds:.4g}")
+        return table
 
     @property
     def speedup(self) -> float:
         """Reference loop time over the decision's."""
-        return self.reference.outcome.loop_seconds / self.decision.outcome.loop_seconds
+        return self.reference_seconds / self.decision.outcome.loop_seconds
+
+    @property
+    def reference_seconds(self) -> float:
+        """The reference's loop time: the mean of its runs."""
+        return float(np.mean([r.outcome.loop_seconds for r in self.replicas or [self.reference]]))
 
     def table(self) -> Table:
         """Per knob value: what it leaves out, the screening number, estimated and measured change,
@@ -117,17 +153,32 @@ class Plan:
     def _cost(self, trial: Trial | None) -> str:
         if trial is None or trial.outcome.failure:
             return ""
-        return f"{trial.outcome.loop_seconds / self.reference.outcome.loop_seconds:.3g}"
+        return f"{trial.outcome.loop_seconds / self.reference_seconds:.3g}"
 
     def notes(self) -> list[str]:
         """The decision in words."""
         d, r = self.decision, self.reference
         unit = "pp" if self.unit == "pp" else "(relative)"
-        lines = [f"reference (richest): {_describe(r.settings)}, loop {r.outcome.loop_seconds:.3g} s",
+        lines = [f"reference (richest): {_describe(r.settings)}, loop {self.reference_seconds:.3g} s"]
+        if len(self.replicas) > 1:
+            mean, one = self.sampling_error()
+            lines.append(f"reference: the mean of {len(self.replicas)} runs with independent seeds; sampling error of "
+                         f"a reading up to {one:.3g} {unit} for one run, {mean:.3g} {unit} for the mean (standard "
+                         "errors); every error is a run's distance from that mean plus twice its standard error")
+        lines += [
                  f"decision: {_describe(d.settings)}: error {d.error:.3g} {unit} (tolerance {self.tolerance:g}), "
                  f"loop {d.outcome.loop_seconds:.3g} s, {self.speedup:.3g}x faster than the reference"]
         if self.command:
             lines.append(f"as options: {self.command}")
+        mean, one = self.sampling_error()
+        if one > 0 and "particles" in d.settings:
+            spread = one * math.sqrt(r.settings["particles"] / d.settings["particles"])
+            lines.append(f"decision: its deck is the verified run (seed {d.seed}); another seed would move a reading by "
+                         f"about {spread:.3g} {unit} (one standard error at its parcel count)")
+        if d is r and d.error > self.tolerance:
+            lines.append(f"no setting holds the tolerance: one run of the reference itself lies {d.error:.3g} {unit} "
+                         "from the converged estimate (its sampling error); plan with more particles at the top of "
+                         "the ladder, or more replicas")
         for t in self.verified:
             if t is not d:
                 verdict = "rejected" if t.error > self.tolerance else "also within the tolerance"
@@ -137,15 +188,19 @@ class Plan:
             if s.verdict == MEASURE:
                 estimate = "no estimate" if s.change is None else f"estimated change {s.change:.3g} {unit}"
                 lines.append(f"not measurable in this scene: {s.label} ({estimate}): left out")
+        for t in self.models:
+            model = _describe({k: t.settings[k] for k in ("drag", "hindrance") if k in t.settings})
+            lines.append(f"other model {model}: " + ("failed: " + t.outcome.failure if t.outcome.failure else
+                         f"changes a reading by up to {t.error:.3g} {unit} against the reference"))
         return lines
 
     def trial_table(self) -> Table:
         """Every run: its settings, loop time, errors per observable."""
         names = sorted(self.reference.errors) or sorted(self.reference.outcome.observations)
-        table = Table(["trial", *[k.name for k in self.knobs], "loop_s", "status",
+        table = Table(["trial", *[k.name for k in self.knobs], "seed", "loop_s", "status",
                        *[f"error_{n}" for n in names], "max_error", "predicted_error", "predicted_cost_ratio"])
-        for t in [self.reference, *self.trials, *self.verified]:
-            table.add(t.name, *[t.settings[k.name] for k in self.knobs], f"{t.outcome.loop_seconds:.4g}",
+        for t in [*self.replicas, *self.trials, *self.verified, *self.models]:
+            table.add(t.name, *[t.settings[k.name] for k in self.knobs], t.seed, f"{t.outcome.loop_seconds:.4g}",
                       "failed: " + t.outcome.failure if t.outcome.failure else "ok",
                       *[f"{t.errors.get(n, math.nan):.4g}" for n in names], f"{t.error:.4g}",
                       "" if t.predicted_error is None else f"{t.predicted_error:.4g}",
@@ -155,7 +210,7 @@ class Plan:
     def as_dict(self) -> dict:
         """Everything in the report, for scripts (report.json)."""
         def trial(t: Trial) -> dict:
-            return {"name": t.name, "settings": t.settings, "loop_seconds": t.outcome.loop_seconds,
+            return {"name": t.name, "settings": t.settings, "seed": t.seed, "loop_seconds": t.outcome.loop_seconds,
                     "failure": t.outcome.failure, "errors": t.errors, "error": t.error if math.isfinite(t.error) else None,
                     "predicted_error": t.predicted_error, "predicted_cost_ratio": t.predicted_cost}
         return {"scene": self.scene_name, "unit": self.unit, "tolerance": self.tolerance,
@@ -164,6 +219,8 @@ class Plan:
                 "reference": trial(self.reference), "trials": [trial(t) for t in self.trials],
                 "verified": [trial(t) for t in self.verified], "decision": trial(self.decision),
                 "speedup": self.speedup, "command": self.command, "scene_options": self.scene_options,
+                "replicas": [trial(t) for t in self.replicas], "models": [trial(t) for t in self.models],
+                "reference_standard_error": {k: np.asarray(v).tolist() for k, v in (self.uncertainty or {}).items()},
                 "candidates": [{"settings": s, "predicted_error": e, "predicted_cost_ratio": c}
                                for s, e, c in self.candidates]}
 
@@ -172,6 +229,7 @@ class Plan:
         folder = Path(folder)
         return [write_text(folder / "effects.csv", self.table().csv()),
                 write_text(folder / "trials.csv", self.trial_table().csv()),
+                *([write_text(folder / "models.csv", self.model_table().csv())] if self.models else []),
                 write_text(folder / "report.json", json.dumps(self.as_dict(), indent=1, default=str) + "\n"),
                 self.plot(folder / "plan.png")]
 
@@ -184,7 +242,7 @@ class Plan:
         ax.scatter(costs, [max(e, floor) for _, e, _ in self.candidates], s=12, color="0.7",
                    label="candidates (predicted)")
         ax.scatter([], [], marker="o", color="C0", label="one knob changed (measured)")
-        ref = self.reference.outcome.loop_seconds
+        ref = self.reference_seconds
         for t in self.trials:
             if not t.outcome.failure:
                 ax.scatter(t.outcome.loop_seconds / ref, max(t.error, floor), marker="o", color="C0")
@@ -245,7 +303,8 @@ def plan_effects(scene, out: Path, tolerance: float, jobs: int = 2, seed: int = 
     jobs : int
         Trials run at once (one rank each).
     seed : int
-        Placement seed of every run (a test), so the report is reproducible.
+        Placement seed of the first reference run (a test); the other runs take the seeds after it, each
+        its own, so the report is reproducible.
     measure_all : bool
         Measure every effect, also those the screening settled.
     progress : bool
@@ -261,9 +320,12 @@ def plan_effects(scene, out: Path, tolerance: float, jobs: int = 2, seed: int = 
         raise ValueError("jobs must be >= 1")
     out = Path(out)
     runs, decided = prepare(out / "runs"), prepare(out / "decision")
-    reference = Trial("reference", {k.name: k.values[0] for k in scene.knobs})
+    seeds = itertools.count(seed)      # every run its own placement: errors include each run's sampling
+    reference = Trial("reference", {k.name: k.values[0] for k in scene.knobs}, next(seeds))
+    replicas = [reference] + [Trial(f"reference-{k + 1}", dict(reference.settings), next(seeds))
+                              for k in range(1, scene.replicas)]
     if scene.screens_from_run:        # a deck prints its screening numbers: run it first
-        _run_all(scene, [reference], runs, seed, 1, progress, "reference")
+        _run_all(scene, [reference], runs, 1, progress, "reference")
         scene.screen_printed(reference.outcome.printed)
     screens = {s.effect: s for s in scene.screens}
     fixed: dict[str, tuple] = {}      # knob -> (value, estimated error, why) when screening settled it
@@ -273,14 +335,20 @@ def plan_effects(scene, out: Path, tolerance: float, jobs: int = 2, seed: int = 
         if settled is not None:
             fixed[knob.name] = settled
             continue
-        trials += [Trial(knob.label(v), dict(reference.settings, **{knob.name: v})) for v in knob.values[1:]]
-    _run_all(scene, trials if scene.screens_from_run else [reference, *trials], runs, seed, jobs, progress, "measure")
-    if reference.outcome.failure:
-        raise RuntimeError(f"the reference run failed: {reference.outcome.failure}")
-    reference.errors = {name: 0.0 for name in reference.outcome.observations}
-    for t in trials:
+        trials += [Trial(knob.label(v), dict(reference.settings, **{knob.name: v}), next(seeds)) for v in knob.values[1:]]
+    models = [Trial("model=" + "+".join(str(v) for v in m.values()), dict(reference.settings, **m), next(seeds))
+              for m in scene.models]
+    first = [] if scene.screens_from_run else replicas
+    _run_all(scene, first + trials + models, runs, jobs, progress, "measure")
+    failed = next((r for r in replicas if r.outcome.failure), None)
+    if failed is not None:
+        raise RuntimeError(f"the reference run {failed.name} failed: {failed.outcome.failure}")
+    converged, uncertainty = scene.combine([r.outcome.observations for r in replicas])
+    # the reference's loop time: the mean of its runs, which ran alongside the others
+    reference_loop = float(np.mean([r.outcome.loop_seconds for r in replicas]))
+    for t in trials + models + replicas:    # a replica's error: how far one run of the reference lies
         if not t.outcome.failure:
-            t.errors = scene.error(t.outcome.observations, reference.outcome.observations)
+            t.errors = scene.error(t.outcome.observations, converged, uncertainty)
 
     options = {}                      # knob -> [(value, error, cost ratio)]
     for knob in scene.knobs:
@@ -291,7 +359,7 @@ def plan_effects(scene, out: Path, tolerance: float, jobs: int = 2, seed: int = 
         # Leaving an effect out does not make a step dearer: a ratio above 1 is timing noise.
         ceiling = 1.0 if knob.kind == "effect" else math.inf
         options[knob.name] = [(knob.values[0], 0.0, 1.0)] + [
-            (t.settings[knob.name], t.error, min(ceiling, t.outcome.loop_seconds / reference.outcome.loop_seconds))
+            (t.settings[knob.name], t.error, min(ceiling, t.outcome.loop_seconds / reference_loop))
             for t in trials if t.settings[knob.name] != knob.values[0] and not t.outcome.failure]
     candidates = []
     for combo in itertools.product(*options.values()):
@@ -311,19 +379,20 @@ def plan_effects(scene, out: Path, tolerance: float, jobs: int = 2, seed: int = 
         if batch[0][0] == reference.settings:
             decision = reference
             break
-        batch = [Trial(f"decision-{len(verified) + k + 1}", settings, predicted_error=error, predicted_cost=cost)
+        batch = [Trial(f"decision-{len(verified) + k + 1}", settings, next(seeds), predicted_error=error,
+                       predicted_cost=cost)
                  for k, (settings, error, cost) in enumerate(batch) if settings != reference.settings]
-        _run_all(scene, batch, runs, seed, jobs, progress, "verify")
+        _run_all(scene, batch, runs, jobs, progress, "verify")
         for trial in batch:
             if not trial.outcome.failure:
-                trial.errors = scene.error(trial.outcome.observations, reference.outcome.observations)
+                trial.errors = scene.error(trial.outcome.observations, converged, uncertainty)
             verified.append(trial)
         decision = next((t for t in batch if t.error <= tolerance), None)
     if decision is None:
         decision = reference
-    scene.write(decision.settings, decided, seed)
+    scene.write(decision.settings, decided, decision.seed)    # the decided deck is the run that was verified
     plan = Plan(name, scene.unit, tolerance, scene.knobs, scene.screens, reference, trials, verified, decision, fixed,
-                candidates, scene.describe(decision.settings), scene.options_record())
+                candidates, scene.describe(decision.settings), scene.options_record(), replicas, uncertainty, models)
     plan.save(out)
     return plan
 
@@ -346,7 +415,7 @@ def _screened(knob: Knob, screens: dict[str, Screen]) -> tuple | None:
     return knob.values[-1], estimate, "; ".join(reasons)
 
 
-def _run_all(scene, trials: list[Trial], runs: Path, seed: int, jobs: int, progress: bool, what: str) -> None:
+def _run_all(scene, trials: list[Trial], runs: Path, jobs: int, progress: bool, what: str) -> None:
     """Runs the trials, `jobs` at a time, with a progress bar."""
     if not trials:
         return
@@ -356,7 +425,7 @@ def _run_all(scene, trials: list[Trial], runs: Path, seed: int, jobs: int, progr
         bar = tqdm(total=len(trials), desc=f"plan: {what}", unit="run")
     pool = ThreadPoolExecutor(max_workers=jobs)
     try:
-        futures = {pool.submit(scene.run, t.settings, runs / t.name, seed): t for t in trials}
+        futures = {pool.submit(scene.run, t.settings, runs / t.name, t.seed): t for t in trials}
         for future in as_completed(futures):
             futures[future].outcome = future.result()
             if bar is not None:

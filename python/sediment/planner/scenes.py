@@ -2,8 +2,10 @@
 """The scenes the planner can measure, each as a set of knobs (an effect or a resolution, values
 ordered from the richest to the cheapest) and a way to run one setting of them and score it.
 
-- `SampleScene`: a sedimentation test written by `sediment sample`; knobs drag (difelice, dallavalle,
-  stokes), particles and courant; observables the instruments' readings, errors in points of percent finer.
+- `SampleScene`: a sedimentation test written by `sediment sample`; knobs hindrance (richardson-zaki,
+  none), drag (standard, stokes), particles and courant; observables the instruments' readings, errors in
+  points of percent finer; the reference replicated with independent seeds (its sampling error), and the
+  other drag models of the literature measured against it.
 - `DeckScene`: any deck that reads ``variable effect_NAME index yes`` for each effect it can switch
   (and any ladder variables given), prints its observables as ``RESULT``/``SERIES`` lines (as for
   `sediment sweep`) and may print ``SCREEN number value`` lines; errors relative.
@@ -21,7 +23,7 @@ import numpy as np
 from ..results import write_text
 from ..sim.deck import deck_text, index_variables
 from ..sim.run import run_batch
-from ..sim.scene import DRAGS
+from ..sim.scene import DRAGS, HINDRANCES
 from .screening import INCLUDE, MEASURE, OMIT, Screen, SedimentationTest, screen, verdict_of
 
 MARKER = ".sediment-plan"    # in a folder of trial runs: the planner owns it and may empty it
@@ -72,7 +74,7 @@ def prepare(folder: Path) -> Path:
 
 
 def decided_options(report: Path) -> tuple[dict, dict]:
-    """The `sediment sample` options (drag, particles, courant) a plan of a sedimentation
+    """The `sediment sample` options (drag, hindrance, particles, courant) a plan of a sedimentation
     test decided, and the test it was made for, from its report.json."""
     import json
 
@@ -81,12 +83,22 @@ def decided_options(report: Path) -> tuple[dict, dict]:
         decision = content["decision"]["settings"]
         if decision["drag"] not in DRAGS:
             raise ValueError(f"drag '{decision['drag']}'")
-        return ({"drag": decision["drag"], "particles": int(decision["particles"]),
+        # a plan made before the hindrance was its own choice: hindered only under drag difelice
+        hindrance = decision.get("hindrance", "difelice" if decision["drag"] == "difelice" else "none")
+        if hindrance not in HINDRANCES:
+            raise ValueError(f"hindrance '{hindrance}'")
+        return ({"drag": decision["drag"], "hindrance": hindrance, "particles": int(decision["particles"]),
                  "courant": float(decision["courant"])}, dict(content.get("scene_options", {})))
     except (json.JSONDecodeError, UnicodeDecodeError) as exc:
         raise ValueError(f"{report} is not a plan's report.json: {exc}") from None
     except (KeyError, TypeError, ValueError) as exc:
         raise ValueError(f"{report} is not the plan of a sedimentation test (no decided {exc})") from None
+
+
+# The drag models of the literature the planner measures against its reference (the standard curve with
+# Richardson & Zaki's hindrance): (drag, hindrance), Bravo et al.'s model first.
+MODELS = (("difelice", "difelice"), ("dallavalle", "richardson-zaki"), ("schiller-naumann", "difelice"),
+          ("standard", "garside"), ("standard", "difelice"))
 
 
 class SampleScene:
@@ -96,7 +108,7 @@ class SampleScene:
     screens_from_run = False          # screened from the PSD and the cylinder, before any run
 
     def __init__(self, test: SedimentationTest, options: dict, particles: list[int], courant: list[float],
-                 tolerance: float):
+                 tolerance: float, replicas: int = 3, models: bool = True):
         self.test = test
         self.options = options              # further keyword arguments of scene.plan
         self.running: set = set()           # runs under way (stopped together on an interrupt)
@@ -104,29 +116,36 @@ class SampleScene:
             raise ValueError("the particle ladder needs at least one count >= 1")
         if not courant or any(not c > 0 for c in courant):
             raise ValueError("the courant ladder needs at least one value > 0")
+        if replicas < 1:
+            raise ValueError("the reference needs at least one run (replicas >= 1)")
+        self.replicas = replicas            # reference runs with independent seeds
         for count in (max(particles), min(particles)):    # a scene the test cannot have fails here, not in a run
-            self._scene({"drag": "difelice", "particles": count, "courant": min(courant)}, 1)
+            self._scene({"drag": "standard", "hindrance": "richardson-zaki", "particles": count,
+                         "courant": min(courant)}, 1)
         self.screens = screen(test, tolerance)
-        self.knobs = [Knob("drag", ("difelice", "dallavalle", "stokes"), "effect", ("hindered", "law")),
+        self.knobs = [Knob("hindrance", ("richardson-zaki", "none"), "effect", ("hindered",)),
+                      Knob("drag", ("standard", "stokes"), "effect", ("law",)),
                       Knob("particles", tuple(sorted(set(particles), reverse=True)), "resolution"),
                       Knob("courant", tuple(sorted(set(courant))), "resolution")]
+        self.models = [{"drag": d, "hindrance": h} for d, h in MODELS] if models else []
 
     def describe(self, settings: dict) -> str:
         """The `sediment sample` options of a setting."""
-        return f"--drag {settings['drag']} --particles {settings['particles']} --courant {settings['courant']:g}"
+        return (f"--drag {settings['drag']} --hindrance {settings['hindrance']} --particles {settings['particles']} "
+                f"--courant {settings['courant']:g}")
 
     def options_record(self) -> dict:
         """The test besides the knobs, as `sediment sample --plan` checks it."""
         t = self.test
         return dict(self.options, mass=t.mass, particle_density=t.suspension.particle_density,
-                    cylinder_area=t.cylinder.area, height=t.cylinder.height)
+                    cylinder_area=t.cylinder.area, height=t.cylinder.height, temperature=t.suspension.temperature)
 
     def _scene(self, settings: dict, seed: int):
         from ..sim.scene import Effects, plan
         t = self.test
         return plan(t.psd, cylinder=t.cylinder, mass=t.mass, suspension=t.suspension, seed=seed,
                     particles=int(settings["particles"]), courant=float(settings["courant"]),
-                    effects=Effects(settings["drag"]), **self.options)
+                    effects=Effects(settings["drag"], hindrance=settings["hindrance"]), **self.options)
 
     def write(self, settings: dict, folder: Path, seed: int) -> Path:
         """Writes the scene of a setting into `folder`; returns its deck."""
@@ -156,8 +175,21 @@ class SampleScene:
         return outcome
 
     @staticmethod
-    def error(run: dict, reference: dict) -> dict[str, float]:
-        """Largest |P - P_ref| [pp] per instrument, over the reading times both have."""
+    def combine(observations: list[dict]) -> tuple[dict, dict]:
+        """The mean readings of replicated runs (the estimate of the converged answer) and the standard
+        error of that mean per reading [pp] (the spread of single runs over sqrt(runs); 0 for one run)."""
+        mean, error = {}, {}
+        for name, (x, _) in observations[0].items():
+            y = np.array([o[name][1] for o in observations])
+            mean[name] = (x, y.mean(axis=0))
+            error[name] = y.std(axis=0, ddof=1) / math.sqrt(len(y)) if len(y) > 1 else np.zeros(len(x))
+        return mean, error
+
+    @staticmethod
+    def error(run: dict, reference: dict, uncertainty: dict | None = None) -> dict[str, float]:
+        """Largest |P - P_ref| [pp] per instrument, over the reading times both have, each reading's
+        difference raised by twice the standard error of the reference at it (the distance from the
+        converged answer that the reference's own sampling cannot rule out)."""
         errors = {}
         for name, (x_ref, y_ref) in reference.items():
             if name not in run:
@@ -165,7 +197,8 @@ class SampleScene:
                 continue
             x, y = run[name]
             common, i, j = np.intersect1d(x, x_ref, return_indices=True)
-            errors[name] = float(np.max(np.abs(y[i] - y_ref[j]))) if len(common) else math.inf
+            margin = 2 * uncertainty[name][j] if uncertainty else 0.0
+            errors[name] = float(np.max(np.abs(y[i] - y_ref[j]) + margin)) if len(common) else math.inf
         return errors
 
 
@@ -220,6 +253,8 @@ class DeckScene:
         self.knobs = [Knob(name, ("yes", "no"), "effect", (name,)) for name, _ in effects]
         self.knobs += [Knob(name, tuple(values), "resolution") for name, values in ladders.items()]
         self.screens: list[Screen] = []
+        self.replicas = 1                   # a deck's runs take no seed: one reference run
+        self.models: list[dict] = []
 
     def options_record(self) -> dict:
         """The deck and the variables every run had."""
@@ -296,7 +331,12 @@ class DeckScene:
         return outcome
 
     @staticmethod
-    def error(run: dict, reference: dict) -> dict[str, float]:
+    def combine(observations: list[dict]) -> tuple[dict, None]:
+        """The one reference run's observables (a deck runs without a seed)."""
+        return observations[0], None
+
+    @staticmethod
+    def error(run: dict, reference: dict, uncertainty=None) -> dict[str, float]:
         """Relative error per observable (a series: largest difference over the reference's magnitude)."""
         from ..studies.sweep import relative_error
 

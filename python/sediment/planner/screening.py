@@ -24,7 +24,6 @@ from ..lab.synthetic import settling_column
 from ..sim.scene import Cylinder
 
 BOLTZMANN = 1.380649e-23      # J/K
-ROOM_TEMPERATURE = 293.15     # K, the 20 C of the water's properties
 BED_PACKING = 0.6             # solid fraction of a settled silt bed (random loose to close packing 0.55-0.64)
 PIPETTE_DEPTH = 0.10          # m, as in the readouts' default
 FILM_REBOUND_STOKES = 10.0    # approach Stokes number below which a squeeze film stops a rebound (Gondret et al. 2002)
@@ -72,11 +71,11 @@ class Screen:
     reason: str
 
 
-def terminal_speeds(suspension: Suspension, diameter: np.ndarray, law: str = "dallavalle",
-                    voidage: float = 1.0) -> np.ndarray:
-    """Terminal speed [m/s] of each diameter under a drag law (difelice: in a suspension of fluid
-    fraction `voidage`, with plain buoyancy)."""
-    model = _core.DragModel(law, suspension.fluid_density, suspension.viscosity)
+def terminal_speeds(suspension: Suspension, diameter: np.ndarray, law: str = "standard",
+                    voidage: float = 1.0, hindrance: str = "none") -> np.ndarray:
+    """Terminal speed [m/s] of each diameter under a drag law (hindered, or law difelice: in a suspension
+    of fluid fraction `voidage`, with plain buoyancy)."""
+    model = _core.DragModel(law, suspension.fluid_density, suspension.viscosity, hindrance=hindrance)
     weight = (suspension.particle_density - suspension.fluid_density) * suspension.gravity * math.pi / 6
     return np.array([model.steady_speed(float(d), weight * float(d) ** 3, voidage)[0] for d in diameter])
 
@@ -165,8 +164,8 @@ def screen(test: SedimentationTest, tolerance: float = 0.5) -> list[Screen]:
     if not tolerance > 0:
         raise ValueError(f"the tolerance must be > 0 percentage points, not {tolerance:g}")
     s, t = test.suspension, test
-    dallavalle = lambda d: terminal_speeds(s, d)    # noqa: E731 - the reference speeds
-    model = ReadingModel(test, dallavalle)
+    single = lambda d: terminal_speeds(s, d)    # noqa: E731 - the reference speeds (the standard curve)
+    model = ReadingModel(test, single)
     lo, hi = t.psd.span()
     phi = t.solid_fraction
     screens = []
@@ -174,18 +173,18 @@ def screen(test: SedimentationTest, tolerance: float = 0.5) -> list[Screen]:
     v_max = float(terminal_speeds(s, np.array([hi]))[0])
     reynolds = s.fluid_density * v_max * hi / s.viscosity
     change = model.change(s.stokes_speed)
-    screens.append(Screen("law", "drag beyond Stokes (Dallavalle)", "largest particle Reynolds number", reynolds, change,
-                          verdict_of(change, tolerance),
-                          f"Stokes' law instead of Dallavalle's moves a reading by up to {change:.3g} pp"))
+    screens.append(Screen("law", "drag beyond Stokes (the standard drag curve)", "largest particle Reynolds number",
+                          reynolds, change, verdict_of(change, tolerance),
+                          f"Stokes' law instead of the standard curve moves a reading by up to {change:.3g} pp"))
 
-    change = model.change(lambda d: terminal_speeds(s, d, "difelice", 1 - phi))
-    screens.append(Screen("hindered", "hindered settling and mixture buoyancy (Di Felice)", "initial solid fraction",
+    change = model.change(lambda d: terminal_speeds(s, d, "standard", 1 - phi, "richardson-zaki"))
+    screens.append(Screen("hindered", "hindered settling (Richardson & Zaki)", "initial solid fraction",
                           phi, change, verdict_of(change, tolerance),
-                          f"settling {100 * (1 - (1 - phi) ** 4.65):.3g} % slower at phi0 = {phi:.3g} moves a "
+                          f"settling {100 * (1 - (1 - phi) ** 4.7):.3g} % slower at phi0 = {phi:.3g} moves a "
                           f"reading by up to {change:.3g} pp (at phi0 throughout: phi falls as grains leave)"))
 
     diameter, share, contacts, delay = encounters(test)
-    slower = lambda d: dallavalle(d) / (1 + np.interp(np.log(d), np.log(diameter), delay))    # noqa: E731
+    slower = lambda d: single(d) / (1 + np.interp(np.log(d), np.log(diameter), delay))    # noqa: E731
     change = model.change(slower)
     bed = t.mass / (s.particle_density * t.cylinder.area * BED_PACKING)
     clearance = t.cylinder.height - lowest_sensed_depth(test) - bed
@@ -208,14 +207,15 @@ def screen(test: SedimentationTest, tolerance: float = 0.5) -> list[Screen]:
                           f"{'<' if film < FILM_REBOUND_STOKES else '>='} {FILM_REBOUND_STOKES:g} they "
                           f"{'stop every rebound' if film < FILM_REBOUND_STOKES else 'let grains rebound'}"))
 
-    tau = float(_core.relaxation_time("dallavalle", s.fluid_density, s.viscosity, hi, s.particle_density))
+    tau = float(_core.relaxation_time("standard", s.fluid_density, s.viscosity, hi, s.particle_density))
     first = float(model.times[1])
     screens.append(Screen("inertia", "particle inertia", "relaxation time / first reading time", tau / first, None,
                           INCLUDE, f"the largest grain reaches its terminal speed in {tau:.3g} s; DEM integrates "
                           "inertia at no extra cost"))
 
     drho = s.particle_density - s.fluid_density
-    d_unit = (6 * BOLTZMANN * ROOM_TEMPERATURE / (math.pi * drho * s.gravity)) ** 0.25    # Pe = 1
+    kelvin = 273.15 + (s.temperature if s.temperature is not None else 20.0)
+    d_unit = (6 * BOLTZMANN * kelvin / (math.pi * drho * s.gravity)) ** 0.25    # Pe = 1
     peclet = (lo / d_unit) ** 4
     below = float(t.psd.at(np.array([d_unit]))[0])
     screens.append(Screen("brownian", "Brownian motion", "Peclet number of the smallest grain", peclet, None, REPORT,
@@ -223,7 +223,7 @@ def screen(test: SedimentationTest, tolerance: float = 0.5) -> list[Screen]:
                           "competes with settling; not simulated"))
 
     ratio = hi / t.cylinder.diameter
-    change = model.change(lambda d: dallavalle(d) / (1 + 2.1 * d / t.cylinder.diameter))
+    change = model.change(lambda d: single(d) / (1 + 2.1 * d / t.cylinder.diameter))
     screens.append(Screen("wall", "cylinder wall (Ladenburg)", "largest diameter / cylinder diameter", ratio, change,
                           REPORT, f"the wall slows grains by up to {100 * 2.1 * ratio:.2g} %, moving a reading by up "
                           f"to {change:.3g} pp; not simulated (the sub-volume is periodic)"))

@@ -44,25 +44,63 @@ class Cylinder:
         return math.sqrt(4 * self.area / math.pi)
 
 
-# The drag of a test, richest first: Dallavalle's curve with Di Felice's hindrance on the local
-# concentration, Dallavalle's curve, Schiller & Naumann's, Stokes' law. The default is the first:
-# left out, the hindrance moved the readings of each of Bravo et al.'s five samples at 60 g/L by 2 to
-# 17 points of percent finer (docs/effects.md).
-DRAGS = ("difelice", "dallavalle", "schiller-naumann", "stokes")
+# The single-sphere drag of a test: the measured standard drag curve (the default), Schiller &
+# Naumann's, Dallavalle's, Stokes' law; and Bravo et al.'s model, Dallavalle's curve under Di Felice's
+# hindrance, named difelice as in the paper (docs/physics.md).
+DRAGS = ("standard", "schiller-naumann", "dallavalle", "stokes", "difelice")
+# How the local concentration hinders the drag: Richardson & Zaki's measured exponent (Rowe's smooth
+# fit, the default: left out, the hindrance moves the readings of Bravo et al.'s five samples at 60 g/L
+# by points of percent finer, docs/effects.md), Garside & Al-Dibouni's, Di Felice's, none.
+HINDRANCES = ("richardson-zaki", "garside", "difelice", "none")
 
 
 @dataclass(frozen=True)
 class Effects:
-    """What the scene simulates beyond buoyancy."""
+    """What the scene simulates beyond buoyancy. drag difelice carries its own hindrance (Di Felice's)."""
 
-    drag: str = "difelice"          # one of DRAGS; readouts assume Stokes, so the difference shows
+    drag: str = "standard"          # one of DRAGS; readouts assume Stokes, so the difference shows
     contacts: bool = False          # Hertz contacts between grains and with the floor
     lubrication: bool = False       # squeeze film between close grains (implies contacts)
+    hindrance: str = "richardson-zaki"    # one of HINDRANCES
+    # "mixture": buoyancy from the local suspension density on top of the hindrance's plain-buoyancy form,
+    # as some models take a measured exponent (the error budget's row; docs/physics.md 3)
+    buoyancy: str = "plain"
+
+    def __post_init__(self) -> None:
+        if self.buoyancy not in ("plain", "mixture"):
+            raise ValueError(f"buoyancy must be plain or mixture, not '{self.buoyancy}'")
+        if self.drag not in DRAGS:
+            raise ValueError(f"drag must be one of {', '.join(DRAGS)}, not '{self.drag}'")
+        if self.hindrance not in HINDRANCES:
+            raise ValueError(f"hindrance must be one of {', '.join(HINDRANCES)}, not '{self.hindrance}'")
+        if self.drag == "difelice":    # Bravo et al.'s model: its hindrance is part of it
+            object.__setattr__(self, "hindrance", "difelice")
+        else:
+            _core.DragModel(self.drag, 1000.0, 1e-3, hindrance=self.hindrance)    # refuses a pair that does not go
 
     @property
     def hindered(self) -> bool:
-        """Whether the drag follows the local concentration (Di Felice)."""
-        return self.drag == "difelice"
+        """Whether the drag follows the local concentration."""
+        return self.hindrance != "none"
+
+    @property
+    def single_law(self) -> str:
+        """The single-sphere drag law (Dallavalle's under law difelice)."""
+        return "dallavalle" if self.drag == "difelice" else self.drag
+
+    def describe(self) -> str:
+        """The drag in words, as decks and reports name it."""
+        if self.drag == "difelice":
+            return "difelice (Dallavalle's curve hindered by Di Felice, Bravo et al.)"
+        return self.drag + (f", hindered ({self.hindrance})" if self.hindered else ", unhindered")
+
+    def fix_arguments(self) -> str:
+        """The law, hindrance and concentration keywords of fix fluid/drag."""
+        if self.drag == "difelice":
+            return "law difelice concentration c_conc"
+        if self.hindered:
+            return f"law {self.drag} hindrance {self.hindrance} concentration c_conc"
+        return f"law {self.drag}"
 
     @property
     def interacting(self) -> bool:
@@ -197,7 +235,7 @@ def contact_modulus(particle_density: float, fastest_speed: float, deposit_press
 
 
 def terminal_speed(suspension: Suspension, diameter: float, law: str) -> float:
-    """Terminal speed [m/s] of a grain of `diameter` under `law` in the suspension's fluid."""
+    """Terminal speed [m/s] of a lone grain of `diameter` under `law` in the suspension's fluid."""
     drag_law = "dallavalle" if law == "difelice" else law    # Di Felice alone is Dallavalle's C_d
     speed, _ = _core.terminal_velocity(drag_law, suspension.fluid_density, suspension.viscosity, 0.0, float(diameter),
                                        suspension.particle_density, suspension.gravity)
@@ -247,8 +285,6 @@ def plan(psd: PSD, *, geometry: str = "column", cylinder: Cylinder = Cylinder(),
     """
     if geometry not in GEOMETRIES:
         raise ValueError(f"geometry must be one of {', '.join(GEOMETRIES)}, not '{geometry}'")
-    if effects.drag not in DRAGS:
-        raise ValueError(f"drag must be one of {', '.join(DRAGS)}, not '{effects.drag}'")
     if effects.interacting and particles is not None:
         raise ValueError("contacts and lubrication need real grains: use --real-grains (no parcels)")
     if not (mass > 0 and layers >= 10 and t_end > 0 and courant > 0):
@@ -434,7 +470,7 @@ def _deck(scene: Scene, data: str, layer_file: str) -> str:
         f"{scene.cylinder.area * 1e4:.4g} cm2 x {scene.cylinder.height:.4g} m (fraction {scene.volume_fraction:.3g}),",
         f"# {len(scene.diameter)} atoms in {int(np.sum(c.count > 0))} size classes standing for {c.represented_grains():.4g} grains "
         f"({scene.mass * 1e3:.4g} g sample, c0 = {scene.initial_concentration:.4g} kg/m3).",
-        f"# Effects: drag ({'dallavalle, hindered (Di Felice)' if e.hindered else e.drag}), buoyancy"
+        f"# Water at {f.temperature_text()}; effects: drag ({e.describe()}), buoyancy"
         f"{', contacts' if e.contacts or e.lubrication else ', deposit on the floor (no contacts)'}"
         f"{', lubrication' if e.lubrication else ''}.",
         f"# {len(stages)} stages, {total_steps} steps to {scene.t_end:g} s; layer frames every {frames_every} steps.",
@@ -472,14 +508,12 @@ def _deck(scene: Scene, data: str, layer_file: str) -> str:
         "",
         f"fix             grav all gravity {f.gravity:.12g} vector {gravity}",
         f"fix             water all fluid density {f.fluid_density:.12g} viscosity {f.viscosity:.12g}",
-        "fix             buoy all fluid/buoyancy water",
         f"compute         conc all concentration/grid layers {up} {scene.layers} bounds 0 {scene.height:.12g}"
         f"{f' thickness {scene.thickness:.12g}' if slab else ''} weight d_weight every ${{field_every}}",
+        "fix             buoy all fluid/buoyancy water"
+        + (f" mixture c_conc {f.particle_density:.12g}" if e.buoyancy == "mixture" else ""),
     ]
-    if e.hindered:
-        lines.append("fix             drag all fluid/drag water law difelice concentration c_conc")
-    else:
-        lines.append(f"fix             drag all fluid/drag water law {e.drag}")
+    lines.append(f"fix             drag all fluid/drag water {e.fix_arguments()}")
     if e.interacting:
         lines += pair_lines(scene)
         lines += [f"fix             floor all wall/gran granular {contact_model(scene)} {up}plane 0 NULL",

@@ -1,0 +1,93 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
+"""The test's physics as options (drag law, hindrance, water temperature) and the error budget: what
+each modelling choice moves, and the band a readout puts around its readings (docs/error-budget.md)."""
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from sediment import cli
+from sediment.lab.psd import read_psd
+from sediment.lab.readout import Suspension
+from sediment.sim.scene import Effects
+from sediment.studies.budget import CHOICES, band_of, error_budget
+
+PSDS = Path(__file__).resolve().parents[2] / "examples" / "granulometry" / "psd"
+
+
+def test_the_deck_names_the_drag_the_hindrance_and_the_water(tmp_path):
+    out = tmp_path / "warm"
+    assert cli.main(["sample", str(PSDS / "sample5.csv"), "--particles", "500", "--temperature", "25",
+                     "--hindrance", "garside", "--out", str(out)]) == 0
+    deck = (out / "in.sedimentation").read_text()
+    water = Suspension.at_temperature(25.0)
+    assert f"density {water.fluid_density:.12g} viscosity {water.viscosity:.12g}" in deck
+    assert "fluid/drag water law standard hindrance garside concentration c_conc" in deck
+    assert "# Water at 25 C" in deck
+    bravo = tmp_path / "bravo"
+    assert cli.main(["sample", str(PSDS / "sample5.csv"), "--particles", "500", "--drag", "difelice",
+                     "--out", str(bravo)]) == 0
+    assert "fluid/drag water law difelice concentration c_conc" in (bravo / "in.sedimentation").read_text()
+    clear = tmp_path / "clear"
+    assert cli.main(["sample", str(PSDS / "sample5.csv"), "--particles", "500", "--hindrance", "none",
+                     "--out", str(clear)]) == 0
+    deck = (clear / "in.sedimentation").read_text()
+    assert "fluid/drag water law standard\n" in deck and "concentration c_conc" not in deck.split("fluid/drag")[1]
+
+
+@pytest.mark.parametrize("args, message", [
+    (["--drag", "difelice", "--hindrance", "garside"], "--drag difelice is Dallavalle's curve with Di Felice's"),
+    (["--drag", "schiller-naumann", "--hindrance", "richardson-zaki"], "does not take hindrance richardson-zaki"),
+    (["--temperature", "45"], "within 0-40 C"),
+    (["--drag", "standart"], "invalid choice: 'standart'"),
+])
+def test_physics_that_does_not_go_is_refused(tmp_path, capsys, args, message):
+    try:
+        code = cli.main(["sample", str(PSDS / "sample5.csv"), "--out", str(tmp_path / "o"), *args])
+    except SystemExit as exit_:    # argparse refuses a value of a choice or type
+        code = exit_.code
+    assert code == 2
+    assert message in capsys.readouterr().err
+    assert not (tmp_path / "o").exists()
+
+
+def test_effects_keep_bravo_et_al_whole():
+    assert Effects("difelice").hindrance == "difelice"
+    assert Effects().describe() == "standard, hindered (richardson-zaki)"
+    with pytest.raises(ValueError, match="buoyancy must be plain or mixture"):
+        Effects(buoyancy="heavy")
+
+
+def test_budget_rows_follow_the_physics(tmp_path):
+    """A short test (30 min, 100 layers): the drag curve and the hindrance exponent move the readings, a
+    choice that changes nothing moves nothing, and the readout takes the physical total as its band."""
+    psd = read_psd(PSDS / "sample5.csv")
+    keep = [c for c in CHOICES if c.key in ("drag", "exponent", "warmer", "courant")]
+    budget = error_budget(psd, tmp_path / "runs", particles=1500, courant=2.0, replicas=2, jobs=2, progress=False,
+                          choices=keep, name="sample5", t_end=1800.0, layers=100, classes=20)
+    rows = {k: change for k, _, _, change in budget.rows}
+    assert set(rows) == {"drag", "exponent", "warmer", "courant", "parcels", "wall", "brownian"}
+    for key in ("drag", "exponent", "warmer"):
+        assert max(rows[key].values()) > 0.05, key       # each a real change of the physics
+    assert 0 < rows["wall"]["pipette"] < 0.2 and 0 < rows["brownian"]["pipette"] < 0.1
+    total = budget.physical_total()
+    assert all(total[n] >= max(rows["drag"][n], rows["exponent"][n]) for n in total)
+    from sediment.studies.budget import save
+    save([budget], tmp_path)
+    assert band_of(tmp_path / "budget.json") == pytest.approx(total)
+    (tmp_path / "empty.json").write_text("[]")
+    with pytest.raises(ValueError, match="not a budget.json"):
+        band_of(tmp_path / "empty.json")
+    with pytest.raises(ValueError, match="no sample 'sample9'"):
+        band_of(tmp_path / "budget.json", "sample9")
+    # the readout's band: each reading's low and high ends
+    run = tmp_path / "runs" / "reference"
+    assert cli.main(["readout", str(run / "layers.h5"), "--band", str(tmp_path / "budget.json"),
+                     "--out", str(tmp_path / "readout")]) == 0
+    rows = np.genfromtxt(tmp_path / "readout" / "pipette.csv", delimiter=",", names=True)
+    assert np.allclose(rows["high"] - rows["percent_finer"], total["pipette"], atol=1e-3)
+    summary = json.loads((tmp_path / "budget.json").read_text())[0]
+    assert summary["sample"] == "sample5" and "physical_total_pp" in summary
