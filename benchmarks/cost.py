@@ -50,7 +50,9 @@ SCENES = {"plain": "nve/sphere + gravity (reference)",
           "schiller": "as drag with schiller-naumann (a Cd jump, not reached)",
           "zhangli": "as drag with zhang-li in water (two Cd jumps, not reached)",
           "bingham": "as zhangli in a Bingham fluid (yield stress half the weight)",
+          "standard": "as drag with the standard drag curve (the sedimentation test's law)",
           "hindered": "as nonlinear + concentration/grid (400 layers) + difelice",
+          "richardson": "as standard + concentration/grid (400 layers) + hindrance richardson-zaki",
           "cells": "as hindered on 20 x 20 x 100 3d cells",
           "lubricated": "as drag + pair lubricate/fluid"}
 
@@ -116,7 +118,9 @@ TARGETS = [
     ("nonlinear implicit (schiller-naumann) / peer", lambda t: t["schiller"] / t["peer"], 2.0),
     ("nonlinear implicit (zhang-li, water) / peer", lambda t: t["zhangli"] / t["peer"], 2.0),
     ("nonlinear implicit (zhang-li, Bingham) / peer", lambda t: t["bingham"] / t["peer"], 2.0),
+    ("nonlinear implicit (standard curve) / peer", lambda t: t["standard"] / t["peer"], 2.0),
     ("grid + Di Felice on top of nonlinear / peer", lambda t: (t["hindered"] - t["nonlinear"]) / t["peer"], 1.0),
+    ("grid + Richardson-Zaki on top of standard / peer", lambda t: (t["richardson"] - t["standard"]) / t["peer"], 1.0),
     ("3d cells + Di Felice on top of nonlinear / peer", lambda t: (t["cells"] - t["nonlinear"]) / t["peer"], 2.0),
     ("lubrication on top of implicit stokes / plain", lambda t: (t["lubricated"] - t["drag"]) / t["plain"], None),
 ]

@@ -16,6 +16,7 @@
 #include "modify.h"
 #include "update.h"
 
+#include <algorithm>
 #include <cstring>
 
 using namespace LAMMPS_NS;
@@ -23,7 +24,7 @@ using namespace FixConst;
 
 FixFluidBuoyancy::FixFluidBuoyancy(LAMMPS *lmp, int narg, char **arg) :
     Fix(lmp, narg, arg), fluid_id(nullptr), gravity_id(nullptr), mixture_id(nullptr), mixture(nullptr),
-    solid_density(0.0), fluid(nullptr), gravity(nullptr)
+    solid_density(0.0), max_fraction(0.64), fluid(nullptr), gravity(nullptr)
 {
   if (narg < 4) error->all(FLERR, "Fix fluid/buoyancy: expected 'fix ID group fluid/buoyancy FLUID-ID'");
   fluid_id = utils::strdup(arg[3]);
@@ -40,8 +41,12 @@ FixFluidBuoyancy::FixFluidBuoyancy(LAMMPS *lmp, int narg, char **arg) :
       mixture_id = utils::strdup(args.text(1));
       solid_density = args.positive(2, "mixture solid density");
       nvalues = 2;
+    } else if (args.is("max_fraction")) {
+      args.need(1, "a value");
+      max_fraction = args.number(1);
+      if (!(max_fraction > 0.0 && max_fraction < 1.0)) args.fail("max_fraction must be in (0, 1)");
     } else {
-      args.unknown("gravity or mixture");
+      args.unknown("gravity, mixture or max_fraction");
     }
     args.next(nvalues);
   }
@@ -115,8 +120,11 @@ void FixFluidBuoyancy::post_force(int /*vflag*/)
     const sediment::Submergence sub =
         everywhere ? sediment::Submergence{1.0, 1.0, 1.0} : fluid->immersion(x[i], radius[i]);
     if (!sub.any()) continue;
-    // The suspension around the sphere, or the clear fluid.
-    const double density = fraction ? sediment::mixture_density(rho, solid_density, fraction[i]) : rho;
+    // The suspension around the sphere, or the clear fluid. The local fraction is capped as the drag
+    // caps it: where parcels stop on a floor without contacts their grid fraction exceeds any packing
+    // (even 1), and an uncapped mixture would float the deposit.
+    const double density =
+        fraction ? sediment::mixture_density(rho, solid_density, std::clamp(fraction[i], 0.0, max_fraction)) : rho;
     const double displaced = sediment::displaced_mass(density, radius[i], sub);
     for (int k = 0; k < 3; ++k) {
       const double fb = -displaced * g[k];

@@ -31,6 +31,7 @@ class FixFluidBuoyancy : public Fix {
   char *fluid_id, *gravity_id, *mixture_id;
   class Compute *mixture;       // per-atom local solid fraction: buoyancy of the suspension
   double solid_density;         // density of the suspended solids, for the mixture density
+  double max_fraction;          // the local solid fraction is capped here
   class FixFluid *fluid;
   double *gravity;            // acceleration vector owned by the fix gravity
   RankSums<4> totals;         // force on the group (3) and number of spheres in the fluid

@@ -1044,6 +1044,7 @@ BAD_INPUT = [
     ("fix f all fluid density 1000 viscosity 1e-3\nfix d all fluid/drag f law schiller-naumann hindrance garside concentration c_x", "jump in Cd at Re = 1000"),
     ("fix f all fluid density 1000 viscosity 1e-3\nfix d all fluid/drag f law difelice hindrance garside concentration c_x", "law difelice is Dallavalle's drag with Di Felice's hindrance"),
     ("fix f all fluid density 1000 viscosity 1e-3\nfix d all fluid/drag f law standart", "unknown law 'standart'"),
+    ("fix f all fluid density 1000 viscosity 1e-3\nfix b all fluid/buoyancy f max_fraction 1", "max_fraction must be in (0, 1)"),
     ("fix f all fluid density 1000 viscosity 1e-3\nfix d all fluid/drag f law difelice concentration c_x\nrun 0", "compute 'x' does not exist"),
     ("fix f all fluid density 1000 viscosity 1e-3\nfix d all fluid/drag f law difelice concentration c_x buoyancy heavy", "buoyancy must be plain or mixture"),
     ("fix f all fluid density 1000 viscosity 1e-3\nfix d all fluid/drag f law difelice concentration c_x max_fraction 1.2", "max_fraction must be in (0, 1)"),
