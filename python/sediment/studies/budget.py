@@ -10,6 +10,10 @@ with independent seeds. The laboratory reduces every run as it would the real te
 recorded temperature (the composite correction of the hydrometer takes out the density of the water and
 dispersant, so only the settling feels them). The cylinder wall and Brownian motion are not simulated
 (the sub-volume is periodic; grains carry no thermal noise): their rows are analytic estimates.
+
+Rows of three kinds: the uncertainties of the best physics ("physical"; their root sum of squares is the
+band a readout can put around a simulated reading), the literature's other models ("model": how far
+each lies from the best physics, e.g. Bravo et al.'s), and the resolution ("numerical").
 """
 from __future__ import annotations
 
@@ -45,25 +49,30 @@ class Choice:
 
     key: str
     label: str
-    kind: str                     # "physical", "numerical" or "model" (a whole model of the literature)
+    # "physical": an uncertainty of the best physics (its rows make the band); "model": another model of
+    # the literature, how far it lies from the best physics; "numerical": the resolution
+    kind: str
     effects: dict = field(default_factory=dict)    # Effects fields that differ from the reference
     temperature: float = 0.0      # water warmer (+) or colder (-) than recorded [C]
     dispersant: bool = False
+    drag_factor: float = 1.0      # the fluid's viscosity times this: the low-Re drag times this
     courant_factor: float = 1.0
 
 
 CHOICES = (
-    Choice("drag", "drag curve: Dallavalle's instead of the standard curve", "physical", {"drag": "dallavalle"}),
-    Choice("exponent", "hindrance exponent: Garside & Al-Dibouni's 5.1 instead of 4.7", "physical",
-           {"hindrance": "garside"}),
-    Choice("voidage", "hindrance function: Di Felice's instead of Richardson & Zaki's", "physical",
-           {"hindrance": "difelice"}),
-    Choice("mixture", "mixture buoyancy on top of the measured exponent", "physical", {"buoyancy": "mixture"}),
+    Choice("curve", "drag curve: 1 % more drag (the standard curve against Davies's fit below Re = 4)", "physical",
+           drag_factor=1.01),
+    Choice("exponent", "hindrance exponent: Garside & Al-Dibouni's 5.1 instead of Richardson & Zaki's 4.7",
+           "physical", {"hindrance": "garside"}),
     Choice("warmer", "water 1 C warmer than recorded", "physical", temperature=1.0),
     Choice("colder", "water 1 C colder than recorded", "physical", temperature=-1.0),
     Choice("dispersant", "5 g/L sodium hexametaphosphate (estimated +3 kg/m3, +1 % viscosity)", "physical",
            dispersant=True),
     Choice("courant", "time step: 4 times the reference's Courant number", "numerical", courant_factor=4.0),
+    Choice("dallavalle", "drag curve: Dallavalle's instead of the standard curve", "model", {"drag": "dallavalle"}),
+    Choice("voidage", "hindrance function: Di Felice's instead of Richardson & Zaki's", "model",
+           {"hindrance": "difelice"}),
+    Choice("mixture", "mixture buoyancy on top of the measured exponent", "model", {"buoyancy": "mixture"}),
     Choice("bravo", "Bravo et al.'s model (Dallavalle's curve, Di Felice's hindrance)", "model",
            {"drag": "difelice"}),
 )
@@ -79,9 +88,9 @@ class Budget:
 
     def physical_total(self) -> dict[str, float]:
         """Root sum of squares of the physical rows per instrument (both temperature rows count as one,
-        the larger; both hindrance rows as one, the larger: each pair is one uncertain quantity)."""
+        the larger: they are one uncertain quantity)."""
         changes = {k: c for k, _, kind, c in self.rows if kind == "physical"}
-        pairs = (("warmer", "colder"), ("exponent", "voidage"))
+        pairs = (("warmer", "colder"),)
         total = {}
         for name in INSTRUMENTS:
             terms = []
@@ -198,6 +207,8 @@ def error_budget(psd: PSD, folder: Path, *, particles: int = 20000, courant: flo
         if c.dispersant:
             water = replace(water, fluid_density=water.fluid_density + DISPERSANT_DENSITY_RISE,
                             viscosity=water.viscosity * DISPERSANT_VISCOSITY_RATIO, temperature=None)
+        if c.drag_factor != 1.0:
+            water = replace(water, viscosity=water.viscosity * c.drag_factor, temperature=None)
         runs[c.key] = (replace(reference, **c.effects), water, courant * c.courant_factor, seed)
 
     def one(key: str) -> dict:
