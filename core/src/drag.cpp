@@ -11,12 +11,13 @@ namespace sediment {
 
 namespace {
 
-struct LawName {
-  DragLaw law;
+// A choice and its name in decks and on the command line.
+template <class Choice> struct Named {
+  Choice value;
   const char *name;
 };
 
-constexpr LawName law_names[] = {
+constexpr Named<DragLaw> law_names[] = {
     {DragLaw::Stokes, "stokes"},
     {DragLaw::SchillerNaumann, "schiller-naumann"},
     {DragLaw::Dallavalle, "dallavalle"},
@@ -26,19 +27,28 @@ constexpr LawName law_names[] = {
     {DragLaw::Standard, "standard"},
 };
 
-struct HindranceName {
-  Hindrance hindrance;
-  const char *name;
-};
-
-constexpr HindranceName hindrance_names_table[] = {
+constexpr Named<Hindrance> hindrance_names_table[] = {
     {Hindrance::None, "none"},
     {Hindrance::DiFelice, "difelice"},
     {Hindrance::RichardsonZaki, "richardson-zaki"},
     {Hindrance::Garside, "garside"},
 };
 
-template <class Table> std::string joined_names(const Table &table)
+template <class Choice, size_t n> std::optional<Choice> from_name(const Named<Choice> (&table)[n], std::string_view name)
+{
+  for (const auto &entry : table)
+    if (name == entry.name) return entry.value;
+  return std::nullopt;
+}
+
+template <class Choice, size_t n> const char *name_of(const Named<Choice> (&table)[n], Choice value)
+{
+  for (const auto &entry : table)
+    if (value == entry.value) return entry.name;
+  return "unknown";
+}
+
+template <class Choice, size_t n> std::string joined_names(const Named<Choice> (&table)[n])
 {
   std::string names;
   for (const auto &entry : table) {
@@ -50,36 +60,12 @@ template <class Table> std::string joined_names(const Table &table)
 
 }    // namespace
 
-std::optional<DragLaw> drag_law_from_name(std::string_view name)
-{
-  for (const auto &entry : law_names)
-    if (name == entry.name) return entry.law;
-  return std::nullopt;
-}
-
-const char *drag_law_name(DragLaw law)
-{
-  for (const auto &entry : law_names)
-    if (law == entry.law) return entry.name;
-  return "unknown";
-}
-
+std::optional<DragLaw> drag_law_from_name(std::string_view name) { return from_name(law_names, name); }
+const char *drag_law_name(DragLaw law) { return name_of(law_names, law); }
 std::string drag_law_names() { return joined_names(law_names); }
 
-std::optional<Hindrance> hindrance_from_name(std::string_view name)
-{
-  for (const auto &entry : hindrance_names_table)
-    if (name == entry.name) return entry.hindrance;
-  return std::nullopt;
-}
-
-const char *hindrance_name(Hindrance hindrance)
-{
-  for (const auto &entry : hindrance_names_table)
-    if (hindrance == entry.hindrance) return entry.name;
-  return "unknown";
-}
-
+std::optional<Hindrance> hindrance_from_name(std::string_view name) { return from_name(hindrance_names_table, name); }
+const char *hindrance_name(Hindrance hindrance) { return name_of(hindrance_names_table, hindrance); }
 std::string hindrance_names() { return joined_names(hindrance_names_table); }
 
 bool law_takes_hindrance(DragLaw law, Hindrance hindrance)

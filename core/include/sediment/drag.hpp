@@ -83,12 +83,12 @@ inline DragCurve schiller_naumann_curve(double re, double power)
 // correlation, fitted to critically selected measurements, made continuous (docs/physics.md 2.1):
 //   Re < 25.66:       Cd Re / 24 = 1 + 0.1315 Re^(0.82 - 0.05 w),  w = log10 Re  (their piece for
 //                     0.01 < Re <= 20, kept down to Re -> 0, where it tends to Stokes' 24 / Re, and up
-//                     to where it meets the next piece, 0.74 % above theirs at Re = 20 at most)
+//                     to where it meets the next piece, 0.74 % below theirs at Re = 20 at most)
 //   25.66 <= Re < 260: Cd Re / 24 = 1 + 0.1935 Re^0.6305
 //   Re >= 260:         log10 Cd = a polynomial in w per range, the constant terms moved by at most
 //                     3.3e-4 (0.07 % in Cd) so that each range starts where the last ends.
 // Every piece is one power or exponential: the caller gives ln Re (NaN stays NaN; ln Re below -700,
-// Re = 0 included, is the Stokes limit) and the exponential of standard_curve_argument.
+// Re = 0 included, is the Stokes limit) and the exponential of argument().
 namespace standard_curve {
 constexpr double low_to_mid = 25.661577155540865;    // where the two lower pieces cross
 constexpr double mid_to_high = 260.0;
@@ -286,10 +286,11 @@ class DragModel {
     single_curves(re, out, n, kind);
     hinder(re, voidage, out, n, kind);
   }
-  // The two parts of curves() under no or Di Felice's hindrance. The single-sphere curves inline, for a caller's loop compiled for
-  // its own instruction set; the law is fixed outside the loop, so each law's loop is vectorised
-  // (with the switch inside, each sphere took an indirect jump and stayed scalar), and
-  // Schiller-Naumann's powers come from exp_many and log_many of this kind.
+  // The two parts of curves() under no or Di Felice's hindrance. The single-sphere curves inline, for
+  // a caller's loop compiled for its own instruction set; the law is fixed outside the loop, so each
+  // law's loop is vectorised (with the switch inside, each sphere took an indirect jump and stayed
+  // scalar), and the powers of Schiller-Naumann and the standard curve come from exp_many and
+  // log_many of this kind.
   [[gnu::always_inline]] void single_curves(const double *re, DragCurve *out, int n, BatchMath kind) const
   {
     switch (single_law_) {
