@@ -367,3 +367,18 @@ TEST(DragLaw, SmoothLawsAreThoseWithoutYieldOrJumps)
   EXPECT_FALSE(DragModel(DragLaw::ZhangLiSmooth, clay).smooth());       // yield stress
   EXPECT_FALSE(DragModel(DragLaw::Stokes, clay).smooth());
 }
+
+TEST(Hindrance, ContinuousWhereTheSuspensionClears)
+{
+  // A sphere whose fraction falls to zero takes the single-sphere law: no jump at eps = 1, where the
+  // model stops applying the hindrance.
+  for (const HindranceBuoyancy buoyancy : {HindranceBuoyancy::Plain, HindranceBuoyancy::Mixture})
+    for (const Hindrance hindrance : {Hindrance::RichardsonZaki, Hindrance::Garside, Hindrance::DiFelice}) {
+      const DragModel model(DragLaw::Standard, water, buoyancy, hindrance);
+      for (double re : {0.0, 1e-4, 0.3, 20.0, 700.0}) {
+        const DragCurve clear = model.curve(re, 1.0), almost = model.curve(re, 1.0 - 1e-12);
+        EXPECT_NEAR(almost.g, clear.g, 1e-10 * clear.g) << hindrance_name(hindrance) << " " << re;
+        EXPECT_NEAR(almost.re_dg, clear.re_dg, 1e-10 * clear.g) << hindrance_name(hindrance) << " " << re;
+      }
+    }
+}
