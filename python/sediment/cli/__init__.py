@@ -7,9 +7,9 @@ import argparse
 import sys
 
 from ..sim.run import RunInterrupted
-from . import budget, calibrate, case_a, paste, plan, readout, run, sample, spheres, sweep, terminal
+from . import budget, calibrate, case_a, invert, paste, plan, readout, run, sample, spheres, sweep, terminal
 
-COMMANDS = (terminal, case_a, sample, plan, run, readout, budget, calibrate, paste, spheres, sweep)
+COMMANDS = (terminal, case_a, sample, plan, run, readout, budget, invert, calibrate, paste, spheres, sweep)
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -33,6 +33,6 @@ def main(argv: list[str] | None = None) -> int:
         print(f"sediment {args.command}: {reason}; files being written were left as *.partial or not written",
               file=sys.stderr)
         return 130
-    except (ValueError, OSError, RuntimeError) as exc:    # OSError: missing, read-only or full files and folders
+    except (ValueError, OSError, RuntimeError) as exc:    # SheetError is a ValueError    # OSError: missing, read-only or full files and folders
         print(f"sediment {args.command}: error: {exc}", file=sys.stderr)
         return 2

@@ -90,9 +90,10 @@ class Column:
             raise ValueError("frame times must increase")
 
     @classmethod
-    def from_layers(cls, layers, surface: float | None = None) -> "Column":
+    def from_layers(cls, layers, surface: float | None = None, fraction: np.ndarray | None = None) -> "Column":
         """The column of a layer file (sediment.layers.LayerFile) below a free surface at
-        coordinate `surface` along the layer axis (default: the top of the layers)."""
+        coordinate `surface` along the layer axis (default: the top of the layers); `fraction`
+        [frames, layers] in the file's order instead of its total (e.g. a sum of its class columns)."""
         attrs = layers.attributes
         missing = [k for k in ("fluid_density", "fluid_viscosity", "particle_density") if k not in attrs]
         if missing:
@@ -106,7 +107,7 @@ class Column:
         depth = (top - z_edges)[::-1]                      # from the top layer down
         keep = depth[1:] > 0                               # layers (partly) below the surface
         edges = np.clip(np.concatenate([depth[:-1][keep][:1], depth[1:][keep]]), 0.0, None)
-        fraction = layers.total[:, ::-1][:, keep]
+        fraction = (layers.total if fraction is None else fraction)[:, ::-1][:, keep]
         suspension = Suspension(attrs["fluid_density"], attrs["fluid_viscosity"], attrs["particle_density"],
                                 temperature=None)
         return cls(edges, np.asarray(layers.time, float), fraction, suspension, attrs.get("slab_thickness", 0.0))

@@ -125,6 +125,9 @@ class Scene:
     t_end: float
     courant: float
     seed: int
+    # diameters [m] splitting the layers into size classes (the grid's `classes`): the layer file then
+    # holds each class's fraction too, as the inverse model reads them
+    tag_classes: tuple[float, ...] = ()
     diameter: np.ndarray = field(default_factory=lambda: np.empty(0))    # per atom [m]
     weight: np.ndarray = field(default_factory=lambda: np.empty(0))
     position: np.ndarray = field(default_factory=lambda: np.empty((0, 3)))
@@ -509,7 +512,8 @@ def _deck(scene: Scene, data: str, layer_file: str) -> str:
         f"fix             grav all gravity {f.gravity:.12g} vector {gravity}",
         f"fix             water all fluid density {f.fluid_density:.12g} viscosity {f.viscosity:.12g}",
         f"compute         conc all concentration/grid layers {up} {scene.layers} bounds 0 {scene.height:.12g}"
-        f"{f' thickness {scene.thickness:.12g}' if slab else ''} weight d_weight every ${{field_every}}",
+        f"{f' thickness {scene.thickness:.12g}' if slab else ''} weight d_weight every ${{field_every}}"
+        + (" classes " + " ".join(f"{d:.12g}" for d in scene.tag_classes) if scene.tag_classes else ""),
         "fix             buoy all fluid/buoyancy water"
         + (f" mixture c_conc {f.particle_density:.12g}" if e.buoyancy == "mixture" else ""),
     ]

@@ -1,0 +1,417 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
+"""From a laboratory's readings to the sample's PSD (docs/inverse.md).
+
+The readings of a test are nearly linear in the mass of each size class: classes settle on their own
+but for the hindrance, which the whole suspension sets. So:
+
+1. The sheets' standard reduction gives a first PSD.
+2. One DEM run of the test with that PSD (the forward model's best physics: standard drag curve,
+   Richardson & Zaki's hindrance, the water at the sheet's mean temperature) writes each of K + 2 size
+   bins' layer fractions (the grid's `classes`): the finest bin below the first edge, K bins between
+   the readings' smallest and largest Stokes diameters, the coarsest above. Scaling each bin's layers
+   gives the column of any other mass split among the bins, as that run's hindrance left it.
+3. The instruments read those columns at the sheet's times (each time mapped to the run's water by
+   the temperature record: a grain falls sum(dt / mu) alike), linearised in the bins' masses: a
+   constrained least squares (masses >= 0, so the cumulative PSD never falls; their sum the sample's
+   mass; a smoothness penalty on the interior bins chosen so that the fit reaches the readings' noise)
+   gives new masses, two Gauss-Newton steps on the exact readings.
+4. A new run with the new PSD updates the hindrance; rounds go on until the PSD moves by less than
+   0.2 points (at most `rounds`).
+5. The band: the fit again for draws of the reading noise and of the thermometer's offset (the
+   sheet's own uncertainty), twice their spread, and the physics' band of an error budget if given.
+
+Assumptions: the sample mass and particle density are known; within a bin the PSD keeps the shape of
+the first guess; the hindrance of a round's run holds for the fit of that round; the temperature
+record maps times in the Stokes regime. It fails where readings do not resolve a size range (only the
+diameters between the finest and the coarsest reading are reported), and where the sheet is not a
+sedimenting suspension of the given sample (its chi-square says so).
+"""
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+
+import numpy as np
+
+from .. import figures
+from ..results import Table, write_text
+from .psd import PSD
+from .readout import BuoyancySphere, Column, Hydrometer, Pipette, Suspension
+from .sheet import Sheet, check_sheet, standard_reduction
+
+CONVERGED = 0.2           # points of percent finer between rounds
+SMOOTHNESS = np.geomspace(1e-6, 1e2, 17)    # penalty weights tried, largest that still fits the noise
+
+
+@dataclass(frozen=True)
+class LabTest:
+    """What the sheets do not say: the sample, the cylinder and the instruments."""
+
+    mass: float = 0.060                  # dry sample [kg]
+    particle_density: float = 2650.0     # [kg/m3]
+    cylinder_area: float = 27.8e-4       # [m2]
+    height: float = 0.36                 # suspension height [m]
+    hydrometer: Hydrometer = field(default_factory=Hydrometer.astm_152h)
+    zero_correction: float = 0.0         # g/L subtracted from each hydrometer reading (composite correction)
+    meniscus: float = 0.0                # g/L added for the depth only
+    sphere_depth: float | None = None    # centre [m], default 0.3 of the height
+    sphere_diameter: float = 0.025       # [m]
+    sphere_mass: float = 0.020           # [kg]
+    # reading noise: 152H read to 0.5 g/L; a balance to 1 mg; pipette sample masses to 0.1 mg (as g/L of 25 mL)
+    noise: dict = field(default_factory=lambda: {"hydrometer": 0.25, "buoyancy": 1e-3, "pipette": 0.1e-3 / 0.025})
+    thermometer: float = 0.5             # C, standard uncertainty of the temperature record
+
+    @property
+    def initial_concentration(self) -> float:
+        """c0 [kg/m3 = g/L]."""
+        return self.mass / (self.cylinder_area * self.height)
+
+    @property
+    def sphere_centre(self) -> float:
+        """The buoyancy sphere's centre depth [m]."""
+        return 0.3 * self.height if self.sphere_depth is None else self.sphere_depth
+
+
+def whole_sample_reading(sheet: Sheet, test: LabTest, water: Suspension) -> float:
+    """What the instrument reads with the whole sample in suspension (its unit)."""
+    c0 = test.initial_concentration
+    gs = test.particle_density / 1000.0
+    if sheet.instrument == "hydrometer":
+        return c0 / (1.65 * gs / (2.65 * (gs - 1)))
+    if sheet.instrument == "pipette":
+        return c0
+    volume = math.pi / 6 * test.sphere_diameter ** 3
+    rho = water.mixture_density(c0 / test.particle_density)
+    return (test.sphere_mass - rho * volume) * 1e3
+
+
+def effective_times(sheet: Sheet, reference: Suspension, offset: float = 0.0) -> np.ndarray:
+    """Each reading's time on a run in water at the reference's temperature: the same fall, sum of
+    dt / mu, under the sheet's temperature record (linear between readings, the first reading's before
+    it; plus `offset` C); the reading times when none was recorded."""
+    if not np.isfinite(sheet.temperature).any():
+        return sheet.time
+    recorded = np.isfinite(sheet.temperature)
+    times, temps = sheet.time[recorded], sheet.temperature[recorded] + offset
+    grid = np.unique(np.concatenate([[0.0], np.linspace(0.0, sheet.time[-1], 2000), sheet.time]))
+    temperature = np.clip(np.interp(grid, times, temps), 0.0, 40.0)
+    from .. import _core
+    rate = reference.viscosity / np.array([_core.water_viscosity(t) for t in temperature])
+    elapsed = np.concatenate([[0.0], np.cumsum(0.5 * (rate[1:] + rate[:-1]) * np.diff(grid))])
+    return np.interp(sheet.time, grid, elapsed)
+
+
+@dataclass
+class ForwardRun:
+    """One DEM run of the test with the bins' layers: their columns scale into the column of any split."""
+
+    layers: object                       # LayerFile
+    bins: list[np.ndarray]               # fraction [frames, layers] of each bin, the file's order
+    masses: np.ndarray                   # each bin's share of the run's solids
+    water: Suspension
+    test: LabTest
+
+    def column(self, shares: np.ndarray) -> Column:
+        """The column of a split of the sample's mass among the bins (shares summing to about 1)."""
+        fraction = sum(s / m * b for s, m, b in zip(shares, self.masses, self.bins) if m > 0)
+        column = Column.from_layers(self.layers, fraction=fraction)
+        return replace(column, suspension=self.water)
+
+    def readings(self, shares: np.ndarray, sheets: list[Sheet], times: list[np.ndarray]) -> np.ndarray:
+        """Every sheet's modelled readings, in order, for a split of the mass."""
+        column = self.column(shares)
+        out = []
+        for sheet, t in zip(sheets, times):
+            if sheet.instrument == "hydrometer":
+                out.append(self.test.hydrometer.read(column, t, cylinder_area=self.test.cylinder_area).reading)
+            elif sheet.instrument == "pipette":
+                out.append(np.array([Pipette(z).read(column, [ti]).reading[0] for z, ti in zip(sheet.depth, t)]))
+            else:
+                sphere = BuoyancySphere(self.test.sphere_centre, self.test.sphere_diameter, self.test.sphere_mass)
+                out.append(sphere.read(column, t).reading)
+        return np.concatenate(out)
+
+
+def run_forward(psd: PSD, edges: np.ndarray, test: LabTest, water: Suspension, t_end: float, folder: Path,
+                particles: int, courant: float, seed: int) -> ForwardRun:
+    """Writes and runs the test with `psd`, its layers split at `edges`."""
+    from ..sim.layers import read_layers
+    from ..sim.run import run_batch
+    from ..sim.scene import Cylinder, Effects, plan, write
+
+    scene = plan(psd, cylinder=Cylinder(test.cylinder_area, test.height), mass=test.mass, suspension=water,
+                 particles=particles, courant=courant, seed=seed, effects=Effects(), t_end=t_end)
+    scene.tag_classes = tuple(float(d) for d in edges)
+    write(scene, folder)
+    out = run_batch(folder / "in.sedimentation", {"overwrite": "yes"}, check=False)
+    if out.error:
+        raise RuntimeError(f"the forward run in {folder} failed: {out.error}")
+    layers = read_layers(folder / "layers.h5")
+    bins = [layers.column(f"class_{k}") for k in range(len(edges) + 1)]
+    solids = np.array([b[0].sum() for b in bins])
+    return ForwardRun(layers, bins, solids / solids.sum(), water, test)
+
+
+def psd_of(shares: np.ndarray, edges: np.ndarray, name: str = "") -> PSD:
+    """The PSD of bin shares: percent finer at the edges, the finest bin down to a third of the first
+    edge, the coarsest up to 1.5 times the last."""
+    cumulative = 100 * np.cumsum(shares)[:-1]
+    diameter = np.concatenate([[edges[0] / 3], edges, [edges[-1] * 1.5]])
+    percent = np.concatenate([[0.0], np.clip(cumulative, 0, 100), [100.0]])
+    return PSD(diameter, np.maximum.accumulate(percent), name)
+
+
+def first_guess(points_d: np.ndarray, points_p: np.ndarray, edges: np.ndarray) -> np.ndarray:
+    """Bin shares from the standard reduction's points (sorted, made non-decreasing, within 0-100),
+    mixed with a tenth of an even split so that every bin has mass for the run to scale."""
+    order = np.argsort(points_d)
+    d, p = points_d[order], np.clip(np.maximum.accumulate(np.clip(points_p[order], 0, 100)), 0, 100)
+    at_edges = np.interp(np.log(edges), np.log(d), p, left=p[0], right=p[-1])
+    shares = np.diff(np.concatenate([[0.0], at_edges, [100.0]])) / 100.0
+    shares = np.maximum(shares, 0.0)
+    return 0.9 * shares / shares.sum() + 0.1 / len(shares)
+
+
+def _penalty(n: int) -> np.ndarray:
+    """Second differences of the interior bins' shares (the tails are free)."""
+    interior = n - 2
+    rows = np.zeros((max(interior - 2, 0), n))
+    for r in range(interior - 2):
+        rows[r, 1 + r:4 + r] = (1.0, -2.0, 1.0)
+    return rows
+
+
+def fit(jacobian: np.ndarray, base: np.ndarray, shares0: np.ndarray, data: np.ndarray, sigma: np.ndarray,
+        smoothness: float | None = None) -> tuple[np.ndarray, float, float]:
+    """The shares that fit the linearised readings, >= 0, summing to 1, with the largest smoothness
+    penalty whose chi-square stays within the readings' count (or the one given); returns the shares,
+    the chi-square and the penalty weight."""
+    from scipy.optimize import lsq_linear
+
+    n = len(shares0)
+    a = jacobian / sigma[:, None]
+    b = (data - base + jacobian @ shares0) / sigma
+    total = 1e4 * np.ones((1, n))
+    penalty = _penalty(n)
+
+    def solve(weight: float) -> tuple[np.ndarray, float]:
+        matrix = np.vstack([a, total, math.sqrt(weight) * penalty * n])
+        target = np.concatenate([b, [1e4], np.zeros(len(penalty))])
+        x = lsq_linear(matrix, target, bounds=(0.0, np.inf), method="bvls").x
+        return x, float(np.sum((a @ x - b) ** 2))
+
+    if smoothness is not None:
+        x, chi2 = solve(smoothness)
+        return x, chi2, smoothness
+    best = None
+    for weight in SMOOTHNESS:
+        x, chi2 = solve(weight)
+        if best is None or chi2 <= max(len(b), 1.05 * best[1]):
+            best = (x, chi2, weight)
+    return best
+
+
+@dataclass
+class Inversion:
+    """The recovered PSD with its band, the standard reduction, the fit and its verdict."""
+
+    edges: np.ndarray            # [m]
+    percent: np.ndarray          # recovered percent finer at the edges
+    low: np.ndarray
+    high: np.ndarray
+    reduction: list[tuple[str, np.ndarray, np.ndarray, np.ndarray]]    # instrument, time, D, P
+    fit_rows: list[tuple[str, float, float, float, float]]             # instrument, time, measured, model, sigma
+    chi2: float
+    rounds: int
+    smoothness: float
+    resolution: str
+    notes: list[str] = field(default_factory=list)
+
+    @property
+    def reduced_chi2(self) -> float:
+        """Chi-square per reading."""
+        return self.chi2 / max(len(self.fit_rows), 1)
+
+    @property
+    def consistent(self) -> bool:
+        """Whether some PSD explains the sheet within the readings' noise (chi-square per reading < 4)."""
+        return self.reduced_chi2 < 4.0
+
+    def psd(self) -> PSD:
+        """The recovered PSD between the finest and the coarsest reading's diameters."""
+        return PSD(self.edges, self.percent, "recovered")
+
+    def table(self) -> Table:
+        """Percent finer with its band at each bin edge."""
+        table = Table(["diameter_um", "percent_finer", "low", "high"], notes=self.notes)
+        for row in zip(self.edges * 1e6, self.percent, self.low, self.high):
+            table.add(*map(float, row))
+        return table
+
+    def save(self, folder: Path) -> list[Path]:
+        """psd.csv, reduction.csv, fit.csv, invert.json, invert.png."""
+        folder = Path(folder)
+        reduction = Table(["instrument", "time_min", "diameter_um", "percent_finer"])
+        for name, t, d, p in self.reduction:
+            for row in zip(t / 60, d * 1e6, p):
+                reduction.add(name, *map(float, row))
+        fitted = Table(["instrument", "time_min", "measured", "simulated", "residual_sigma"])
+        for name, t, measured, model, sigma in self.fit_rows:
+            fitted.add(name, t / 60, measured, model, (model - measured) / sigma)
+        summary = {"psd": {"diameter_um": (self.edges * 1e6).tolist(), "percent_finer": self.percent.tolist(),
+                           "low": self.low.tolist(), "high": self.high.tolist()},
+                   "chi2_per_reading": self.reduced_chi2, "consistent": self.consistent, "rounds": self.rounds,
+                   "smoothness": self.smoothness, "resolution": self.resolution, "notes": self.notes}
+        return [write_text(folder / "psd.csv", self.table().csv()),
+                write_text(folder / "reduction.csv", reduction.csv()),
+                write_text(folder / "fit.csv", fitted.csv()),
+                write_text(folder / "invert.json", json.dumps(summary, indent=1) + "\n"),
+                self.plot(folder / "invert.png")]
+
+    def plot(self, path: Path) -> Path:
+        """The recovered PSD with its band and the standard reduction; the fit's residuals."""
+        plt = figures.pyplot()
+        fig, (ax, res) = plt.subplots(1, 2, figsize=(11, 4.5), gridspec_kw={"width_ratios": [3, 2]})
+        d = self.edges * 1e6
+        ax.fill_between(d, self.low, self.high, color="C0", alpha=0.25, label="band")
+        ax.plot(d, self.percent, "C0-o", ms=4, label="recovered PSD")
+        for k, (name, _, dd, p) in enumerate(self.reduction):
+            ax.plot(dd * 1e6, p, "s", ms=5, color=f"C{k + 1}", label=f"standard reduction ({name})")
+        ax.set(xscale="log", xlabel="diameter [um]", ylabel="percent finer [%]", ylim=(0, 100),
+               title="the sample's PSD from the sheet")
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=8)
+        for k, name in enumerate(dict.fromkeys(r[0] for r in self.fit_rows)):
+            rows = [r for r in self.fit_rows if r[0] == name]
+            res.plot([r[1] / 60 for r in rows], [(r[3] - r[2]) / r[4] for r in rows], "o-", ms=4, label=name)
+        res.axhline(0, color="k", lw=0.8)
+        res.set(xscale="log", xlabel="time [min]", ylabel="(simulated - measured) / noise",
+                title=f"fit: chi2 per reading {self.reduced_chi2:.2g}")
+        res.legend(fontsize=8)
+        res.grid(alpha=0.3)
+        return figures.save(fig, path)
+
+
+def invert(sheets: list[Sheet], test: LabTest, folder: Path, *, bins: int = 12, particles: int = 20000,
+           courant: float = 4.0, rounds: int = 4, draws: int = 16, seed: int = 1,
+           budget_band: float = 0.0) -> Inversion:
+    """Recovers the PSD the sheets were read from (the method above).
+
+    Parameters
+    ----------
+    sheets : list of Sheet
+        The readings (any of hydrometer, pipette, buoyancy sphere, one sheet each or several).
+    test : LabTest
+        Sample mass, particle density, cylinder and instruments.
+    folder : Path
+        Where the forward runs go.
+    bins : int
+        Size bins between the finest and the coarsest reading's diameters.
+    particles, courant : int, float
+        Resolution of the forward runs (`sediment sample`'s defaults).
+    rounds : int
+        Forward runs at most.
+    draws : int
+        Draws of the reading noise and the thermometer for the band.
+    budget_band : float
+        Points of percent finer the physics' uncertainty adds (an error budget's physical total).
+    """
+    if not sheets:
+        raise ValueError("no sheet to invert")
+    recorded = np.concatenate([s.temperature[np.isfinite(s.temperature)] for s in sheets])
+    mean_temperature = float(recorded.mean()) if len(recorded) else 20.0
+    water = Suspension.at_temperature(mean_temperature, test.particle_density)
+    c0 = test.initial_concentration
+    for sheet in sheets:
+        check_sheet(sheet, whole_sample_reading(sheet, test, water), 2 * test.noise[sheet.instrument])
+    reduction = []
+    for sheet in sheets:
+        reading = sheet.reading - (test.zero_correction if sheet.instrument == "hydrometer" else 0.0)
+        d, p = standard_reduction(replace(sheet, reading=reading), water, c0, test.hydrometer, test.cylinder_area,
+                                  test.sphere_centre, test.sphere_diameter, test.sphere_mass, test.meniscus)
+        reduction.append((sheet.instrument, sheet.time, d, p))
+    diameters = np.concatenate([d for _, _, d, _ in reduction])
+    edges = np.geomspace(diameters.min(), diameters.max(), bins)
+    shares = first_guess(diameters, np.concatenate([p for *_, p in reduction]), edges)
+    data = np.concatenate([s.reading - (test.zero_correction if s.instrument == "hydrometer" else 0.0) for s in sheets])
+    sigma = np.concatenate([np.full(len(s.time), test.noise[s.instrument]) for s in sheets])
+    times = [effective_times(s, water) for s in sheets]
+    t_end = 1.02 * max(t[-1] for t in times)
+
+    def linearised(run: ForwardRun, x: np.ndarray, when: list[np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
+        base = run.readings(x, sheets, when)
+        step = 1e-3
+        jac = np.empty((len(base), len(x)))
+        for k in range(len(x)):
+            moved = x.copy()
+            moved[k] += step
+            jac[:, k] = (run.readings(moved, sheets, when) - base) / step
+        return base, jac
+
+    previous = None
+    weight = None
+    reading_sigma = sigma
+    for round_number in range(1, rounds + 1):
+        # every bin keeps some mass in the run, so that its columns can be scaled to any share
+        spread = 0.8 * shares + 0.2 / len(shares)
+        run = run_forward(psd_of(spread, edges), edges, test, water, t_end, folder / f"round{round_number}",
+                          particles, courant, seed)
+        if round_number == 1:
+            # the forward model's own sampling error: the same PSD with another placement; its rms
+            # difference per instrument (over sqrt 2) adds to each reading's noise
+            other = run_forward(psd_of(spread, edges), edges, test, water, t_end, folder / "sampling", particles,
+                                courant, seed + 1)
+            gap = run.readings(shares, sheets, times) - other.readings(shares, sheets, times)
+            start = 0
+            model_sigma = np.empty(len(data))
+            for sheet in sheets:
+                n = len(sheet.time)
+                model_sigma[start:start + n] = math.sqrt(np.mean(gap[start:start + n] ** 2) / 2)
+                start += n
+            sigma = np.sqrt(reading_sigma ** 2 + model_sigma ** 2)
+        for _ in range(2):    # Gauss-Newton on this run's columns
+            base, jac = linearised(run, shares, times)
+            shares, chi2, weight = fit(jac, base, shares, data, sigma)
+        percent = 100 * np.cumsum(shares)[:-1]
+        if previous is not None and np.max(np.abs(percent - previous)) < CONVERGED:
+            break
+        previous = percent
+    base, jac = linearised(run, shares, times)
+    model = run.readings(shares, sheets, times)
+    chi2 = float(np.sum(((model - data) / sigma) ** 2))
+    # the band: the fit again for draws of the reading noise and the thermometer's offset
+    rng = np.random.default_rng(seed)
+    draws_percent = []
+    for _ in range(draws):
+        offset = rng.normal(0.0, test.thermometer)
+        shifted = [effective_times(s, water, offset) for s in sheets]
+        b, j = linearised(run, shares, shifted) if offset else (base, jac)
+        noisy = data + rng.normal(0.0, reading_sigma)
+        x, _, _ = fit(j, b, shares, noisy, sigma, weight)
+        draws_percent.append(100 * np.cumsum(x)[:-1])
+    spread = 2 * np.std(draws_percent, axis=0) if draws > 1 else np.zeros(len(edges))
+    band = np.sqrt(spread ** 2 + budget_band ** 2)
+    percent = 100 * np.cumsum(shares)[:-1]
+    rows = []
+    start = 0
+    for sheet in sheets:
+        n = len(sheet.time)
+        rows += [(sheet.instrument, float(t), float(m), float(f), float(s))
+                 for t, m, f, s in zip(sheet.time, data[start:start + n], model[start:start + n], sigma[start:start + n])]
+        start += n
+    resolution = (f"{particles} parcels, Courant {courant:g}, standard drag curve + Richardson & Zaki, water at "
+                  f"{mean_temperature:.3g} C")
+    result = Inversion(edges, percent, np.clip(percent - band, 0, 100), np.clip(percent + band, 0, 100), reduction,
+                       rows, chi2, round_number, float(weight), resolution)
+    result.notes.append(f"forward model: {resolution}; {round_number} round(s)")
+    if not result.consistent:
+        result.notes.append(f"NOT CONSISTENT: chi-square per reading {result.reduced_chi2:.3g} (>= 4): no PSD of this "
+                            "sample under this physics gives these readings within their noise: a misread, a "
+                            "flocculated sample, or a wrong sample mass or particle density")
+    flagged = [r for r in rows if abs(r[3] - r[2]) > 4 * r[4]]
+    for name, t, measured, modelled, s in flagged:
+        result.notes.append(f"reading {name} at {t / 60:g} min is {abs(modelled - measured) / s:.1f} noise units off the "
+                            "fit: check it")
+    return result

@@ -1,0 +1,165 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
+"""A laboratory's sheet of readings (docs/inverse.md): what `sediment invert` takes in, checked row by
+row, and the standard ASTM reduction of it.
+
+A sheet is a CSV a laboratory already keeps, one kind per file, told apart by its header:
+
+- hydrometer (152H, reading in g/L of soil): ``time_min,reading,temperature_C``
+- pipette: ``time_min,depth_cm,mass_g`` (the dry solids of one pipette sample), ``temperature_C`` optional
+- buoyancy sphere: ``time_min,apparent_mass_g`` (what the balance shows), ``temperature_C`` optional
+
+A sheet that no sedimenting suspension can give is refused with the reason: times out of order,
+missing temperatures, hydrometer readings in g/cm3, readings rising with time or above what the whole
+sample in suspension reads.
+"""
+from __future__ import annotations
+
+import csv
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from .readout import Hydrometer, Suspension
+
+KINDS = {
+    "hydrometer": ("time_min", "reading", "temperature_C"),
+    "pipette": ("time_min", "depth_cm", "mass_g"),
+    "buoyancy": ("time_min", "apparent_mass_g"),
+}
+
+
+class SheetError(ValueError):
+    """A sheet that cannot be a record of a sedimentation test, with the reason and the row."""
+
+
+@dataclass(frozen=True)
+class Sheet:
+    """One instrument's readings: times [s], the readings in the instrument's unit (152H g/L, pipette
+    g/L of the sample, sphere apparent mass g), the water temperature at each [C] (NaN: not recorded)
+    and, for the pipette, the depth of each sample [m]."""
+
+    instrument: str
+    path: Path
+    time: np.ndarray
+    reading: np.ndarray
+    temperature: np.ndarray
+    depth: np.ndarray = field(default_factory=lambda: np.empty(0))
+
+    @property
+    def label(self) -> str:
+        return f"{self.path.name} ({self.instrument})"
+
+
+def read_sheet(path: str | Path, pipette_volume: float = 25e-6) -> Sheet:
+    """Reads and checks one sheet (its kind from its header); a pipette's masses become g/L of the sample."""
+    path = Path(path)
+    try:
+        with path.open(newline="") as handle:
+            rows = [row for row in csv.reader(handle) if row and not row[0].lstrip().startswith("#")]
+    except UnicodeDecodeError as exc:
+        raise SheetError(f"{path}: not a text CSV ({exc.reason})") from None
+    if not rows:
+        raise SheetError(f"{path}: empty sheet")
+    header = [h.strip() for h in rows[0]]
+    kind = next((k for k, columns in KINDS.items() if set(columns) <= set(header)), None)
+    if kind is None:
+        expected = "; ".join(",".join(c) for c in KINDS.values())
+        raise SheetError(f"{path}: header {','.join(header)} is none of the sheets (expected {expected})")
+    if len(rows) < 2:
+        raise SheetError(f"{path}: no readings below the header")
+    values: dict[str, list[float]] = {name: [] for name in header}
+    for number, row in enumerate(rows[1:], start=2):
+        if len(row) != len(header):
+            raise SheetError(f"{path}, row {number}: {len(row)} fields, the header has {len(header)}")
+        for name, text in zip(header, row):
+            text = text.strip()
+            if text == "" and name == "temperature_C":
+                values[name].append(math.nan)
+                continue
+            try:
+                values[name].append(float(text))
+            except ValueError:
+                raise SheetError(f"{path}, row {number}: {name} '{text}' is not a number") from None
+            if not math.isfinite(values[name][-1]):
+                raise SheetError(f"{path}, row {number}: {name} is not finite")
+    time = np.array(values["time_min"]) * 60.0
+    if time[0] <= 0 or np.any(np.diff(time) <= 0):
+        raise SheetError(f"{path}: the times must be > 0 and increase from row to row")
+    temperature = np.array(values.get("temperature_C", [math.nan] * len(time)))
+    recorded = np.isfinite(temperature)
+    if kind == "hydrometer" and not recorded.all():
+        missing = ", ".join(str(k + 2) for k in np.flatnonzero(~recorded))
+        raise SheetError(f"{path}: no temperature in row(s) {missing}: a hydrometer's reading needs the temperature "
+                         "it was taken at")
+    if np.any(recorded & ((temperature < 0) | (temperature > 40))):
+        raise SheetError(f"{path}: temperatures outside 0-40 C, the range of the water correlations")
+    depth = np.empty(0)
+    if kind == "hydrometer":
+        reading = np.array(values["reading"])
+        if np.all((reading > 0.95) & (reading < 1.15)):
+            raise SheetError(f"{path}: the readings ({reading.min():g}-{reading.max():g}) look like specific gravities "
+                             "(a 151H, g/cm3): the sheet takes a 152H's readings in g/L")
+    elif kind == "pipette":
+        depth = np.array(values["depth_cm"]) / 100.0
+        mass = np.array(values["mass_g"])
+        if np.any(depth <= 0) or np.any(mass < 0):
+            raise SheetError(f"{path}: depths must be > 0 and masses >= 0")
+        reading = mass / (pipette_volume * 1e3)      # g per litre of the sample
+    else:
+        reading = np.array(values["apparent_mass_g"])
+        if np.any(reading <= 0):
+            raise SheetError(f"{path}: apparent masses must be > 0")
+    return Sheet(kind, path, time, reading, temperature, depth)
+
+
+def check_sheet(sheet: Sheet, whole: float, resolution: float) -> None:
+    """Refuses what no sedimenting suspension reads: a reading beyond `whole` (what the whole sample in
+    suspension reads, in the instrument's unit) or one that moves back towards it with time by more than
+    the reading's `resolution` (the solids at a depth only fall as the test goes on; a pipette is held
+    to this between samples at one depth)."""
+    # the solids signal, falling with time: the sphere's apparent mass rises as the suspension thins
+    signal, top = (-sheet.reading, -whole) if sheet.instrument == "buoyancy" else (sheet.reading, whole)
+    over = np.flatnonzero(signal > top + resolution)
+    if len(over):
+        k = over[0]
+        raise SheetError(f"{sheet.label}: the reading at {sheet.time[k] / 60:g} min ({sheet.reading[k]:g}) is beyond what "
+                         f"the whole sample in suspension reads ({whole:.4g}): check the sample mass, the units or the "
+                         "sheet")
+    same_depth = np.ones(len(signal), bool) if sheet.instrument != "pipette" else np.r_[True, np.diff(sheet.depth) == 0]
+    rises = np.flatnonzero((np.diff(signal) > resolution) & same_depth[1:])
+    if len(rises):
+        k = rises[0] + 1
+        raise SheetError(f"{sheet.label}: the reading at {sheet.time[k] / 60:g} min ({sheet.reading[k]:g}) goes back "
+                         f"towards the initial one by more than the reading's resolution ({resolution:g}): the solids "
+                         "at a depth only fall as the test goes on (a misread, or a flocculating sample)")
+
+
+def standard_reduction(sheet: Sheet, suspension: Suspension, initial_concentration: float,
+                       hydrometer: Hydrometer, cylinder_area: float, sphere_depth: float, sphere_diameter: float,
+                       sphere_mass: float, meniscus: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
+    """The ASTM reduction of each reading: Stokes' diameter at the instrument's depth with the water at
+    the reading's temperature (the test's where none was recorded), and percent finer from the reading
+    (152H: 100 a R / c0)."""
+    temperature = np.where(np.isfinite(sheet.temperature), sheet.temperature,
+                           suspension.temperature if suspension.temperature is not None else 20.0)
+    gs = suspension.specific_gravity
+    if sheet.instrument == "hydrometer":
+        a = 1.65 * gs / (2.65 * (gs - 1))
+        bulb = hydrometer.scale_zero - hydrometer.scale_step * (sheet.reading + meniscus)
+        depth = bulb + 0.5 * (hydrometer.bulb_length - hydrometer.bulb_volume / cylinder_area)
+        percent = 100 * a * sheet.reading / initial_concentration
+    elif sheet.instrument == "pipette":
+        depth = sheet.depth
+        percent = 100 * sheet.reading / initial_concentration
+    else:
+        volume = math.pi / 6 * sphere_diameter ** 3
+        water = np.array([Suspension.at_temperature(t, suspension.particle_density).fluid_density for t in temperature])
+        in_water = sphere_mass - water * volume
+        concentration = (in_water - sheet.reading * 1e-3) / volume * gs / (gs - 1)
+        depth = np.full(len(sheet.time), sphere_depth)
+        percent = 100 * concentration / initial_concentration
+    diameter = np.array([Suspension.at_temperature(t, suspension.particle_density).stokes_diameter(z, time)
+                         for t, z, time in zip(temperature, depth, sheet.time)], float)
+    return diameter, percent
