@@ -49,6 +49,7 @@ class Sheet:
 
     @property
     def label(self) -> str:
+        """The sheet's file and instrument, as messages name it."""
         return f"{self.path.name} ({self.instrument})"
 
 
