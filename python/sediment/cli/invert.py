@@ -6,7 +6,7 @@ import argparse
 from pathlib import Path
 
 from ..constants import D422_CYLINDER_AREA, D422_CYLINDER_HEIGHT, SOIL_PARTICLE_DENSITY
-from .types import count, finite, positive
+from .types import count, finite, positive, positive_list
 
 
 def add_parser(commands) -> argparse.ArgumentParser:
@@ -21,7 +21,12 @@ def add_parser(commands) -> argparse.ArgumentParser:
         "reduction.csv, fit.csv, invert.json, invert.png. See docs/inverse.md. "
         "Example: sediment invert examples/inverse/hydrometer.csv examples/inverse/pipette.csv --mass 0.06 "
         "--out out/invert")
-    parser.add_argument("sheets", type=Path, nargs="+", help="the sheets of one sample (CSV)")
+    parser.add_argument("sheets", type=Path, nargs="*", help="the sheets of one sample (CSV)")
+    parser.add_argument("--design", type=Path, metavar="PSD",
+                        help="instead of sheets: the PSD a sample is expected to have; compares instruments, reading "
+                        "times and sample masses by how well each recovers it (OUT/design.csv, design.png)")
+    parser.add_argument("--masses", type=positive_list, default=[0.030, 0.045, 0.060, 0.080],
+                        help="with --design: sample masses to compare [kg] (default 0.03,0.045,0.06,0.08)")
     parser.add_argument("--mass", type=positive, default=0.060, help="dry sample mass [kg] (default 0.06)")
     parser.add_argument("--particle-density", type=positive, default=SOIL_PARTICLE_DENSITY, help="[kg/m3] (default 2650)")
     parser.add_argument("--cylinder-area", type=positive, default=D422_CYLINDER_AREA, help="[m2] (default D422's)")
@@ -41,8 +46,8 @@ def add_parser(commands) -> argparse.ArgumentParser:
     parser.add_argument("--budget", type=Path, help="budget.json of `sediment budget` for this test: its physical "
                         "total widens the band")
     parser.add_argument("--budget-sample", metavar="NAME", help="the sample of a budget.json that holds several")
-    parser.add_argument("--bins", type=count, default=12, help="size bins between the finest and coarsest "
-                        "reading's diameters (default 12)")
+    parser.add_argument("--bins", type=count, default=24, help="size bins between the finest and coarsest "
+                        "reading's diameters (default 24)")
     parser.add_argument("--particles", type=count, default=20000, help="parcels of the forward runs (default 20000)")
     parser.add_argument("--seed", type=int, default=1, help="placement seed of the forward runs")
     parser.add_argument("--out", type=Path, default=Path("out/invert"), help="output folder")
@@ -54,12 +59,16 @@ def run(args: argparse.Namespace) -> int:
     from ..lab.inverse import LabTest, invert
     from ..lab.sheet import read_sheet
 
-    sheets = [read_sheet(p, args.pipette_volume) for p in args.sheets]
+    if (args.design is None) == (not args.sheets):
+        raise ValueError("give the sheets of a sample, or --design PSD to plan a test (not both)")
     noise = {"hydrometer": args.hydrometer_noise, "buoyancy": args.balance_noise,
              "pipette": args.pipette_noise / (args.pipette_volume * 1e3)}
     test = LabTest(args.mass, args.particle_density, args.cylinder_area, args.height, zero_correction=args.zero_correction,
                    meniscus=args.meniscus, sphere_depth=args.sphere_depth, sphere_diameter=args.sphere_diameter,
                    sphere_mass=args.sphere_mass, noise=noise, thermometer=args.thermometer)
+    if args.design is not None:
+        return _design(args, test)
+    sheets = [read_sheet(p, args.pipette_volume) for p in args.sheets]
     band = 0.0
     if args.budget is not None:
         from ..studies.budget import band_of
@@ -71,3 +80,32 @@ def run(args: argparse.Namespace) -> int:
     for path in result.save(args.out):
         print(f"wrote {path}")
     return 0 if result.consistent else 3
+
+
+def _design(args: argparse.Namespace, test) -> int:
+    """Compares the designs of a test of the expected PSD; prints and writes the table and figure."""
+    from .. import figures
+    from ..lab.inverse import design_test
+    from ..lab.psd import read_psd
+    from ..results import Table, write_text
+
+    rows = design_test(read_psd(args.design), args.out / "runs", masses=tuple(args.masses), test=test, bins=args.bins,
+                       particles=args.particles, seed=args.seed)
+    table = Table(["design", "mass_g", "readings", "mean_error_pp", "worst_error_pp"],
+                  notes=[f"{args.design.name}: the recovered PSD's error at the bin edges, mean over noise draws; "
+                         "the hindrance's own uncertainty, growing with the mass, is not in it"])
+    for name, mass, n, mean, worst in rows:
+        table.add(name, f"{mass * 1e3:g}", n, f"{mean:.3g}" if n else "cannot read", f"{worst:.3g}" if n else "")
+    print(table.text(), end="")
+    plt = figures.pyplot()
+    fig, ax = plt.subplots(figsize=(7, 4.5))
+    for name in dict.fromkeys(r[0] for r in rows):
+        mine = [r for r in rows if r[0] == name]
+        ax.plot([r[1] * 1e3 for r in mine], [r[4] for r in mine], "o-", label=name)
+    ax.set(xlabel="sample mass [g]", ylabel="worst error of the recovered PSD [pp]", yscale="log",
+           title=f"designs of a test of {args.design.stem}")
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8)
+    for path in (write_text(args.out / "design.csv", table.csv()), figures.save(fig, args.out / "design.png")):
+        print(f"wrote {path}")
+    return 0

@@ -35,7 +35,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .. import figures
+from .. import _core, figures
 from ..results import Table, write_text
 from .psd import PSD
 from .readout import BuoyancySphere, Column, Hydrometer, Pipette, Suspension
@@ -87,6 +87,13 @@ def whole_sample_reading(sheet: Sheet, test: LabTest, water: Suspension) -> floa
     return (test.sphere_mass - rho * volume) * 1e3
 
 
+def clear_reading(sheet: Sheet, test: LabTest, water: Suspension) -> float:
+    """What the instrument reads in clear water (its unit)."""
+    if sheet.instrument == "buoyancy":
+        return (test.sphere_mass - water.fluid_density * math.pi / 6 * test.sphere_diameter ** 3) * 1e3
+    return 0.0
+
+
 def effective_times(sheet: Sheet, reference: Suspension, offset: float = 0.0) -> np.ndarray:
     """Each reading's time on a run in water at the reference's temperature: the same fall, sum of
     dt / mu, under the sheet's temperature record (linear between readings, the first reading's before
@@ -97,7 +104,6 @@ def effective_times(sheet: Sheet, reference: Suspension, offset: float = 0.0) ->
     times, temps = sheet.time[recorded], sheet.temperature[recorded] + offset
     grid = np.unique(np.concatenate([[0.0], np.linspace(0.0, sheet.time[-1], 2000), sheet.time]))
     temperature = np.clip(np.interp(grid, times, temps), 0.0, 40.0)
-    from .. import _core
     rate = reference.viscosity / np.array([_core.water_viscosity(t) for t in temperature])
     elapsed = np.concatenate([[0.0], np.cumsum(0.5 * (rate[1:] + rate[:-1]) * np.diff(grid))])
     return np.interp(sheet.time, grid, elapsed)
@@ -129,8 +135,12 @@ class ForwardRun:
             elif sheet.instrument == "pipette":
                 out.append(np.array([Pipette(z).read(column, [ti]).reading[0] for z, ti in zip(sheet.depth, t)]))
             else:
+                # the balance reads the sphere in the water at each reading's temperature
                 sphere = BuoyancySphere(self.test.sphere_centre, self.test.sphere_diameter, self.test.sphere_mass)
-                out.append(sphere.read(column, t).reading)
+                volume = math.pi / 6 * self.test.sphere_diameter ** 3
+                recorded = np.where(np.isfinite(sheet.temperature), sheet.temperature, self.water.temperature or 20.0)
+                water = np.array([_core.water_density(c) for c in recorded])
+                out.append(sphere.read(column, t).reading - (water - self.water.fluid_density) * volume * 1e3)
         return np.concatenate(out)
 
 
@@ -156,9 +166,9 @@ def run_forward(psd: PSD, edges: np.ndarray, test: LabTest, water: Suspension, t
 
 def psd_of(shares: np.ndarray, edges: np.ndarray, name: str = "") -> PSD:
     """The PSD of bin shares: percent finer at the edges, the finest bin down to a third of the first
-    edge, the coarsest up to 1.5 times the last."""
+    edge, the coarsest as wide in log as the bin below it."""
     cumulative = 100 * np.cumsum(shares)[:-1]
-    diameter = np.concatenate([[edges[0] / 3], edges, [edges[-1] * 1.5]])
+    diameter = np.concatenate([[edges[0] / 3], edges, [edges[-1] ** 2 / edges[-2]]])
     percent = np.concatenate([[0.0], np.clip(cumulative, 0, 100), [100.0]])
     return PSD(diameter, np.maximum.accumulate(percent), name)
 
@@ -294,7 +304,7 @@ class Inversion:
         return figures.save(fig, path)
 
 
-def invert(sheets: list[Sheet], test: LabTest, folder: Path, *, bins: int = 12, particles: int = 20000,
+def invert(sheets: list[Sheet], test: LabTest, folder: Path, *, bins: int = 24, particles: int = 20000,
            courant: float = 4.0, rounds: int = 4, draws: int = 16, seed: int = 1,
            budget_band: float = 0.0) -> Inversion:
     """Recovers the PSD the sheets were read from (the method above).
@@ -325,7 +335,11 @@ def invert(sheets: list[Sheet], test: LabTest, folder: Path, *, bins: int = 12, 
     water = Suspension.at_temperature(mean_temperature, test.particle_density)
     c0 = test.initial_concentration
     for sheet in sheets:
-        check_sheet(sheet, whole_sample_reading(sheet, test, water), 2 * test.noise[sheet.instrument])
+        # the tolerance: twice the reading's noise, and 2 % of the solids' signal for the sampling of a real
+        # suspension (a pipette's first samples can draw a little more than the mean)
+        whole = whole_sample_reading(sheet, test, water)
+        signal = abs(whole - clear_reading(sheet, test, water))
+        check_sheet(sheet, whole, max(2 * test.noise[sheet.instrument], 0.02 * signal))
     reduction = []
     for sheet in sheets:
         reading = sheet.reading - (test.zero_correction if sheet.instrument == "hydrometer" else 0.0)
@@ -333,7 +347,10 @@ def invert(sheets: list[Sheet], test: LabTest, folder: Path, *, bins: int = 12, 
                                   test.sphere_centre, test.sphere_diameter, test.sphere_mass, test.meniscus)
         reduction.append((sheet.instrument, sheet.time, d, p))
     diameters = np.concatenate([d for _, _, d, _ in reduction])
-    edges = np.geomspace(diameters.min(), diameters.max(), bins)
+    # the bins between the finest and the coarsest reading, and one more above: the earliest readings
+    # see the grains just coarser than their own diameter pass
+    reported = np.geomspace(diameters.min(), diameters.max(), bins)
+    edges = np.append(reported, reported[-1] ** 2 / reported[-2])
     shares = first_guess(diameters, np.concatenate([p for *_, p in reduction]), edges)
     data = np.concatenate([s.reading - (test.zero_correction if s.instrument == "hydrometer" else 0.0) for s in sheets])
     sigma = np.concatenate([np.full(len(s.time), test.noise[s.instrument]) for s in sheets])
@@ -368,7 +385,9 @@ def invert(sheets: list[Sheet], test: LabTest, folder: Path, *, bins: int = 12, 
             model_sigma = np.empty(len(data))
             for sheet in sheets:
                 n = len(sheet.time)
-                model_sigma[start:start + n] = math.sqrt(np.mean(gap[start:start + n] ** 2) / 2)
+                # and at least the resolution's 0.2 points of percent finer (the time step's, error budget)
+                floor = 0.002 * abs(whole_sample_reading(sheet, test, water) - clear_reading(sheet, test, water))
+                model_sigma[start:start + n] = max(math.sqrt(np.mean(gap[start:start + n] ** 2) / 2), floor)
                 start += n
             sigma = np.sqrt(reading_sigma ** 2 + model_sigma ** 2)
         for _ in range(2):    # Gauss-Newton on this run's columns
@@ -403,7 +422,9 @@ def invert(sheets: list[Sheet], test: LabTest, folder: Path, *, bins: int = 12, 
         start += n
     resolution = (f"{particles} parcels, Courant {courant:g}, standard drag curve + Richardson & Zaki, water at "
                   f"{mean_temperature:.3g} C")
-    result = Inversion(edges, percent, np.clip(percent - band, 0, 100), np.clip(percent + band, 0, 100), reduction,
+    inside = slice(0, len(reported))
+    percent, band = percent[inside], band[inside]
+    result = Inversion(reported, percent, np.clip(percent - band, 0, 100), np.clip(percent + band, 0, 100), reduction,
                        rows, chi2, round_number, float(weight), resolution)
     result.notes.append(f"forward model: {resolution}; {round_number} round(s)")
     if not result.consistent:
@@ -415,3 +436,83 @@ def invert(sheets: list[Sheet], test: LabTest, folder: Path, *, bins: int = 12, 
         result.notes.append(f"reading {name} at {t / 60:g} min is {abs(modelled - measured) / s:.1f} noise units off the "
                             "fit: check it")
     return result
+
+
+# The designs `design_test` compares: instruments and their reading times [min] (the pipette at 10 cm).
+DESIGNS = {
+    "152H, D422 times": [("hydrometer", (2, 5, 15, 30, 60, 250, 1440))],
+    "152H, D7928 times": [("hydrometer", (1, 2, 4, 15, 30, 60, 240, 1440))],
+    "pipette at 10 cm": [("pipette", None)],
+    "buoyancy sphere, Bravo et al.'s times": [("buoyancy", (0.5, 1, 2, 4, 15, 30, 60, 120, 240, 480))],
+    "152H (D7928) + pipette": [("hydrometer", (1, 2, 4, 15, 30, 60, 240, 1440)), ("pipette", None)],
+}
+
+
+def design_test(psd: PSD, folder: Path, masses=(0.030, 0.045, 0.060, 0.080), designs: dict = DESIGNS,
+                test: LabTest = LabTest(), bins: int = 12, draws: int = 24, particles: int = 20000,
+                seed: int = 1) -> list[tuple[str, float, int, float, float]]:
+    """Which instrument, reading times and sample mass recover `psd` best: for each mass a forward run of
+    the test, each design's readings of it with their noise drawn `draws` times and fitted as `invert`
+    fits (linearised at the truth), and the error of the recovered PSD at the bin edges against the
+    truth. Returns (design, mass, readings, mean error, worst error) [pp], the mean over the draws of each
+    draw's mean and worst absolute error (NaN, with no readings, where the instrument cannot read that
+    mass, e.g. a suspension beyond the 152H's scale). The hindrance's own uncertainty, which grows with the mass, is
+    not in it (docs/error-budget.md: the exponent row)."""
+    water = Suspension.at_temperature(20.0, test.particle_density)
+    rng = np.random.default_rng(seed)
+    results = []
+    for mass in masses:
+        trial = replace(test, mass=mass)
+        # the edges from the Stokes diameters the designs' readings resolve, as `invert` takes them
+        scales = [d for parts in designs.values() for d in _design_diameters(parts, trial, water)]
+        edges = np.geomspace(min(scales), max(scales), bins)
+        truth = np.diff(np.concatenate([[0.0], psd.at(edges), [100.0]])) / 100.0
+        spread = 0.8 * truth + 0.2 / len(truth)
+        run = run_forward(psd_of(spread, edges), edges, trial, water, 1.02 * 86400, folder / f"mass{mass * 1e3:g}g",
+                          particles, 4.0, seed)
+        for name, parts in designs.items():
+            sheets = _design_sheets(parts, trial, water)
+            times = [s.time for s in sheets]
+            try:
+                base = run.readings(truth, sheets, times)
+                jac = np.empty((len(base), len(truth)))
+                for k in range(len(truth)):
+                    moved = truth.copy()
+                    moved[k] += 1e-3
+                    jac[:, k] = (run.readings(moved, sheets, times) - base) / 1e-3
+            except ValueError:    # e.g. a suspension denser than the 152H's scale: it cannot read this mass
+                results.append((name, mass, 0, math.nan, math.nan))
+                continue
+            sigma = np.concatenate([np.full(len(s.time), trial.noise[s.instrument]) for s in sheets])
+            mean_errors, worst_errors = [], []
+            for _ in range(draws):
+                noisy = base + rng.normal(0.0, sigma)
+                x, _, _ = fit(jac, base, truth, noisy, sigma)
+                error = np.abs(100 * (np.cumsum(x) - np.cumsum(truth))[:-1])
+                mean_errors.append(error.mean())
+                worst_errors.append(error.max())
+            results.append((name, mass, len(base), float(np.mean(mean_errors)), float(np.mean(worst_errors))))
+    return results
+
+
+def _design_sheets(parts, test: LabTest, water: Suspension) -> list[Sheet]:
+    """The sheets of a design (readings unset: the forward run reads them)."""
+    sheets = []
+    for instrument, minutes in parts:
+        if instrument == "pipette":
+            time = np.sort(Pipette(0.10).default_times(water))
+            depth = np.full(len(time), 0.10)
+        else:
+            time = np.array(minutes, float) * 60
+            depth = np.empty(0)
+        sheets.append(Sheet(instrument, Path(instrument), time, np.zeros(len(time)), np.full(len(time), 20.0), depth))
+    return sheets
+
+
+def _design_diameters(parts, test: LabTest, water: Suspension) -> list[float]:
+    """The Stokes diameters a design's readings resolve, at the instruments' nominal depths."""
+    out = []
+    for sheet in _design_sheets(parts, test, water):
+        depth = {"hydrometer": 0.15, "pipette": 0.10, "buoyancy": test.sphere_centre}[sheet.instrument]
+        out += list(water.stokes_diameter(depth, sheet.time))
+    return out
