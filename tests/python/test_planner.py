@@ -126,6 +126,12 @@ def test_the_errors_are_against_the_converged_answer_with_its_sampling_error(tmp
     assert list(models)[0] == ("difelice", "difelice") and len(models) == 5
     assert all(e is not None and e > 0 for e in models.values())
     assert (tmp_path / "models.csv").read_text().startswith("model,")
+    # each model's change of every reading, and each run's sampling error at its parcel count
+    bravo = report["models"][0]["changes"]
+    assert set(bravo) == {"hydrometer", "buoyancy", "pipette"} and all(len(v) >= 3 for v in bravo.values())
+    assert max(abs(c) for v in bravo.values() for _, c in v) <= models[("difelice", "difelice")]
+    fewer = next(t for t in report["trials"] if t["name"] == "particles=1000")
+    assert fewer["sampling_error"] == pytest.approx(report["replicas"][0]["sampling_error"] * 2 ** 0.5)
 
 
 def test_the_report_of_a_test_is_reproducible_with_a_seed(tmp_path):

@@ -75,6 +75,7 @@ class Plan:
     replicas: list[Trial] = field(default_factory=list)     # the reference's runs (the first is `reference`)
     uncertainty: dict | None = None      # standard error of the reference's mean per observable and reading
     models: list[Trial] = field(default_factory=list)       # the scene's other models, against the reference
+    converged: dict = field(default_factory=dict)    # the reference's mean observables (the converged estimate)
 
     def sampling_error(self) -> tuple[float, float]:
         """The largest standard error of the reference's mean and of one run at the reference's resolution
@@ -83,6 +84,25 @@ class Plan:
             return 0.0, 0.0
         mean = max(float(np.max(e)) for e in self.uncertainty.values())
         return mean, mean * math.sqrt(len(self.replicas))
+
+    def run_sampling(self, t: Trial) -> float | None:
+        """The sampling error of a reading for one run of a trial [the scene's unit]: one run's at the
+        reference's parcels, scaled by the square root of the parcel ratio (None without replicas)."""
+        _, one = self.sampling_error()
+        if not one or "particles" not in t.settings:
+            return None
+        return one * math.sqrt(self.reference.settings["particles"] / t.settings["particles"])
+
+    def model_changes(self, t: Trial) -> dict[str, list[list[float]]]:
+        """A model's change of every reading against the reference's mean: {observable: [[x, change], ...]}."""
+        changes = {}
+        for name, (x_ref, y_ref) in self.converged.items():
+            if name not in t.outcome.observations:
+                continue
+            x, y = t.outcome.observations[name]
+            _, i, j = np.intersect1d(x, x_ref, return_indices=True)
+            changes[name] = [[float(x[a]), float(y[a] - y_ref[b])] for a, b in zip(i, j)]
+        return changes
 
     def model_table(self) -> Table:
         """Each other model's change of the readings against the reference, per observable."""
@@ -198,11 +218,14 @@ class Plan:
         """Every run: its settings, loop time, errors per observable."""
         names = sorted(self.reference.errors) or sorted(self.reference.outcome.observations)
         table = Table(["trial", *[k.name for k in self.knobs], "seed", "loop_s", "status",
-                       *[f"error_{n}" for n in names], "max_error", "predicted_error", "predicted_cost_ratio"])
+                       *[f"error_{n}" for n in names], "max_error", "sampling_error", "predicted_error",
+                       "predicted_cost_ratio"])
         for t in [*self.replicas, *self.trials, *self.verified, *self.models]:
+            sampling = self.run_sampling(t)
             table.add(t.name, *[t.settings[k.name] for k in self.knobs], t.seed, f"{t.outcome.loop_seconds:.4g}",
                       "failed: " + t.outcome.failure if t.outcome.failure else "ok",
                       *[f"{t.errors.get(n, math.nan):.4g}" for n in names], f"{t.error:.4g}",
+                      "" if sampling is None else f"{sampling:.4g}",
                       "" if t.predicted_error is None else f"{t.predicted_error:.4g}",
                       "" if t.predicted_cost is None else f"{t.predicted_cost:.4g}")
         return table
@@ -211,6 +234,7 @@ class Plan:
         """Everything in the report, for scripts (report.json)."""
         def trial(t: Trial) -> dict:
             return {"name": t.name, "settings": t.settings, "seed": t.seed, "loop_seconds": t.outcome.loop_seconds,
+                    "sampling_error": self.run_sampling(t),
                     "failure": t.outcome.failure, "errors": t.errors, "error": t.error if math.isfinite(t.error) else None,
                     "predicted_error": t.predicted_error, "predicted_cost_ratio": t.predicted_cost}
         return {"scene": self.scene_name, "unit": self.unit, "tolerance": self.tolerance,
@@ -219,7 +243,8 @@ class Plan:
                 "reference": trial(self.reference), "trials": [trial(t) for t in self.trials],
                 "verified": [trial(t) for t in self.verified], "decision": trial(self.decision),
                 "speedup": self.speedup, "command": self.command, "scene_options": self.scene_options,
-                "replicas": [trial(t) for t in self.replicas], "models": [trial(t) for t in self.models],
+                "replicas": [trial(t) for t in self.replicas],
+                "models": [dict(trial(t), changes=self.model_changes(t)) for t in self.models],
                 "reference_standard_error": {k: np.asarray(v).tolist() for k, v in (self.uncertainty or {}).items()},
                 "candidates": [{"settings": s, "predicted_error": e, "predicted_cost_ratio": c}
                                for s, e, c in self.candidates]}
@@ -392,7 +417,8 @@ def plan_effects(scene, out: Path, tolerance: float, jobs: int = 2, seed: int = 
         decision = reference
     scene.write(decision.settings, decided, decision.seed)    # the decided deck is the run that was verified
     plan = Plan(name, scene.unit, tolerance, scene.knobs, scene.screens, reference, trials, verified, decision, fixed,
-                candidates, scene.describe(decision.settings), scene.options_record(), replicas, uncertainty, models)
+                candidates, scene.describe(decision.settings), scene.options_record(), replicas, uncertainty, models,
+                converged)
     plan.save(out)
     return plan
 
