@@ -133,7 +133,7 @@ def check_sheet(sheet: Sheet, whole: float, resolution: float) -> None:
     if len(rises):
         k = rises[0] + 1
         raise SheetError(f"{sheet.label}: the reading at {sheet.time[k] / 60:g} min ({sheet.reading[k]:g}) goes back "
-                         f"towards the initial one by more than the reading's resolution ({resolution:g}): the solids "
+                         f"towards the initial one by more than the tolerance ({resolution:.3g}): the solids "
                          "at a depth only fall as the test goes on (a misread, or a flocculating sample)")
 
 
