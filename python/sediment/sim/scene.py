@@ -50,7 +50,7 @@ class Cylinder:
 DRAGS = ("standard", "schiller-naumann", "dallavalle", "stokes", "difelice")
 # How the local concentration hinders the drag: Richardson & Zaki's measured exponent (Rowe's smooth
 # fit, the default: left out, the hindrance moves the readings of Bravo et al.'s five samples at 60 g/L
-# by points of percent finer, docs/effects.md), Garside & Al-Dibouni's, Di Felice's, none.
+# by 2.1 to 18.9 points of percent finer, docs/effects.md), Garside & Al-Dibouni's, Di Felice's, none.
 HINDRANCES = ("richardson-zaki", "garside", "difelice", "none")
 
 
@@ -82,11 +82,6 @@ class Effects:
     def hindered(self) -> bool:
         """Whether the drag follows the local concentration."""
         return self.hindrance != "none"
-
-    @property
-    def single_law(self) -> str:
-        """The single-sphere drag law (Dallavalle's under law difelice)."""
-        return "dallavalle" if self.drag == "difelice" else self.drag
 
     def describe(self) -> str:
         """The drag in words, as decks and reports name it."""
