@@ -150,6 +150,9 @@ void ComputeConcentrationGrid::init()
     const bool own_bounds = has_bounds && grid.resolved[d];
     const double lo = own_bounds ? bounds[d][0] : domain->boxlo[d];
     const double hi = own_bounds ? bounds[d][1] : domain->boxhi[d];
+    if (own_bounds && (hi <= domain->boxlo[d] || lo >= domain->boxhi[d]))
+      error->all(FLERR, "Compute concentration/grid: its bounds {} to {} along {} lie wholly outside the box ({} to {}): "
+                 "it would see no atom", lo, hi, "xyz"[d], domain->boxlo[d], domain->boxhi[d]);
     grid.axes[d] = {lo, (hi - lo) / counts[d], counts[d], domain->periodicity[d] && !own_bounds};
     cell_volume *= grid.resolved[d] ? grid.axes[d].thickness : extent(d);
   }

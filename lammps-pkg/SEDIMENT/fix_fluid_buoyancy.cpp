@@ -13,11 +13,13 @@
 #include "atom.h"
 #include "compute.h"
 #include "error.h"
+#include "group.h"
 #include "modify.h"
 #include "update.h"
 
 #include <algorithm>
 #include <cstring>
+#include <mpi.h>
 
 using namespace LAMMPS_NS;
 using namespace FixConst;
@@ -88,6 +90,18 @@ void FixFluidBuoyancy::init()
     gravity_fix = gravities.front();
   }
   mixture = mixture_id ? ComputeConcentrationGrid::find_fraction(lmp, mixture_id, caller) : nullptr;
+  // Two fixes of one fluid on the same atom would add its buoyancy twice.
+  for (Fix *other : sediment_fixes_of_style(lmp, "fluid/buoyancy")) {
+    if (other == this || FixFluid::find(lmp, static_cast<FixFluidBuoyancy *>(other)->fluid_id, caller) != fluid) continue;
+    int both = 0;
+    for (int i = 0; i < atom->nlocal; ++i) both += (atom->mask[i] & groupbit) && (atom->mask[i] & other->groupbit);
+    int both_all = 0;
+    MPI_Allreduce(&both, &both_all, 1, MPI_INT, MPI_SUM, world);
+    if (both_all > 0)
+      error->all(FLERR, "Fix fluid/buoyancy: fixes {} and {} both give the buoyancy of fluid {} to {} atom(s) (groups "
+                 "{} and {}): it would count twice; give each atom one", id, other->id, fluid_id, both_all,
+                 group->names[igroup], group->names[other->igroup]);
+  }
   int dim = 0;
   gravity = static_cast<double *>(gravity_fix->extract("gvec", dim));
   if (!gravity) error->all(FLERR, "Fix fluid/buoyancy: fix gravity does not expose its vector");

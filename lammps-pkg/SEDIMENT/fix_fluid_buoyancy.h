@@ -26,6 +26,7 @@ class FixFluidBuoyancy : public Fix {
   void setup(int) override;
   void post_force(int) override;
   double compute_vector(int) override;
+  class FixFluid *fluid_fix() const { return fluid; }
 
  private:
   char *fluid_id, *gravity_id, *mixture_id;

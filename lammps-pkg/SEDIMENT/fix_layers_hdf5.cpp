@@ -213,6 +213,8 @@ FixLayersHDF5::FixLayersHDF5(LAMMPS *lmp, int narg, char **arg) :
   nevery = utils::inumeric(FLERR, arg[3], false, lmp);
   if (nevery <= 0) error->all(FLERR, "Fix layers/hdf5: N must be > 0");
   path = arg[4];
+  if (path.empty() || path.back() == '/')
+    error->all(FLERR, "Fix layers/hdf5: '{}' names no file: give a file name such as layers.h5", path);
   if (strncmp(arg[5], "c_", 2) != 0)
     error->all(FLERR, "Fix layers/hdf5: expected a compute reference c_ID, not '{}'", arg[5]);
   compute_id = utils::strdup(arg[5] + 2);

@@ -181,6 +181,9 @@ int FixNVESphereFluid::setmask()
 
 void FixNVESphereFluid::init()
 {
+  if (!(update->dt > 0.0))
+    error->all(FLERR, "Fix nve/sphere/fluid: the timestep must be > 0, not {} (a drag step runs forward in time)",
+               update->dt);
   drags.clear();
   for (Fix *drag : sediment_fixes_of_style(lmp, "fluid/drag")) drags.push_back(static_cast<FixFluidDrag *>(drag));
   uniform = nullptr;    // decided in setup(), once every fix is initialised

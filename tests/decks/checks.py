@@ -966,6 +966,7 @@ print "RESULT atoms $(atoms) outside $(f_step[3])"
 # Current LAMMPS refuses numbers beyond the double range in utils::numeric itself, before the style
 # sees them; LAMMPS 2021 turns them into inf, which the style refuses.
 OUT_OF_RANGE = "is out of range"
+ONE_SPHERE = "create_atoms 1 single 0.5 0.5 0.5\nset atom 1 diameter 1e-3 density 2500\n"
 BAD_INPUT = [
     ("fix f all fluid density -1 viscosity 1e-3", "density must be finite and > 0"),
     ("fix f all fluid density 1e400 viscosity 1e-3", ("density must be finite and > 0", OUT_OF_RANGE)),
@@ -1045,6 +1046,16 @@ BAD_INPUT = [
     ("fix f all fluid density 1000 viscosity 1e-3\nfix d all fluid/drag f law difelice hindrance garside concentration c_x", "law difelice is Dallavalle's drag with Di Felice's hindrance"),
     ("fix f all fluid density 1000 viscosity 1e-3\nfix d all fluid/drag f law standart", "unknown law 'standart'"),
     ("fix f all fluid density 1000 viscosity 1e-3\nfix b all fluid/buoyancy f max_fraction 1", "max_fraction must be in (0, 1)"),
+    # what the styles cannot honour
+    (ONE_SPHERE + "fix f all fluid density 1000 viscosity 1e-3\nfix b1 all fluid/buoyancy f\nfix b2 all fluid/buoyancy f\nrun 0",
+     "fixes b1 and b2 both give the buoyancy of fluid f to 1 atom(s)"),
+    (ONE_SPHERE + "fix f all fluid density 1000 viscosity 1e-3\nfix d all fluid/drag f law stokes\ntimestep 0\n"
+     "fix s all nve/sphere/fluid\nrun 1", "the timestep must be > 0, not 0"),
+    (ONE_SPHERE + "fix f all fluid density 1000 viscosity 1e-3\nfix d all fluid/drag f law stokes\ntimestep -0.001\n"
+     "fix s all nve/sphere/fluid\nrun 1", "the timestep must be > 0, not -0.001"),
+    ("compute c all concentration/grid layers z 10 bounds 2 3\nrun 0", "lie wholly outside the box"),
+    ("fix f all fluid density 1000 viscosity 1e-3\ncompute c all concentration/grid layers z 10\n"
+     "fix l all layers/hdf5 1 '' c_c", "'' names no file"),
     ("fix f all fluid density 1000 viscosity 1e-3\nfix d all fluid/drag f law difelice concentration c_x\nrun 0", "compute 'x' does not exist"),
     ("fix f all fluid density 1000 viscosity 1e-3\nfix d all fluid/drag f law difelice concentration c_x buoyancy heavy", "buoyancy must be plain or mixture"),
     ("fix f all fluid density 1000 viscosity 1e-3\nfix d all fluid/drag f law difelice concentration c_x max_fraction 1.2", "max_fraction must be in (0, 1)"),
