@@ -15,7 +15,8 @@ __version__ = "0.1.0"
 
 _CORE = ("DragModel", "critical_yield_number", "drag_coefficient", "drag_law_names", "explicit_step_limit",
          "mixture_density", "rayleigh_time", "relaxation_time", "rotation_drag_rate", "sphere_inertia",
-         "stokes_velocity", "submergence", "terminal_velocity", "time_to_fraction")
+         "stokes_velocity", "submergence", "terminal_velocity", "time_to_fraction", "water_density",
+         "water_viscosity")
 _STYLES = ("lammps_with_styles", "register_styles")
 
 __all__ = sorted(_CORE + _STYLES)
@@ -35,3 +36,8 @@ def __getattr__(name: str):
 
         return getattr(styles, name)
     raise AttributeError(f"module 'sediment' has no attribute '{name}'")
+
+
+def __dir__() -> list[str]:
+    """The module's own names and those loaded on first use, for dir() and completion."""
+    return sorted(set(globals()) | set(__all__))

@@ -68,3 +68,12 @@ def test_water_at_the_laboratory_temperature():
 def test_hindrance_refused_where_it_does_not_apply(law, hindrance, message):
     with pytest.raises(ValueError, match=message):
         _core.DragModel(law, 998.2, 1.002e-3, hindrance=hindrance)
+
+
+def test_the_package_exports_what_the_core_has():
+    import sediment
+
+    assert sediment.water_viscosity(20.0) == pytest.approx(1.0016e-3)
+    for name in sediment.__all__:
+        assert callable(getattr(sediment, name)), name
+        assert name in dir(sediment)
