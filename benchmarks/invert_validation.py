@@ -69,9 +69,9 @@ def synthesise(psd_path: Path, folder: Path) -> list[Path]:
     sphere_times = np.array(SCHEDULES["bravo"], float) * 60
     # the balance reads the sphere in the water of the moment (its density at the drifted temperature)
     from sediment import _core
-    volume = np.pi / 6 * 0.025 ** 3
-    shift = np.array([_core.water_density(t) - water.fluid_density for t in drift(sphere_times)]) * volume * 1e3
-    apparent = BuoyancySphere(0.3 * scene.height).read(column, lab_to_run(sphere_times)).reading - shift
+    sphere = BuoyancySphere(0.3 * scene.height)
+    shift = np.array([_core.water_density(t) - water.fluid_density for t in drift(sphere_times)]) * sphere.volume * 1e3
+    apparent = sphere.read(column, lab_to_run(sphere_times)).reading - shift
     lines = ["time_min,apparent_mass_g,temperature_C"] + [
         f"{t / 60:g},{np.round(a, 3):.3f},{np.round(T, 1):g}" for t, a, T in zip(sphere_times, apparent, drift(sphere_times))]
     (folder / "buoyancy.csv").write_text("\n".join(lines) + "\n")

@@ -38,7 +38,7 @@ import numpy as np
 from .. import _core, figures
 from ..results import Table, write_text
 from .psd import PSD
-from .readout import BuoyancySphere, Column, Hydrometer, Pipette, Suspension
+from .readout import BuoyancySphere, Column, Hydrometer, Pipette, Suspension, gs_correction
 from .sheet import Sheet, check_sheet, standard_reduction
 
 CONVERGED = 0.2           # points of percent finer between rounds
@@ -69,29 +69,31 @@ class LabTest:
         return self.mass / (self.cylinder_area * self.height)
 
     @property
-    def sphere_centre(self) -> float:
-        """The buoyancy sphere's centre depth [m]."""
-        return 0.3 * self.height if self.sphere_depth is None else self.sphere_depth
+    def sphere(self) -> BuoyancySphere:
+        """The buoyancy sphere, its centre at `sphere_depth` (default 0.3 of the height)."""
+        depth = 0.3 * self.height if self.sphere_depth is None else self.sphere_depth
+        return BuoyancySphere(depth, self.sphere_diameter, self.sphere_mass)
+
+    def corrected(self, sheet: Sheet) -> np.ndarray:
+        """The sheet's readings after the hydrometer's zero correction."""
+        return sheet.reading - (self.zero_correction if sheet.instrument == "hydrometer" else 0.0)
 
 
 def whole_sample_reading(sheet: Sheet, test: LabTest, water: Suspension) -> float:
     """What the instrument reads with the whole sample in suspension (its unit)."""
     c0 = test.initial_concentration
-    gs = test.particle_density / 1000.0
     if sheet.instrument == "hydrometer":
-        return c0 / (1.65 * gs / (2.65 * (gs - 1)))
+        return c0 / gs_correction(test.particle_density / 1000.0)
     if sheet.instrument == "pipette":
         return c0
-    volume = math.pi / 6 * test.sphere_diameter ** 3
     rho = water.mixture_density(c0 / test.particle_density)
-    return (test.sphere_mass - rho * volume) * 1e3
+    return (test.sphere_mass - rho * test.sphere.volume) * 1e3
 
 
-def clear_reading(sheet: Sheet, test: LabTest, water: Suspension) -> float:
-    """What the instrument reads in clear water (its unit)."""
-    if sheet.instrument == "buoyancy":
-        return (test.sphere_mass - water.fluid_density * math.pi / 6 * test.sphere_diameter ** 3) * 1e3
-    return 0.0
+def solids_signal(sheet: Sheet, test: LabTest, water: Suspension) -> float:
+    """How far the whole sample moves the instrument's reading from clear water's (its unit)."""
+    clear = (test.sphere_mass - water.fluid_density * test.sphere.volume) * 1e3 if sheet.instrument == "buoyancy" else 0.0
+    return abs(whole_sample_reading(sheet, test, water) - clear)
 
 
 def effective_times(sheet: Sheet, reference: Suspension, offset: float = 0.0) -> np.ndarray:
@@ -136,12 +138,25 @@ class ForwardRun:
                 out.append(np.array([Pipette(z).read(column, [ti]).reading[0] for z, ti in zip(sheet.depth, t)]))
             else:
                 # the balance reads the sphere in the water at each reading's temperature
-                sphere = BuoyancySphere(self.test.sphere_centre, self.test.sphere_diameter, self.test.sphere_mass)
-                volume = math.pi / 6 * self.test.sphere_diameter ** 3
+                sphere = self.test.sphere
                 recorded = np.where(np.isfinite(sheet.temperature), sheet.temperature, self.water.temperature or 20.0)
                 water = np.array([_core.water_density(c) for c in recorded])
-                out.append(sphere.read(column, t).reading - (water - self.water.fluid_density) * volume * 1e3)
+                out.append(sphere.read(column, t).reading - (water - self.water.fluid_density) * sphere.volume * 1e3)
         return np.concatenate(out)
+
+
+def linearise(run: ForwardRun, shares: np.ndarray, sheets: list[Sheet],
+              times: list[np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
+    """The modelled readings of a split of the mass and their derivatives by each bin's share
+    (forward differences of 1e-3)."""
+    base = run.readings(shares, sheets, times)
+    step = 1e-3
+    jac = np.empty((len(base), len(shares)))
+    for k in range(len(shares)):
+        moved = shares.copy()
+        moved[k] += step
+        jac[:, k] = (run.readings(moved, sheets, times) - base) / step
+    return base, jac
 
 
 def run_forward(psd: PSD, edges: np.ndarray, test: LabTest, water: Suspension, t_end: float, folder: Path,
@@ -334,17 +349,16 @@ def invert(sheets: list[Sheet], test: LabTest, folder: Path, *, bins: int = 24, 
     mean_temperature = float(recorded.mean()) if len(recorded) else 20.0
     water = Suspension.at_temperature(mean_temperature, test.particle_density)
     c0 = test.initial_concentration
-    for sheet in sheets:
+    signals = [solids_signal(sheet, test, water) for sheet in sheets]
+    for sheet, signal in zip(sheets, signals):
         # the tolerance: twice the reading's noise, and 2 % of the solids' signal for the sampling of a real
         # suspension (a pipette's first samples can draw a little more than the mean)
-        whole = whole_sample_reading(sheet, test, water)
-        signal = abs(whole - clear_reading(sheet, test, water))
-        check_sheet(sheet, whole, max(2 * test.noise[sheet.instrument], 0.02 * signal))
+        check_sheet(sheet, whole_sample_reading(sheet, test, water), max(2 * test.noise[sheet.instrument], 0.02 * signal))
+    corrected = [test.corrected(sheet) for sheet in sheets]
     reduction = []
-    for sheet in sheets:
-        reading = sheet.reading - (test.zero_correction if sheet.instrument == "hydrometer" else 0.0)
+    for sheet, reading in zip(sheets, corrected):
         d, p = standard_reduction(replace(sheet, reading=reading), water, c0, test.hydrometer, test.cylinder_area,
-                                  test.sphere_centre, test.sphere_diameter, test.sphere_mass, test.meniscus)
+                                  test.sphere, test.meniscus)
         reduction.append((sheet.instrument, sheet.time, d, p))
     diameters = np.concatenate([d for _, _, d, _ in reduction])
     # the bins between the finest and the coarsest reading, and one more above: the earliest readings
@@ -352,20 +366,10 @@ def invert(sheets: list[Sheet], test: LabTest, folder: Path, *, bins: int = 24, 
     reported = np.geomspace(diameters.min(), diameters.max(), bins)
     edges = np.append(reported, reported[-1] ** 2 / reported[-2])
     shares = first_guess(diameters, np.concatenate([p for *_, p in reduction]), edges)
-    data = np.concatenate([s.reading - (test.zero_correction if s.instrument == "hydrometer" else 0.0) for s in sheets])
+    data = np.concatenate(corrected)
     sigma = np.concatenate([np.full(len(s.time), test.noise[s.instrument]) for s in sheets])
     times = [effective_times(s, water) for s in sheets]
     t_end = 1.02 * max(t[-1] for t in times)
-
-    def linearised(run: ForwardRun, x: np.ndarray, when: list[np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
-        base = run.readings(x, sheets, when)
-        step = 1e-3
-        jac = np.empty((len(base), len(x)))
-        for k in range(len(x)):
-            moved = x.copy()
-            moved[k] += step
-            jac[:, k] = (run.readings(moved, sheets, when) - base) / step
-        return base, jac
 
     previous = None
     weight = None
@@ -383,22 +387,20 @@ def invert(sheets: list[Sheet], test: LabTest, folder: Path, *, bins: int = 24, 
             gap = run.readings(shares, sheets, times) - other.readings(shares, sheets, times)
             start = 0
             model_sigma = np.empty(len(data))
-            for sheet in sheets:
+            for sheet, signal in zip(sheets, signals):
                 n = len(sheet.time)
                 # and at least the resolution's 0.2 points of percent finer (the time step's, error budget)
-                floor = 0.002 * abs(whole_sample_reading(sheet, test, water) - clear_reading(sheet, test, water))
-                model_sigma[start:start + n] = max(math.sqrt(np.mean(gap[start:start + n] ** 2) / 2), floor)
+                model_sigma[start:start + n] = max(math.sqrt(np.mean(gap[start:start + n] ** 2) / 2), 0.002 * signal)
                 start += n
             sigma = np.sqrt(reading_sigma ** 2 + model_sigma ** 2)
         for _ in range(2):    # Gauss-Newton on this run's columns
-            base, jac = linearised(run, shares, times)
+            base, jac = linearise(run, shares, sheets, times)
             shares, chi2, weight = fit(jac, base, shares, data, sigma)
         percent = 100 * np.cumsum(shares)[:-1]
         if previous is not None and np.max(np.abs(percent - previous)) < CONVERGED:
             break
         previous = percent
-    base, jac = linearised(run, shares, times)
-    model = run.readings(shares, sheets, times)
+    model, jac = linearise(run, shares, sheets, times)
     chi2 = float(np.sum(((model - data) / sigma) ** 2))
     # the band: the fit again for draws of the reading noise and the thermometer's offset
     rng = np.random.default_rng(seed)
@@ -406,7 +408,7 @@ def invert(sheets: list[Sheet], test: LabTest, folder: Path, *, bins: int = 24, 
     for _ in range(draws):
         offset = rng.normal(0.0, test.thermometer)
         shifted = [effective_times(s, water, offset) for s in sheets]
-        b, j = linearised(run, shares, shifted) if offset else (base, jac)
+        b, j = linearise(run, shares, sheets, shifted) if offset else (model, jac)
         noisy = data + rng.normal(0.0, reading_sigma)
         x, _, _ = fit(j, b, shares, noisy, sigma, weight)
         draws_percent.append(100 * np.cumsum(x)[:-1])
@@ -474,12 +476,7 @@ def design_test(psd: PSD, folder: Path, masses=(0.030, 0.045, 0.060, 0.080), des
             sheets = _design_sheets(parts, trial, water)
             times = [s.time for s in sheets]
             try:
-                base = run.readings(truth, sheets, times)
-                jac = np.empty((len(base), len(truth)))
-                for k in range(len(truth)):
-                    moved = truth.copy()
-                    moved[k] += 1e-3
-                    jac[:, k] = (run.readings(moved, sheets, times) - base) / 1e-3
+                base, jac = linearise(run, truth, sheets, times)
             except ValueError:    # e.g. a suspension denser than the 152H's scale: it cannot read this mass
                 results.append((name, mass, 0, math.nan, math.nan))
                 continue
@@ -513,6 +510,6 @@ def _design_diameters(parts, test: LabTest, water: Suspension) -> list[float]:
     """The Stokes diameters a design's readings resolve, at the instruments' nominal depths."""
     out = []
     for sheet in _design_sheets(parts, test, water):
-        depth = {"hydrometer": 0.15, "pipette": 0.10, "buoyancy": test.sphere_centre}[sheet.instrument]
+        depth = {"hydrometer": 0.15, "pipette": 0.10, "buoyancy": test.sphere.depth}[sheet.instrument]
         out += list(water.stokes_diameter(depth, sheet.time))
     return out

@@ -236,6 +236,11 @@ class Hydrometer:
             lo, hi = (mid, hi) if excess(mid) < 0 else (lo, mid)
         return 0.5 * (lo + hi)
 
+    def stokes_depth(self, top, cylinder_area: float = D422_CYLINDER_AREA, level_rise: bool = True):
+        """The depth Stokes' law takes for a bulb whose top is at `top`: its centre, with `level_rise`
+        as D422 takes it, L = L1 + (L2 - VB / A_c) / 2 (the bulb lifts the surface by VB / A_c)."""
+        return top + 0.5 * (self.bulb_length - (self.bulb_volume / cylinder_area if level_rise else 0.0))
+
     def read(self, column: Column, times_s, cylinder_area: float = D422_CYLINDER_AREA, level_rise: bool = True) -> Readings:
         """Readings at the given times. The Stokes depth is the bulb centre; with `level_rise` it is
         taken as in D422, L = L1 + (L2 - VB / A_c) / 2: the bulb lifts the surface by VB / A_c."""
@@ -245,12 +250,12 @@ class Hydrometer:
                              f"({bulb_area * 1e4:.3g} cm2)")
         suspension = column.suspension
         c0 = column.initial_concentration()
-        a = 1.65 * suspension.specific_gravity / (2.65 * (suspension.specific_gravity - 1))    # 152H Gs correction
+        a = gs_correction(suspension.specific_gravity)
         rows = []
         for t in times_s:
             top = self.bulb_top_depth(column, t)
             reading = (self.scale_zero - top) / self.scale_step
-            depth = top + 0.5 * (self.bulb_length - (self.bulb_volume / cylinder_area if level_rise else 0.0))
+            depth = self.stokes_depth(top, cylinder_area, level_rise)
             rows.append((t, depth, reading, suspension.stokes_diameter(depth, t), _percent(reading * a, c0)))
         return _readings("hydrometer", rows)
 
@@ -264,20 +269,29 @@ class BuoyancySphere:
     diameter: float = 0.025
     mass: float = 0.020     # its own mass [kg]; shifts the apparent mass, not the percent finer
 
+    @property
+    def volume(self) -> float:
+        """[m3]."""
+        return np.pi / 6 * self.diameter ** 3
+
+    def solids(self, apparent, fluid_density, specific_gravity: float):
+        """Solids per volume [kg/m3] around the sphere from its apparent mass [kg] in water of
+        `fluid_density` (Gs from water at 1000 kg/m3)."""
+        in_water = self.mass - fluid_density * self.volume
+        return (in_water - apparent) / self.volume * specific_gravity / (specific_gravity - 1)
+
     def read(self, column: Column, times_s) -> Readings:
         """Apparent mass [g] of the sphere at each time, with the diameter and percent finer it gives."""
         _fits(column, self.depth, self.diameter / 2, "buoyancy sphere")
         suspension = column.suspension
-        volume = np.pi / 6 * self.diameter ** 3
+        volume = self.volume
         c0 = column.initial_concentration()
         rows = []
         for t in times_s:
             phi = column.weighted_mean(t, self.depth, self.diameter / 2)
             rho = suspension.mixture_density(phi)
             apparent = self.mass - rho * volume
-            in_water = self.mass - suspension.fluid_density * volume
-            gs = suspension.specific_gravity
-            concentration = (in_water - apparent) / volume * gs / (gs - 1)    # kg/m3 (Gs from water at 1000)
+            concentration = self.solids(apparent, suspension.fluid_density, suspension.specific_gravity)
             rows.append((t, self.depth, apparent * 1e3, suspension.stokes_diameter(self.depth, t),
                          _percent(concentration, c0)))
         return _readings("buoyancy", rows)
@@ -308,6 +322,11 @@ class Pipette:
     def default_times(self, suspension: Suspension) -> np.ndarray:
         """Stokes times of 50, 20, 10, 5 and 2 um at the pipette depth."""
         return suspension.stokes_time(self.depth, np.array([50, 20, 10, 5, 2]) * 1e-6)
+
+
+def gs_correction(specific_gravity: float) -> float:
+    """The 152H's correction a for grains of another Gs: solids [g/L] = a R (a = 1 at Gs 2.65)."""
+    return 1.65 * specific_gravity / (2.65 * (specific_gravity - 1))
 
 
 def _percent(concentration: float, initial: float) -> float:

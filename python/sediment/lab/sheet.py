@@ -21,7 +21,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .readout import Hydrometer, Suspension
+from .readout import BuoyancySphere, Hydrometer, Suspension, gs_correction
 
 KINDS = {
     "hydrometer": ("time_min", "reading", "temperature_C"),
@@ -138,8 +138,8 @@ def check_sheet(sheet: Sheet, whole: float, resolution: float) -> None:
 
 
 def standard_reduction(sheet: Sheet, suspension: Suspension, initial_concentration: float,
-                       hydrometer: Hydrometer, cylinder_area: float, sphere_depth: float, sphere_diameter: float,
-                       sphere_mass: float, meniscus: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
+                       hydrometer: Hydrometer, cylinder_area: float, sphere: BuoyancySphere,
+                       meniscus: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
     """The ASTM reduction of each reading: Stokes' diameter at the instrument's depth with the water at
     the reading's temperature (the test's where none was recorded), and percent finer from the reading
     (152H: 100 a R / c0)."""
@@ -147,20 +147,16 @@ def standard_reduction(sheet: Sheet, suspension: Suspension, initial_concentrati
                            suspension.temperature if suspension.temperature is not None else 20.0)
     gs = suspension.specific_gravity
     if sheet.instrument == "hydrometer":
-        a = 1.65 * gs / (2.65 * (gs - 1))
-        bulb = hydrometer.scale_zero - hydrometer.scale_step * (sheet.reading + meniscus)
-        depth = bulb + 0.5 * (hydrometer.bulb_length - hydrometer.bulb_volume / cylinder_area)
-        percent = 100 * a * sheet.reading / initial_concentration
+        depth = hydrometer.stokes_depth(hydrometer.scale_zero - hydrometer.scale_step * (sheet.reading + meniscus),
+                                        cylinder_area)
+        percent = 100 * gs_correction(gs) * sheet.reading / initial_concentration
     elif sheet.instrument == "pipette":
         depth = sheet.depth
         percent = 100 * sheet.reading / initial_concentration
     else:
-        volume = math.pi / 6 * sphere_diameter ** 3
         water = np.array([Suspension.at_temperature(t, suspension.particle_density).fluid_density for t in temperature])
-        in_water = sphere_mass - water * volume
-        concentration = (in_water - sheet.reading * 1e-3) / volume * gs / (gs - 1)
-        depth = np.full(len(sheet.time), sphere_depth)
-        percent = 100 * concentration / initial_concentration
+        depth = np.full(len(sheet.time), sphere.depth)
+        percent = 100 * sphere.solids(sheet.reading * 1e-3, water, gs) / initial_concentration
     diameter = np.array([Suspension.at_temperature(t, suspension.particle_density).stokes_diameter(z, time)
                          for t, z, time in zip(temperature, depth, sheet.time)], float)
     return diameter, percent
