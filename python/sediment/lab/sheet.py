@@ -145,6 +145,7 @@ def standard_reduction(sheet: Sheet, suspension: Suspension, initial_concentrati
     (152H: 100 a R / c0)."""
     temperature = np.where(np.isfinite(sheet.temperature), sheet.temperature,
                            suspension.temperature if suspension.temperature is not None else 20.0)
+    waters = [Suspension.at_temperature(t, suspension.particle_density) for t in temperature]
     gs = suspension.specific_gravity
     if sheet.instrument == "hydrometer":
         depth = hydrometer.stokes_depth(hydrometer.scale_zero - hydrometer.scale_step * (sheet.reading + meniscus),
@@ -154,9 +155,8 @@ def standard_reduction(sheet: Sheet, suspension: Suspension, initial_concentrati
         depth = sheet.depth
         percent = 100 * sheet.reading / initial_concentration
     else:
-        water = np.array([Suspension.at_temperature(t, suspension.particle_density).fluid_density for t in temperature])
+        water = np.array([w.fluid_density for w in waters])
         depth = np.full(len(sheet.time), sphere.depth)
         percent = 100 * sphere.solids(sheet.reading * 1e-3, water, gs) / initial_concentration
-    diameter = np.array([Suspension.at_temperature(t, suspension.particle_density).stokes_diameter(z, time)
-                         for t, z, time in zip(temperature, depth, sheet.time)], float)
+    diameter = np.array([w.stokes_diameter(z, time) for w, z, time in zip(waters, depth, sheet.time)], float)
     return diameter, percent

@@ -111,8 +111,7 @@ class Plan:
                       notes=[f"against the reference ({_describe(self.reference.settings)}), each change raised by "
                              "twice the standard error of the reference's mean"])
         for t in self.models:
-            table.add(_describe({k: t.settings[k] for k in ("drag", "hindrance") if k in t.settings}),
-                      *[f"{t.errors.get(n, math.nan):.4g}" for n in names], f"{t.error:.4g}",
+            table.add(_model_name(t), *[f"{t.errors.get(n, math.nan):.4g}" for n in names], f"{t.error:.4g}",
                       f"{t.outcome.loop_seconds:.4g}")
         return table
 
@@ -124,7 +123,7 @@ class Plan:
     @property
     def reference_seconds(self) -> float:
         """The reference's loop time: the mean of its runs."""
-        return float(np.mean([r.outcome.loop_seconds for r in self.replicas or [self.reference]]))
+        return _mean_loop(self.replicas or [self.reference])
 
     def table(self) -> Table:
         """Per knob value: what it leaves out, the screening number, estimated and measured change,
@@ -190,9 +189,8 @@ class Plan:
                  f"loop {d.outcome.loop_seconds:.3g} s, {self.speedup:.3g}x faster than the reference"]
         if self.command:
             lines.append(f"as options: {self.command}")
-        mean, one = self.sampling_error()
-        if one > 0 and "particles" in d.settings:
-            spread = one * math.sqrt(r.settings["particles"] / d.settings["particles"])
+        spread = self.run_sampling(d)
+        if spread:
             lines.append(f"decision: its deck is the verified run (seed {d.seed}); another seed would move a reading by "
                          f"about {spread:.3g} {unit} (one standard error at its parcel count)")
         if d is r and d.error > self.tolerance:
@@ -209,8 +207,7 @@ class Plan:
                 estimate = "no estimate" if s.change is None else f"estimated change {s.change:.3g} {unit}"
                 lines.append(f"not measurable in this scene: {s.label} ({estimate}): left out")
         for t in self.models:
-            model = _describe({k: t.settings[k] for k in ("drag", "hindrance") if k in t.settings})
-            lines.append(f"other model {model}: " + ("failed: " + t.outcome.failure if t.outcome.failure else
+            lines.append(f"other model {_model_name(t)}: " + ("failed: " + t.outcome.failure if t.outcome.failure else
                          f"changes a reading by up to {t.error:.3g} {unit} against the reference"))
         return lines
 
@@ -294,6 +291,16 @@ def _describe(settings: dict) -> str:
     return ", ".join(f"{k}={v}" for k, v in settings.items())
 
 
+def _model_name(t: Trial) -> str:
+    """An other model's drag and hindrance, as the report names it."""
+    return _describe({k: t.settings[k] for k in ("drag", "hindrance") if k in t.settings})
+
+
+def _mean_loop(runs: list[Trial]) -> float:
+    """The mean loop time of runs of one setting [s]."""
+    return float(np.mean([r.outcome.loop_seconds for r in runs]))
+
+
 def pin(scene, pins: dict[str, str]) -> None:
     """Fixes knobs at the user's values (NAME=VALUE): they are no longer planned, and the reference
     runs with them."""
@@ -370,7 +377,7 @@ def plan_effects(scene, out: Path, tolerance: float, jobs: int = 2, seed: int = 
         raise RuntimeError(f"the reference run {failed.name} failed: {failed.outcome.failure}")
     converged, uncertainty = scene.combine([r.outcome.observations for r in replicas])
     # the reference's loop time: the mean of its runs, which ran alongside the others
-    reference_loop = float(np.mean([r.outcome.loop_seconds for r in replicas]))
+    reference_loop = _mean_loop(replicas)
     for t in trials + models + replicas:    # a replica's error: how far one run of the reference lies
         if not t.outcome.failure:
             t.errors = scene.error(t.outcome.observations, converged, uncertainty)
