@@ -24,6 +24,7 @@ sys.path.insert(0, str(HERE.parent / "python"))
 from sediment.lab.granulometry import read_all  # noqa: E402
 from sediment.lab.psd import read_psd  # noqa: E402
 from sediment.lab.readout import Column, Suspension  # noqa: E402
+from sediment.planner.scenes import SampleScene  # noqa: E402
 from sediment.sim.layers import read_layers  # noqa: E402
 from sediment.sim.run import run_batch  # noqa: E402
 from sediment.sim.scene import Cylinder, Effects, plan, write  # noqa: E402
@@ -35,15 +36,6 @@ def readings(folder: Path) -> dict:
     """Each instrument's (times, percent finer) of the run in `folder`."""
     found, _ = read_all(Column.from_layers(read_layers(folder / "layers.h5")), INSTRUMENTS)
     return {r.instrument: (r.time, r.percent_finer) for r in found}
-
-
-def largest_difference(a: dict, b: dict) -> dict[str, float]:
-    """max |P_a - P_b| per instrument over the reading times both have."""
-    out = {}
-    for name in a:
-        _, i, j = np.intersect1d(a[name][0], b[name][0], return_indices=True)
-        out[name] = float(np.max(np.abs(a[name][1][i] - b[name][1][j])))
-    return out
 
 
 def main() -> None:
@@ -75,11 +67,11 @@ def main() -> None:
     print(f"decision: {report['command']} (plan's error {report['decision']['error']:.3g} pp, tolerance "
           f"{report['tolerance']:g})")
     for seed, run in runs.items():
-        diff = largest_difference(decision, run)
+        diff = SampleScene.error(decision, run)
         print(f"against {args.particles} parcels, Courant 1, seed {seed}: "
               + ", ".join(f"{n} {v:.3g}" for n, v in diff.items()) + f" pp (max {max(diff.values()):.3g})")
     for a, b in itertools.combinations(args.seeds, 2):
-        diff = largest_difference(runs[a], runs[b])
+        diff = SampleScene.error(runs[a], runs[b])
         print(f"converged runs {a} against {b}: max {max(diff.values()):.3g} pp")
 
 

@@ -29,6 +29,7 @@ from .. import figures
 from ..lab.granulometry import read_all
 from ..lab.psd import PSD
 from ..lab.readout import SCHEDULES, Column, Suspension
+from ..planner.scenes import SampleScene
 from ..results import Table, write_text
 from ..sim.layers import read_layers
 from ..sim.run import run_batch
@@ -131,15 +132,6 @@ def _readings(layer_file: Path, lab: Suspension, cylinder: Cylinder) -> dict[str
     return {r.instrument: (np.asarray(r.time), np.asarray(r.percent_finer)) for r in found}
 
 
-def _largest_change(run: dict, reference: dict) -> dict[str, float]:
-    change = {}
-    for name, (t_ref, p_ref) in reference.items():
-        t, p = run[name]
-        _, i, j = np.intersect1d(t, t_ref, return_indices=True)
-        change[name] = float(np.max(np.abs(p[i] - p_ref[j])))
-    return change
-
-
 def brownian_change(psd: PSD, lab: Suspension, depths=(0.10, 0.30 * 0.36)) -> float:
     """Largest change of a reading from Brownian motion [pp], estimated: a grain's arrival at the
     sensing depth L is spread by sqrt(2 D L / v) about L / v (Stokes-Einstein D, Stokes v), which
@@ -236,7 +228,7 @@ def error_budget(psd: PSD, folder: Path, *, particles: int = 20000, courant: flo
     ref = results["reference"]
     rows = []
     for c in choices:
-        rows.append((c.key, c.label, c.kind, _largest_change(results[c.key], ref)))
+        rows.append((c.key, c.label, c.kind, SampleScene.error(results[c.key], ref)))
     sampled = [results[k] for k in results if k == "reference" or k.startswith("replica-")]
     spread = {n: float(np.max(np.std([r[n][1] for r in sampled], axis=0, ddof=1))) for n in ref}
     rows.append(("parcels", f"sampling: one standard error of a reading at {particles} parcels ({replicas} seeds)",
