@@ -164,6 +164,22 @@ void ComputeConcentrationGrid::init()
     if (weight_index < 0 || !is_double || cols != 0)
       error->all(FLERR, "Compute concentration/grid: weight d_{} is not a per-atom floating-point vector "
                         "(define it with fix property/atom d_{})", weight_name, weight_name);
+    // A weight of zero (a data file cut before its weights, which then read as zero) would make
+    // grains vanish from every profile without a sign.
+    const double *weight = atom->dvector[weight_index];
+    bigint bad = 0, all_bad = 0;
+    tagint first = MAXTAGINT, all_first;
+    for (int i = 0; i < atom->nlocal; ++i)
+      if ((atom->mask[i] & groupbit) && !(weight[i] > 0.0 && std::isfinite(weight[i]))) {
+        ++bad;
+        first = std::min(first, atom->tag[i]);
+      }
+    MPI_Allreduce(&bad, &all_bad, 1, MPI_LMP_BIGINT, MPI_SUM, world);
+    MPI_Allreduce(&first, &all_first, 1, MPI_LMP_TAGINT, MPI_MIN, world);
+    if (all_bad > 0)
+      error->all(FLERR, "Compute concentration/grid: {} atoms have a weight d_{} that is not > 0 (atom {} the first): "
+                 "did the data file lose its weights section, or were they never set?", all_bad, weight_name,
+                 all_first);
   }
 }
 

@@ -206,7 +206,7 @@ void copy_file(const std::string &from, const std::string &to)
 FixLayersHDF5::FixLayersHDF5(LAMMPS *lmp, int narg, char **arg) :
     Fix(lmp, narg, arg), compute_id(nullptr), fluid_id(nullptr), particle_density(0.0), grid(nullptr),
     fluid(nullptr), file(-1), frame_sets{-1, -1, -1}, is_open(false), frames(0), last_write(0.0),
-    overwrite(false)
+    overwrite(false), end_time(-1.0), resumed_frames(-1), last_frame_step(-1)
 {
   if (narg < 6)
     error->all(FLERR, "Fix layers/hdf5: expected 'fix ID group layers/hdf5 N FILE.h5 c_ID [keyword value ...]'");
@@ -228,8 +228,10 @@ FixLayersHDF5::FixLayersHDF5(LAMMPS *lmp, int narg, char **arg) :
       particle_density = args.positive(1, "particle_density");
     } else if (args.is("overwrite")) {
       overwrite = args.yes_no(1);
+    } else if (args.is("end_time")) {
+      end_time = args.positive(1, "end_time");
     } else {
-      args.unknown("fluid, particle_density or overwrite");
+      args.unknown("fluid, particle_density, overwrite or end_time");
     }
     args.next(1);
   }
@@ -246,10 +248,13 @@ FixLayersHDF5::~FixLayersHDF5()
     if (set >= 0) H5Dclose(set);
   if (file >= 0) H5Fclose(file);
   // LAMMPS is done with the fix (end of input, unfix or clear; never after an error): the frames
-  // are complete. Only now does the file replace an earlier result under its name.
+  // are complete if they run without a gap up to end_time. Only then does the file replace an
+  // earlier result under its name.
   if (comm->me == 0 && !writing.empty()) {
     try {
       Handle done(H5Fopen(writing.c_str(), H5F_ACC_RDWR, H5P_DEFAULT), H5Fclose, "reopening");
+      const std::string why = incomplete_reason(done);
+      if (!why.empty()) throw std::runtime_error(why);
       set_attribute(done, "complete", 1.0);
       done.close();
       if (rename(writing.c_str(), path.c_str()) != 0) throw std::runtime_error(std::string("renaming: ") + strerror(errno));
@@ -326,6 +331,9 @@ void FixLayersHDF5::open_file()
   const char *run_id = input->variable->retrieve("sediment_run_id");
 
   on_rank0([&] {
+    if (!writing.empty() && !file_exists(writing))
+      throw std::runtime_error(fmt::format("{} vanished while this run wrote it (deleted?): the frames before step "
+                                           "{} are lost; start the run anew", writing, step_now));
     if (writing.empty()) writing = choose_file(step_now, shape[0], shape[1], identity, run_id ? run_id : "");
     if (file_exists(writing)) {
       // Continue the file: keep the frames before this step, so that a restarted run neither
@@ -385,6 +393,7 @@ void FixLayersHDF5::take_frame(bool write_now)
       for (int c = 0; c < cols; ++c) pending_values.push_back(array[k][c + 1]);
     pending_time.push_back(update->atime + (step - update->atimestep) * update->dt);
     pending_step.push_back(step);
+    last_frame_step = step;
     ++frames;
     if (write_now || MPI_Wtime() - last_write >= WRITE_INTERVAL ||
         pending_values.size() * sizeof(double) >= PENDING_BYTES)
@@ -434,48 +443,110 @@ std::string FixLayersHDF5::choose_file(bigint step_now, size_t layers, size_t co
   // New frames go to PATH.partial, which replaces PATH when LAMMPS is done (destructor). A run that
   // continues one whose frames are under PATH.partial (killed, resumed) or PATH (finished, restarted
   // from a restart file) carries on from a copy; PATH itself is never modified, so an earlier result
-  // survives a run that dies.
+  // survives a run that dies. A run resumed from a restart file of this fix continues the frames of
+  // the run that wrote it, or none: 'overwrite' never applies to it.
   const std::string partial = path + ".partial";
+  const bool resumed = resumed_frames >= 0;
   for (const std::string &candidate : {partial, path}) {
     if (!file_exists(candidate)) continue;
-    if (H5Fis_hdf5(candidate.c_str()) <= 0) throw std::runtime_error("exists but is not an HDF5 file; not overwriting it");
-    Handle old(H5Fopen(candidate.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), H5Fclose, candidate + " cannot be opened");
-    if (read_string_attribute(old, "schema") != SCHEMA)
-      throw std::runtime_error(candidate + " is not a SEDIMENT layer file; not overwriting it");
     const std::string what = candidate == partial ? "an unfinished run's frames" : "an earlier run's frames";
-    std::string differs;    // why the frames held there are not this run's
-    Handle set(H5Dopen2(old, "fraction", H5P_DEFAULT), H5Dclose, "dataset fraction");
-    Handle space(H5Dget_space(set), H5Sclose, "dataspace");
-    hsize_t dims[3];
-    H5Sget_simple_extent_dims(space, dims, nullptr);
-    if (dims[1] != layers || dims[2] != columns)
-      differs = fmt::format("{} layers x {} columns, the compute gives {} x {}", dims[1], dims[2], layers, columns);
-    for (const auto &[name, value] : identity) {
-      const double held = H5Aexists(old, name) > 0 ? read_double_attribute(old, name) : 0.0;
-      if (differs.empty() && held != value) differs = fmt::format("{} {}, this run has {}", name, held, value);
+    if (candidate == path && H5Fis_hdf5(candidate.c_str()) <= 0)
+      throw std::runtime_error("exists but is not an HDF5 file; not overwriting it");
+    std::string differs;    // how the frames held there differ in what they mean
+    std::string other_run;  // whose they are, if another run's
+    long long before = 0;   // frames before this step
+    try {
+      Handle old(H5Fopen(candidate.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), H5Fclose, "the file cannot be opened");
+      const std::string schema = read_string_attribute(old, "schema");
+      if (schema != SCHEMA) {    // a file of someone else's under the name is never replaced (invalid_argument)
+        if (candidate == path) throw std::invalid_argument(candidate + " is not a SEDIMENT layer file; not overwriting it");
+        throw std::runtime_error("not a layer file");
+      }
+      Handle set(H5Dopen2(old, "fraction", H5P_DEFAULT), H5Dclose, "dataset fraction");
+      Handle space(H5Dget_space(set), H5Sclose, "dataspace");
+      hsize_t dims[3];
+      H5Sget_simple_extent_dims(space, dims, nullptr);
+      if (dims[1] != layers || dims[2] != columns)
+        differs = fmt::format("{} layers x {} columns, the compute gives {} x {}", dims[1], dims[2], layers, columns);
+      for (const auto &[name, value] : identity) {
+        const double held = H5Aexists(old, name) > 0 ? read_double_attribute(old, name) : 0.0;
+        if (differs.empty() && held != value) differs = fmt::format("{} {}, this run has {}", name, held, value);
+      }
+      const std::string held_id = read_string_attribute(old, "run_id");
+      if (!held_id.empty() && !run_id.empty() && held_id != run_id)
+        other_run = fmt::format("run {}, this is run {}", held_id, run_id);
+      before = frames_before(old, step_now);
+    } catch (const std::invalid_argument &e) {
+      throw std::runtime_error(e.what());
+    } catch (const std::exception &e) {
+      // A damaged file of this fix (a run killed while it wrote, a truncated copy): what it holds
+      // cannot be checked, so it is never continued; 'overwrite yes' may replace it on a fresh start.
+      if (overwrite && !resumed) continue;
+      throw std::runtime_error(fmt::format("{} is damaged ({}): its frames cannot be {}; remove it to start the run "
+                                           "anew", candidate, e.what(), resumed ? "continued" : "checked"));
     }
-    const std::string held_id = read_string_attribute(old, "run_id");
-    if (differs.empty() && !held_id.empty() && !run_id.empty() && held_id != run_id)
-      differs = fmt::format("run {}, this is run {}", held_id, run_id);
-    // A run continues the frames it finds when they are its own and it starts after the first of them
-    // (from a restart file); an unfinished run's frames are continued even with 'overwrite yes'.
-    const bool continues = differs.empty() && step_now > 0 && frames_before(old, step_now) > 0;
-    if (overwrite && !(continues && candidate == partial)) continue;
-    if (!differs.empty())
-      throw std::runtime_error(fmt::format("{} holds {} with {}: use another file or 'overwrite yes'", candidate,
-                                           what, differs));
-    if (!continues)
-      throw std::runtime_error(fmt::format("{} holds {} and this run starts anew at step {}: remove it, use "
-                                           "another file or 'overwrite yes'", candidate, what, step_now));
-    if (candidate == path) {    // a finished file, continued after a restart: work on a copy
-      old.close();
-      copy_file(path, partial);
+    if (differs.empty()) differs = other_run;
+    if (resumed) {
+      if (!differs.empty() && candidate == path)
+        throw std::runtime_error(fmt::format("the frames this run wrote before step {} ({}) are gone and {} holds {} "
+                                             "with {}: start the run anew", step_now, partial, path, what, differs));
+      if (!differs.empty())
+        throw std::runtime_error(fmt::format("{} holds {} with {}: the restart file is not of the run that wrote "
+                                             "them; start the run anew", candidate, what, differs));
+      if (before != resumed_frames)
+        throw std::runtime_error(fmt::format("{} holds {} frames before step {} and the restart file was written "
+                                             "after {}: they are not the frames of one run; start the run anew",
+                                             candidate, before, step_now, resumed_frames));
+    } else {
+      // A run continues the frames it finds when they are its own and it starts after the first of
+      // them (read_restart of a restart file without this fix); an unfinished run's frames are
+      // continued even with 'overwrite yes'.
+      const bool continues = differs.empty() && step_now > 0 && before > 0;
+      if (overwrite && !(continues && candidate == partial)) continue;
+      if (step_now == 0 && differs == other_run) differs.clear();    // a fresh start: whose they are is moot
+      if (!differs.empty())
+        throw std::runtime_error(fmt::format("{} holds {} with {}: use another file or 'overwrite yes'", candidate,
+                                             what, differs));
+      if (!continues)
+        throw std::runtime_error(fmt::format("{} holds {} and this run starts anew at step {}: remove it, use "
+                                             "another file or 'overwrite yes'", candidate, what, step_now));
     }
+    if (candidate == path) copy_file(path, partial);    // a finished file, continued: work on a copy
     return partial;
   }
+  if (resumed)
+    throw std::runtime_error(fmt::format("this run resumes at step {} from a restart file, but the {} frames before "
+                                         "that step ({} or {}) are gone: start the run anew", step_now,
+                                         resumed_frames, partial, path));
   if (file_exists(partial) && remove(partial.c_str()) != 0)
     throw std::runtime_error(partial + " cannot be replaced");
   return partial;
+}
+
+std::string FixLayersHDF5::incomplete_reason(long long file_id) const
+{
+  // The frames must follow each other every nevery steps (a gap means frames of two runs were
+  // spliced, or lost) and, with end_time, reach it (a deck that stopped early is not the test).
+  Handle set(H5Dopen2(file_id, "step", H5P_DEFAULT), H5Dclose, "dataset step");
+  Handle space(H5Dget_space(set), H5Sclose, "dataspace");
+  hsize_t count = 0;
+  H5Sget_simple_extent_dims(space, &count, nullptr);
+  if (count == 0) return "no frames";
+  std::vector<long long> steps(count);
+  check(H5Dread(set, H5T_NATIVE_LLONG, H5S_ALL, H5S_ALL, H5P_DEFAULT, steps.data()), "step");
+  for (hsize_t k = 1; k < count; ++k)
+    if (steps[k] <= steps[k - 1] || steps[k] - steps[k - 1] > nevery)
+      return fmt::format("the frames jump from step {} to step {} (frames of two runs, or frames lost)", steps[k - 1],
+                         steps[k]);
+  if (end_time > 0.0) {
+    Handle times(H5Dopen2(file_id, "time", H5P_DEFAULT), H5Dclose, "dataset time");
+    std::vector<double> time(count);
+    check(H5Dread(times, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, time.data()), "time");
+    if (!(time.back() >= end_time * (1.0 - 1e-9)))
+      return fmt::format("the frames end at time {:.6g}, before end_time {:.6g} (the input stopped early)",
+                         time.back(), end_time);
+  }
+  return "";
 }
 
 
@@ -512,23 +583,50 @@ void FixLayersHDF5::close_file()
   is_open = false;
 }
 
+// The state a restart file keeps: a marker (older files began with the time, never negative), the
+// simulated time, the step, the frames taken before that step and the run identity.
+namespace {
+constexpr double RESTART_MARKER = -1.0;
+constexpr size_t RESTART_NUMBERS = 4, RESTART_ID_BYTES = 64;
+}    // namespace
+
 void FixLayersHDF5::write_restart(FILE *fp)
 {
   // The simulated time at this step: with time steps changed between runs it is not step x dt,
   // and LAMMPS 2021 restart files lose it (time would restart as step x the current dt).
   if (comm->me != 0) return;
-  const double state[2] = {update->atime + (update->ntimestep - update->atimestep) * update->dt,
-                           static_cast<double>(update->ntimestep)};
-  const int size = sizeof(state);
+  const bigint step = update->ntimestep;
+  const double numbers[RESTART_NUMBERS] = {RESTART_MARKER, update->atime + (step - update->atimestep) * update->dt,
+                                           static_cast<double>(step),
+                                           static_cast<double>(frames - (last_frame_step == step ? 1 : 0))};
+  std::vector<char> state(sizeof(numbers) + RESTART_ID_BYTES, '\0');
+  memcpy(state.data(), numbers, sizeof(numbers));
+  const char *run_id = input->variable->retrieve("sediment_run_id");
+  if (run_id) strncpy(state.data() + sizeof(numbers), run_id, RESTART_ID_BYTES - 1);
+  const int size = static_cast<int>(state.size());
   fwrite(&size, sizeof(int), 1, fp);
-  fwrite(state, sizeof(double), 2, fp);
+  fwrite(state.data(), 1, state.size(), fp);
 }
 
 void FixLayersHDF5::restart(char *buf)
 {
-  const auto *state = reinterpret_cast<const double *>(buf);
-  update->atime = state[0];
-  update->atimestep = static_cast<bigint>(state[1]);
+  double numbers[RESTART_NUMBERS];
+  memcpy(numbers, buf, 2 * sizeof(double));
+  if (numbers[0] != RESTART_MARKER) {    // a file of SEDIMENT 0.1.0: time and step only
+    update->atime = numbers[0];
+    update->atimestep = static_cast<bigint>(numbers[1]);
+    return;
+  }
+  memcpy(numbers, buf, sizeof(numbers));
+  update->atime = numbers[1];
+  update->atimestep = static_cast<bigint>(numbers[2]);
+  resumed_frames = static_cast<long long>(numbers[3]);
+  const char *held = buf + sizeof(numbers);
+  const std::string resumed_run_id(held, strnlen(held, RESTART_ID_BYTES - 1));
+  const char *run_id = input->variable->retrieve("sediment_run_id");
+  if (run_id && *run_id && !resumed_run_id.empty() && resumed_run_id != run_id)
+    error->all(FLERR, "Fix layers/hdf5: the restart file was written by run {}, this is run {}: a run resumes "
+               "from its own restart files only", resumed_run_id, run_id);
 }
 
 double FixLayersHDF5::compute_scalar()

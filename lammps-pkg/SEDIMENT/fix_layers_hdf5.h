@@ -55,12 +55,18 @@ class FixLayersHDF5 : public Fix {
   static constexpr double WRITE_INTERVAL = 1.0;             // seconds a frame waits at most
   static constexpr size_t PENDING_BYTES = size_t(64) << 20;    // or until this many bytes wait
   bool overwrite;       // a new run may replace an earlier file of other parameters
+  double end_time;      // the frames are complete once they reach this simulated time (< 0: at the end)
+  // Set by restart(): the frames taken before the restart file's step (-1: not resumed from a
+  // restart file of this fix).
+  long long resumed_frames;
+  bigint last_frame_step;    // step of the newest frame taken (rank 0)
   std::string writing;  // the file the frames go to (rank 0): PATH.partial until LAMMPS is done
 
   void open_file();
   std::vector<std::pair<const char *, double>> parameters(const sediment::Layers &layers) const;
   std::string choose_file(bigint step_now, size_t layers, size_t columns,
                           const std::vector<std::pair<const char *, double>> &identity, const std::string &run_id);
+  std::string incomplete_reason(long long file_id) const;    // why finished frames are no complete result
   void take_frame(bool write_now);    // takes a frame; writes the waiting ones if due or write_now
   void write_pending();
   void open_frame_sets();    // rank 0, the file open
