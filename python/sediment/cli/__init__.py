@@ -28,9 +28,11 @@ def main(argv: list[str] | None = None) -> int:
     args = build_parser().parse_args(argv)
     try:
         return args.func(args)
-    except (KeyboardInterrupt, RunInterrupted) as exc:
-        reason = str(exc) or "interrupted"
-        print(f"sediment {args.command}: {reason}; files being written were left as *.partial or not written",
+    except RunInterrupted as exc:    # says what the run left
+        print(f"sediment {args.command}: {exc}", file=sys.stderr)
+        return 130
+    except KeyboardInterrupt:
+        print(f"sediment {args.command}: interrupted; files being written were left as *.partial or not written",
               file=sys.stderr)
         return 130
     except (ValueError, OSError, RuntimeError) as exc:    # SheetError is a ValueError    # OSError: missing, read-only or full files and folders

@@ -6,10 +6,11 @@ thermo rows beginning with step and time; the bar advances in simulated time and
 the steps, which cost alike whatever the time step."""
 from __future__ import annotations
 
-import fcntl
 import hashlib
+import json
 import os
 import re
+import secrets
 import signal
 import subprocess
 import sys
@@ -23,6 +24,7 @@ from typing import Callable
 
 import numpy as np
 
+from ..results import exclusive, write_text
 from .paths import lmp_executable, mpirun_prefix
 
 
@@ -36,26 +38,68 @@ def _launch(deck: str, log: str, ranks: int, variables: dict[str, object] | None
 
 
 def _start(cmd: list[str], env: dict[str, str], cwd: Path, **kwargs) -> subprocess.Popen:
-    """Starts a run in its own process group (stopped as a whole), tied to this process's life:
-    util-linux's setpriv gives it SIGTERM when this process dies, even by SIGKILL, so neither mpirun
-    (which passes the signal to its ranks) nor a serial LAMMPS outlives it. Output that is not UTF-8
-    (a binary deck echoed in an error) is replaced, not fatal."""
-    return subprocess.Popen(["setpriv", "--pdeathsig", "TERM", "--", *cmd], cwd=cwd, env=env, text=True,
+    """Starts a run in its own session, tied to this process's life: util-linux's setpriv gives it
+    SIGTERM when this process dies, and a guard (`_guard`) stops every process of the session (mpirun
+    puts each rank in a process group of its own) even if mpirun ignores that or this process dies by
+    SIGKILL. Output that is not UTF-8 (a binary deck echoed in an error) is replaced, not fatal."""
+    proc = subprocess.Popen(["setpriv", "--pdeathsig", "TERM", "--", *cmd], cwd=cwd, env=env, text=True,
                             errors="replace", start_new_session=True, **kwargs)
+    proc.guard = _guard(proc.pid)
+    return proc
+
+
+def _guard(session: int) -> subprocess.Popen:
+    """A process outside the run that waits on a pipe only this process holds: when this process ends
+    in any way, the pipe closes and the guard stops the run's session (SIGTERM, then SIGKILL)."""
+    script = f"read _; pkill -TERM -s {session}; sleep 5; pkill -KILL -s {session}"
+    return subprocess.Popen(["sh", "-c", script], stdin=subprocess.PIPE, stdout=subprocess.DEVNULL,
+                            stderr=subprocess.DEVNULL, start_new_session=True)
+
+
+def _release(proc: subprocess.Popen) -> None:
+    """The run is over: its guard goes without acting."""
+    guard = getattr(proc, "guard", None)
+    if guard is not None and guard.poll() is None:
+        guard.kill()
+        guard.wait()
+        guard.stdin.close()
+
+
+def _session(session: int) -> list[int]:
+    """The live processes of a session (zombies excluded)."""
+    pids = []
+    for entry in os.scandir("/proc"):
+        if not entry.name.isdigit():
+            continue
+        try:
+            stat = Path(entry.path, "stat").read_text()
+        except OSError:
+            continue
+        fields = stat[stat.rindex(")") + 2:].split()    # state, ppid, pgrp, session, ...
+        if int(fields[3]) == session and fields[0] != "Z":
+            pids.append(int(entry.name))
+    return pids
 
 
 def _stop(proc: subprocess.Popen, grace: float = 10.0) -> None:
-    """SIGTERM to the run's process group (mpirun and every rank), SIGKILL after `grace` seconds."""
+    """SIGTERM to every process of the run's session (mpirun and every rank), SIGKILL to those left
+    after `grace` seconds."""
     for sig in (signal.SIGTERM, signal.SIGKILL):
-        try:
-            os.killpg(proc.pid, sig)
-        except ProcessLookupError:
-            return
+        for pid in _session(proc.pid):
+            try:
+                os.kill(pid, sig)
+            except ProcessLookupError:
+                pass
+        end = time.monotonic() + grace
         try:
             proc.wait(timeout=grace)
-            return
         except subprocess.TimeoutExpired:
             continue
+        while _session(proc.pid) and time.monotonic() < end:
+            time.sleep(0.05)
+        if not _session(proc.pid):
+            break
+    _release(proc)
 
 
 class RunInterrupted(RuntimeError):
@@ -79,31 +123,121 @@ def _signals_stop(proc: subprocess.Popen):
             signal.signal(sig, old)
 
 
-@contextmanager
-def _folder_lock(folder: Path):
-    """One `sediment run` at a time per folder: a second one would write the same files."""
-    path = folder / ".sediment-run.lock"
-    with open(path, "a+") as handle:
-        try:
-            fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
-        except BlockingIOError:
-            handle.seek(0)
-            raise RuntimeError(f"another sediment run is using {folder} (pid {handle.read().strip() or '?'}); "
-                               "wait for it, or run the deck from another folder") from None
-        handle.seek(0)
-        handle.truncate()
-        handle.write(str(os.getpid()))
-        handle.flush()
-        yield
+LOCK = ".sediment-run.lock"
+RECORD = ".sediment-run.json"    # the folder's latest run: its identity, deck, variables and state
+RUN_OUTPUTS = ("restart.a.bin", "restart.b.bin", "log.lammps", "log.failed.lammps", RECORD)
+
+
+def folder_lock(folder: Path, what: str = "run"):
+    """One `sediment run` or `sample` at a time per folder: a second one would write the same files."""
+    folder.mkdir(parents=True, exist_ok=True)
+    return exclusive(folder / LOCK, f"wait for it, or {what} in another folder")
+
+
+# Commands whose first literal argument (after an ID for molecule) is a file the deck reads.
+_READS = re.compile(r"^\s*(?:read_data|include|read_dump|molecule\s+\S+)\s+([^\s$\"']+)", re.MULTILINE)
+
+
+def input_files(deck: Path) -> list[Path]:
+    """The files a deck reads besides itself: the literal names after read_data, include, read_dump and
+    molecule (also inside an if's quoted commands) that exist beside it. Names built from variables
+    cannot be known before the run and are not covered."""
+    text = Path(deck).read_text(errors="replace").replace('"', "\n")
+    names = dict.fromkeys(m.group(1) for m in _READS.finditer(text))
+    return [Path(deck).parent / n for n in names if (Path(deck).parent / n).is_file()]
+
+
+def inputs_id(deck: Path) -> str:
+    """A hash of what a deck reads: its text (without whole-line comments, which `sediment sample`
+    dates) and every file of `input_files`, each with its name."""
+    digest = hashlib.sha256()
+    deck = Path(deck)
+    for path in [deck, *input_files(deck)]:
+        data = path.read_bytes()
+        if path == deck:
+            data = b"\n".join(line for line in data.splitlines() if not line.lstrip().startswith(b"#"))
+        digest.update(f"{path.name}\0{len(data)}\0".encode() + data)
+    return digest.hexdigest()[:12]
+
+
+def layer_file_of(deck: Path, variables: dict[str, str]) -> Path | None:
+    """The layer file a deck's fix layers/hdf5 writes (its name from -var or an index/string variable of
+    the deck), or None if it has none or its name cannot be known before the run."""
+    text = Path(deck).read_text(errors="replace")
+    found = re.search(r"^\s*fix\s+\S+\s+\S+\s+layers/hdf5\s+\S+\s+(\S+)", text, re.MULTILINE)
+    if found is None:
+        return None
+    name = found.group(1)
+    reference = re.fullmatch(r"\$\{(\w+)\}|\$(\w)", name)
+    if reference:
+        key = reference.group(1) or reference.group(2)
+        defined = re.search(rf"^\s*variable\s+{key}\s+(?:index|string)\s+(\S+)", text, re.MULTILINE)
+        name = variables.get(key) or (defined.group(1) if defined else None)
+    if not name or "$" in name:
+        return None
+    return Path(deck).parent / name
+
+
+def _finished(layers: Path, identity: str) -> bool:
+    """Whether `layers` is complete and of the run `identity`, with no frames of it left partial."""
+    import h5py
+
+    if not identity or not layers.is_file() or layers.with_name(layers.name + ".partial").exists():
+        return False
+    try:
+        with h5py.File(layers, "r") as f:
+            held = f.attrs.get("run_id", b"")
+            return f.attrs.get("complete", 0) == 1 and (held.decode() if isinstance(held, bytes) else held) == identity
+    except OSError:
+        return False
 
 
 def run_id(deck: Path, variables: dict[str, object]) -> str:
-    """The identity of a run: a hash of the deck's text and its variables (stored in the layer file,
-    which refuses to be continued by another run)."""
-    digest = hashlib.sha256(Path(deck).read_bytes())
+    """A new run's identity, INPUTS-VARIABLES-START: the hash of what the deck reads (`inputs_id`), of
+    its variables, and a token of this start. Stored in the layer file and in each restart file: a
+    resumed run continues only the frames and restart files of the start it resumes."""
+    digest = hashlib.sha256()
     for name, value in sorted(variables.items()):
         digest.update(f"\0{name}={value}".encode())
-    return digest.hexdigest()[:16]
+    return f"{inputs_id(deck)}-{digest.hexdigest()[:6]}-{secrets.token_hex(4)}"
+
+
+def read_record(folder: Path) -> dict | None:
+    """The folder's run record (None if there is none); ValueError if it is damaged."""
+    path = Path(folder) / RECORD
+    if not path.is_file():
+        return None
+    try:
+        record = json.loads(path.read_text())
+        if not isinstance(record, dict) or not {"run_id", "deck", "state"} <= record.keys():
+            raise ValueError("fields missing")
+        return record
+    except (ValueError, UnicodeDecodeError) as exc:
+        raise ValueError(f"{path} is damaged ({exc}); remove it, and run the deck anew with --force") from None
+
+
+def _write_record(folder: Path, **record) -> None:
+    write_text(folder / RECORD, json.dumps(record, indent=1) + "\n")
+
+
+def _resume_id(deck: Path, variables: dict[str, object]) -> str:
+    """The identity of the interrupted run in the deck's folder, after checking that it can be resumed:
+    it did not finish, it ran this deck, and what the deck reads has not changed since."""
+    folder = deck.parent
+    record = read_record(folder)
+    if record is None or record.get("deck") != deck.name:
+        raise ValueError(f"nothing to resume in {folder}: no interrupted run of {deck.name} is recorded there "
+                         f"({RECORD}); run it without --resume")
+    if record["state"] == "finished":
+        raise ValueError(f"the run of {deck.name} in {folder} finished: nothing to resume; run it again with --force")
+    if record["run_id"].split("-")[0] != inputs_id(deck):
+        raise ValueError(f"{deck.name} or a file it reads ({', '.join(p.name for p in input_files(deck)) or 'none'}) "
+                         "changed since the interrupted run: its restart files are of other inputs; start the run "
+                         "anew with --force")
+    if record.get("variables", {}) != {k: str(v) for k, v in variables.items()}:
+        raise ValueError(f"the interrupted run had the variables {record.get('variables')}, this one "
+                         f"{ {k: str(v) for k, v in variables.items()} }: resume it with the same --var options")
+    return record["run_id"]
 
 
 @dataclass
@@ -121,6 +255,9 @@ def run_deck(deck: Path, ranks: int = 1, variables: dict[str, str] | None = None
              oversubscribe: bool = False, force: bool = False, resume: bool = False) -> RunResult:
     """Runs a deck in its folder with a progress bar in simulated time, writing log.lammps there.
 
+    Each fresh start gets an identity (`run_id`) that the layer file and every restart file keep and
+    that the folder's run record (.sediment-run.json) names; a resumed run takes the interrupted one's.
+
     Parameters
     ----------
     deck : Path
@@ -134,10 +271,11 @@ def run_deck(deck: Path, ranks: int = 1, variables: dict[str, str] | None = None
     oversubscribe : bool
         Allow more ranks than cores.
     force : bool
-        Let the layer file replace one of another run (``-var overwrite yes``).
+        Start anew, letting the layer file replace one of another run (``-var overwrite yes``).
     resume : bool
-        Continue a killed or failed run from the newest restart file beside the deck (restart.a.bin or
-        restart.b.bin, as decks of `sediment sample` write them); its layer file continues.
+        Continue the folder's interrupted run (killed or failed) from its newest intact restart file
+        (restart.a.bin or restart.b.bin, as decks of `sediment sample` write them), refused if the
+        deck or a file it reads changed since; its layer file continues.
 
     Returns
     -------
@@ -151,23 +289,27 @@ def run_deck(deck: Path, ranks: int = 1, variables: dict[str, str] | None = None
     RunInterrupted
         SIGINT or SIGTERM stopped it; mpirun and every rank were stopped too.
     ValueError
-        More ranks than cores without `oversubscribe`.
+        More ranks than cores without `oversubscribe`; nothing to resume; --force with --resume.
     """
     deck = Path(deck).resolve()
     if deck.is_dir():
         raise ValueError(f"{deck} is a folder; give the deck file (e.g. {deck / 'in.sedimentation'})")
     if not deck.is_file():
         raise FileNotFoundError(f"{deck}: no such deck")
+    if force and resume:
+        raise ValueError("--resume continues the interrupted run and --force starts the deck anew: give one of them")
     cores = len(os.sched_getaffinity(0))
     if ranks > cores and not oversubscribe:
         raise ValueError(f"--np {ranks} asks for more ranks than the {cores} cores here, which runs far slower than "
                          f"--np {cores}; add --oversubscribe to run it anyway")
-    variables = dict(variables or {})
-    variables.setdefault("sediment_run_id", run_id(deck, variables))    # a resumed run is the same run
-    if force:
-        variables["overwrite"] = "yes"
+    variables = {k: str(v) for k, v in (variables or {}).items()}
     folder = deck.parent
-    if resume:
+    with folder_lock(folder):
+        if not resume:
+            launch = dict(variables, sediment_run_id=run_id(deck, variables))
+            if force:
+                launch["overwrite"] = "yes"
+            return _run_recorded(deck, ranks, variables, launch, progress)
         if "${resume}" not in deck.read_text(errors="replace"):
             raise ValueError(f"{deck.name} cannot be resumed: it has no 'resume' variable (decks written by "
                              "`sediment sample` have one)")
@@ -176,59 +318,125 @@ def run_deck(deck: Path, ranks: int = 1, variables: dict[str, str] | None = None
         if not restarts:
             raise ValueError(f"nothing to resume in {folder}: no restart file (restart.a.bin, restart.b.bin); "
                              "run it without --resume")
-        # The newest restart file may be the one a kill cut short: then the other, one interval older.
+        identity = _resume_id(deck, variables)
+        # The newest restart file may be damaged (a kill while it was written): then the older one, if the
+        # failed attempt wrote no restart file of its own. A restart file of another run is refused by
+        # fix layers/hdf5 and passed over likewise.
+        failures = []
         for k, restart in enumerate(restarts):
+            stamps = [p.stat().st_mtime_ns for p in restarts]
+            launch = dict(variables, sediment_run_id=identity, resume="yes", restart_file=restart.name)
             try:
-                return run_deck(deck, ranks, {**variables, "resume": "yes", "restart_file": restart.name}, progress,
-                                oversubscribe, force)
+                return _run_recorded(deck, ranks, variables, launch, progress)
             except RuntimeError as exc:
-                if k + 1 == len(restarts) or "restart" not in str(exc).lower():
-                    raise
+                failures.append(f"{restart.name}: {exc}")
+                if k + 1 == len(restarts) or [p.stat().st_mtime_ns for p in restarts] != stamps:
+                    break
+                print(f"resuming from {restart.name} failed ({str(exc).splitlines()[0]}); trying {restarts[k + 1].name}",
+                      file=sys.stderr)
+        if all("written by run" in f for f in failures):
+            raise RuntimeError(f"the restart files in {folder} are of an earlier run, not of the interrupted run "
+                               f"{identity} (it stopped before it wrote one): start it anew with --force")
+        reasons = dict.fromkeys(f.split(": ", 1)[1] for f in failures)    # the same reason once
+        raise RuntimeError(f"cannot resume from {' or '.join(f.split(':')[0] for f in failures)}: " + "; ".join(reasons))
+
+
+def _run_recorded(deck: Path, ranks: int, variables: dict[str, str], launch: dict[str, str],
+                  progress: bool) -> RunResult:
+    """Runs the deck with the `launch` variables (the folder locked), keeping the folder's run record:
+    running, then finished, failed or interrupted."""
+    record = dict(run_id=launch["sediment_run_id"], deck=deck.name, variables=variables)
+    _write_record(deck.parent, **record, state="running")
+    try:
+        result = _run(deck, ranks, launch, progress)
+    except RunInterrupted:
+        _write_record(deck.parent, **record, state="interrupted")
+        raise
+    except BaseException:
+        _write_record(deck.parent, **record, state="failed")
+        raise
+    _write_record(deck.parent, **record, state="finished")
+    return result
+
+
+def _run(deck: Path, ranks: int, variables: dict[str, str], progress: bool) -> RunResult:
+    """One launch of the deck in its folder with a progress bar; see `run_deck`."""
+    folder = deck.parent
     log, failed_log = folder / "log.lammps", folder / "log.failed.lammps"
-    with _folder_lock(folder):
-        # The log is written under a temporary name: log.lammps is always a complete log of a run
-        # that succeeded, log.failed.lammps that of the last one that did not.
-        partial_log = folder / f".log.lammps.{os.getpid()}.partial"
-        cmd, env = _launch(deck.name, partial_log.name, ranks, variables)
-        start = time.monotonic()
-        total_steps, t_end, step, now, errors, tail = 0, 0.0, 0, 0.0, [], deque(maxlen=5)
-        bar = None
-        proc = _start(cmd, env, folder, stdout=subprocess.PIPE, stderr=subprocess.STDOUT)
-        try:
-            with _signals_stop(proc):
-                assert proc.stdout is not None
-                for line in proc.stdout:
-                    tail.append(line.rstrip())
-                    words = line.split()
-                    if line.startswith("ERROR"):
-                        errors.append(line.strip())
-                    elif line.startswith("SEDIMENT plan") and len(words) >= 6:
-                        total_steps, t_end = int(words[3]), float(words[5])
-                        if progress:
-                            from tqdm import tqdm
-                            bar = tqdm(total=t_end, unit="s", desc="simulated", file=sys.stderr, dynamic_ncols=True,
-                                       mininterval=0.5, bar_format="{desc}: {percentage:3.0f}%|{bar}| "
-                                                                   "{n:.4g}/{total:.4g} s [{elapsed}{postfix}]")
-                    elif len(words) >= 2 and words[0].isdigit() and _is_float(words[1]):
-                        step, now = int(words[0]), float(words[1])
-                        if bar is not None and step:
-                            left = (time.monotonic() - start) * (total_steps - step) / step
-                            bar.set_postfix_str(f"ETA {_clock(left)}", refresh=False)
-                            bar.update(min(now, t_end) - bar.n)
-                code = proc.wait()
-        except BaseException:
+    # The log is written under a temporary name: log.lammps is always a complete log of a run
+    # that succeeded, log.failed.lammps that of the last one that did not.
+    partial_log = folder / f".log.lammps.{os.getpid()}.partial"
+    for stale in folder.glob(".log.lammps.*.partial"):    # of a sediment killed outright (the folder is locked)
+        stale.unlink(missing_ok=True)
+    cmd, env = _launch(deck.name, partial_log.name, ranks, variables)
+    start = time.monotonic()
+    errors: list[str] = []
+    tail: deque = deque(maxlen=5)
+    bar = None
+    state = dict(total_steps=0, t_end=0.0, step=0, now=0.0)
+
+    def take(line: str) -> None:
+        nonlocal bar
+        tail.append(line.rstrip())
+        words = line.split()
+        if line.startswith("ERROR"):
+            errors.append(line.strip())
+        elif line.startswith("SEDIMENT plan") and len(words) >= 6:
+            state.update(total_steps=int(words[3]), t_end=float(words[5]))
+            if progress:
+                from tqdm import tqdm
+                bar = tqdm(total=state["t_end"], unit="s", desc="simulated", file=sys.stderr, dynamic_ncols=True,
+                           mininterval=0.5, bar_format="{desc}: {percentage:3.0f}%|{bar}| "
+                                                       "{n:.4g}/{total:.4g} s [{elapsed}{postfix}]")
+        elif len(words) >= 2 and words[0].isdigit() and _is_float(words[1]):
+            state.update(step=int(words[0]), now=float(words[1]))
+            if bar is not None and state["step"]:
+                left = (time.monotonic() - start) * (state["total_steps"] - state["step"]) / state["step"]
+                bar.set_postfix_str(f"ETA {_clock(left)}", refresh=False)
+                bar.update(min(state["now"], state["t_end"]) - bar.n)
+
+    proc = _start(cmd, env, folder, stdout=subprocess.PIPE, stderr=subprocess.STDOUT)
+    try:
+        with _signals_stop(proc):
+            assert proc.stdout is not None
+            for line in proc.stdout:
+                take(line)
+            code = proc.wait()
+    except RunInterrupted as exc:
+        layers = layer_file_of(deck, variables)
+        if layers is not None and _finished(layers, variables.get("sediment_run_id", "")):
+            # The stop came as LAMMPS finished: the layer file is this run's and complete.
+            print(f"({exc} as the run finished: its results are complete)", file=sys.stderr)
+            code = 0
+        else:
             if partial_log.exists():
                 os.replace(partial_log, failed_log)
-            raise
-        finally:
-            if bar is not None:
-                bar.close()
-        if code != 0 or errors:
-            if partial_log.exists():
-                os.replace(partial_log, failed_log)
-            message = errors[0] if errors else "\n".join(tail)
-            raise RuntimeError(f"{deck.name} failed (exit {code}): {message} (see {failed_log})")
-        os.replace(partial_log, log)
+            left = "no layer file"
+            if layers is not None:
+                partial = layers.with_name(layers.name + ".partial")
+                left = f"its frames so far are in {partial.name}" if partial.exists() else "it wrote no frames"
+            raise RunInterrupted(f"{exc} at step {state['step']} of {state['total_steps'] or '?'} (t = "
+                                 f"{state['now']:.6g} s): every rank was stopped; {left}, an earlier result is "
+                                 "untouched; sediment run --resume continues it from its last restart file") from None
+    except BaseException:
+        if partial_log.exists():
+            os.replace(partial_log, failed_log)
+        raise
+    finally:
+        _release(proc)
+        if bar is not None:
+            bar.close()
+    if code != 0 or errors:
+        if partial_log.exists():
+            os.replace(partial_log, failed_log)
+        message = errors[0] if errors else "\n".join(tail)
+        raise RuntimeError(f"{deck.name} failed (exit {code}): {message} (see {failed_log})")
+    step, now = state["step"], state["now"]
+    if state["total_steps"] and step < state["total_steps"]:
+        os.replace(partial_log, failed_log)
+        raise RuntimeError(f"{deck.name} ended at step {step} of the {state['total_steps']} it announced (t = {now:.6g} s): "
+                           f"the deck is cut short or stops early (see {failed_log})")
+    os.replace(partial_log, log)
     return RunResult(deck, log, time.monotonic() - start, step, now)
 
 
@@ -321,6 +529,7 @@ def run_batch(deck: Path, variables: dict[str, object] | None = None, ranks: int
         _stop(proc)
         raise
     finally:
+        _release(proc)
         if timer is not None:
             timer.cancel()
         if running is not None:
