@@ -12,7 +12,7 @@ sample=${1:?usage: run.sh sample1..sample5 [OUT] [sediment sample options]}
 out=${2:-out/$sample}
 [ $# -ge 2 ] && shift 2 || shift 1
 ranks=${SEDIMENT_RANKS:-2}
-"$sediment" sample "$here/psd/$sample.csv" --out "$out" "$@"
+"$sediment" sample "$here/psd/$sample.csv" --out "$out" ${SEDIMENT_REPLACE:+--force} "$@"
 "$sediment" run "$out/in.sedimentation" --np "$ranks" ${SEDIMENT_REPLACE:+--force}
 "$sediment" readout "$out/layers.h5" --out "$out/readout"
 echo "figure: $out/readout/granulometry.png"

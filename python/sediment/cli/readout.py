@@ -73,6 +73,7 @@ def run(args: argparse.Namespace) -> int:
     if args.layers is not None:
         from ..sim.layers import read_layers
         layers = read_layers(args.layers)
+        check_inputs(args.layers, layers.identity.get("run_id", ""))
         if not layers.complete:
             message = (f"{args.layers} is partial: the run writing it did not finish ({len(layers.time)} frames, the "
                        f"last at {layers.time[-1] / 60:.4g} min)")
@@ -88,6 +89,8 @@ def run(args: argparse.Namespace) -> int:
         if args.viscosity is not None:
             column = replace(column, suspension=replace(column.suspension, viscosity=args.viscosity, temperature=None))
         title = f"{args.layers.parent.name}/{args.layers.name}: simulated sedimentation test"
+        made_by = " by " + layers.identity["code_version"] if "code_version" in layers.identity else ""
+        frames_of = f"frames of run {layers.identity.get('run_id') or '(unnamed)'}{made_by}: {args.layers}"
     else:
         if psd is None:
             raise ValueError("give a layer file, or --psd with --stokes-preview for an analytic column")
@@ -102,6 +105,8 @@ def run(args: argparse.Namespace) -> int:
                           sphere_depth=args.sphere_depth, pipette_depth=args.pipette_depth,
                           pipette_volume=args.pipette_volume, cylinder_area=args.cylinder_area,
                           hydrometer=hydrometer)
+    if args.layers is not None:
+        report.notes.append(frames_of)
     if args.band is not None:
         from ..studies.budget import band_of
 
@@ -115,3 +120,20 @@ def run(args: argparse.Namespace) -> int:
         print(f"wrote {path}")
     print(report.table().text(), end="")
     return 0
+
+
+def check_inputs(path: Path, identity: str) -> None:
+    """Refuses a layer file beside a deck whose inputs are not those of the run that wrote it (the
+    folder sampled again since): its frames would be read against another test's tables."""
+    from ..sim.run import input_files, inputs_id, read_record
+
+    record = read_record(path.parent)
+    deck = path.parent / (record["deck"] if record else "in.sedimentation")
+    held = identity.split("-")
+    if len(held) != 3 or not deck.is_file():
+        return
+    if inputs_id(deck) != held[0]:
+        reads = ", ".join([deck.name] + [p.name for p in input_files(deck)])
+        raise ValueError(f"{path} was written by a run of other inputs than those now in its folder ({reads}): it was "
+                         "sampled again since, and its tables describe another test; run the deck again, or read the "
+                         "frames where their own tables are")

@@ -34,6 +34,9 @@ def add_parser(commands) -> argparse.ArgumentParser:
     parser.add_argument("--courant", type=positive, default=4.0,
                         help="layers the fastest grain in suspension may cross per step (default 4: within 0.25 "
                         "points of percent finer of Courant 1 for the five samples of docs/effects.md)")
+    parser.add_argument("--force", action="store_true",
+                        help="delete the files of a run in --out whose deck or data this sample changes (its layer "
+                        "file, restart files, logs) instead of refusing")
     parser.add_argument("--plan", type=Path, metavar="REPORT",
                         help="take the drag, hindrance, parcels and Courant number that `sediment plan` decided "
                         "(its report.json) instead of --drag, --hindrance, --particles and --courant")
@@ -104,8 +107,14 @@ def run(args: argparse.Namespace) -> int:
                     t_end=args.t_end, mass=args.mass, particle_density=args.particle_density,
                     cylinder_area=cylinder.area, height=cylinder.height, temperature=args.temperature)
         differ = [f"{k} {planned[k]} (here {v})" for k, v in here.items() if k in planned and planned[k] != v]
+        psd = read_psd(args.psd)
+        if "psd" not in planned:
+            print(f"warning: {args.plan} does not record the PSD it was made for (a plan of an earlier version)")
+        elif not _same_psd(planned["psd"], psd):
+            differ.insert(0, f"the PSD ({args.psd} differs from the plan's)")
         if differ:
-            print("warning: the plan was made for another test: " + ", ".join(differ))
+            raise ValueError(f"{args.plan} was made for another test: " + ", ".join(differ) +
+                             "; plan this one (sediment plan) or sample without --plan")
         print(f"the plan's decision ({args.plan}): --drag {args.drag} --hindrance {args.hindrance} "
               f"--particles {args.particles} --courant {args.courant:g}")
 
@@ -115,7 +124,19 @@ def run(args: argparse.Namespace) -> int:
                  effects=effects_of(args, args.contacts, args.lubrication),
                  layers=args.layers, t_end=args.t_end, courant=args.courant, seed=args.seed)
     print(describe(scene))
-    for path in write(scene, args.out):
+    for path in write(scene, args.out, force=args.force):
         print(f"wrote {path}")
     print(f"next: sediment run {args.out / 'in.sedimentation'}")
     return 0
+
+
+def _same_psd(recorded: dict, psd) -> bool:
+    """Whether a plan's recorded PSD is this one (to the digits a report keeps)."""
+    import numpy as np
+
+    try:
+        d, p = np.asarray(recorded["diameter_um"], float), np.asarray(recorded["percent_finer"], float)
+    except (KeyError, TypeError, ValueError):
+        return False
+    return (d.shape == psd.diameter.shape and np.allclose(d, psd.diameter * 1e6, rtol=1e-9, atol=0)
+            and np.allclose(p, psd.percent_finer, rtol=1e-9, atol=1e-9))

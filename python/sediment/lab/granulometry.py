@@ -11,7 +11,7 @@ import numpy as np
 
 from .. import figures
 from ..constants import D422_CYLINDER_AREA
-from ..results import Table, write_atomic, write_text
+from ..results import Table, hold_one, write_atomic, write_text
 from .psd import PSD
 from .readout import SCHEDULES, BuoyancySphere, Column, Hydrometer, Pipette, Readings
 
@@ -62,10 +62,24 @@ def read_all(column: Column, instruments: list[str], schedule: str = "d422", sph
         else:
             pipette = Pipette(pipette_depth, pipette_volume)
             read, times = pipette.read, pipette.default_times(column.suspension)
+        early, late = int(np.sum(times <= column.time[0])), int(np.sum(times > column.time[-1]))
         covered = times[(times > column.time[0]) & (times <= column.time[-1])]
-        if len(covered) < len(times):
-            notes.append(f"{name}: {len(times) - len(covered)} of {len(times)} reading times lie beyond the "
-                         f"frames (last at {column.time[-1] / 60:.3g} min)")
+        if early:
+            notes.append(f"{name}: {early} of {len(times)} reading times come before the first frame after the start "
+                         f"(at {column.time[min(1, len(column.time) - 1)] / 60:.3g} min)")
+        if late:
+            notes.append(f"{name}: {late} of {len(times)} reading times come after the last frame (at "
+                         f"{column.time[-1] / 60:.3g} min)")
+        # A reading is interpolated between the frames around it: frames farther apart than the
+        # reading's own time would make it a guess.
+        index = np.clip(np.searchsorted(column.time, covered), 1, len(column.time) - 1)
+        gaps = column.time[index] - column.time[index - 1]
+        if np.any(gaps > covered):
+            k = int(np.argmax(gaps > covered))
+            raise ValueError(f"{name}: the frames around the reading at {covered[k] / 60:.3g} min are "
+                             f"{gaps[k] / 60:.3g} min apart, longer than the reading's own time: it would be a guess "
+                             "between them; write frames more often (a lower --courant, or a column nearer the "
+                             "cylinder's height)")
         if len(covered):
             results.append(read(column, covered))
     return results, notes
@@ -114,7 +128,7 @@ class Granulometry:
         written = [path for r in self.readings for path in r.save(folder)]
         if self.references():
             written.append(write_text(folder / "errors.csv", self.table().csv()))
-        return written + _plot(self, folder)
+        return hold_one(folder, written + _plot(self, folder))
 
 
 def granulometry(column: Column, instruments: list[str], psd: PSD | None = None, simulated: PSD | None = None,

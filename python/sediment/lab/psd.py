@@ -30,11 +30,11 @@ class PSD:
         if not np.all(np.isfinite(d)) or not np.all(np.isfinite(p)):
             raise PSDError(f"{where}diameters and percents must be numbers")
         if d[0] <= 0:
-            raise PSDError(f"{where}diameters must be > 0 (row 1: {d[0]:g})")
+            raise PSDError(f"{where}diameters must be > 0 (row 1: {d[0] * 1e6:g} um)")
         bad = np.flatnonzero(np.diff(d) <= 0)
         if bad.size:
-            raise PSDError(f"{where}diameters must increase: row {bad[0] + 2} ({d[bad[0] + 1]:g}) "
-                           f"after row {bad[0] + 1} ({d[bad[0]]:g})")
+            raise PSDError(f"{where}diameters must increase: row {bad[0] + 2} ({d[bad[0] + 1] * 1e6:.10g} um) "
+                           f"after row {bad[0] + 1} ({d[bad[0]] * 1e6:.10g} um)")
         outside = np.flatnonzero((p < 0) | (p > 100))
         if outside.size:
             raise PSDError(f"{where}percent finer must be within 0..100: row {outside[0] + 1} has {p[outside[0]]:g}")

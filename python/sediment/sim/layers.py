@@ -10,6 +10,7 @@ Schema (version 1; lammps-pkg/SEDIMENT/doc/fix_layers_hdf5.rst): root attributes
 """
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -114,8 +115,11 @@ def read_layers(path: str | Path) -> LayerFile:
                              centres=np.asarray(f["layer_centre"]), columns=columns,
                              class_edges=np.asarray(f["class_edges"]), time=time,
                              step=np.asarray(f["step"][:frames]), fraction=fraction, attributes=extra,
-                             complete=bool(f.attrs.get("complete", 1)), identity=identity)
-        except KeyError as exc:
-            raise LayerFileError(f"{path}: layer file lacks {exc}") from None
+                             complete=f.attrs.get("complete", 0) == 1, identity=identity)
+        except KeyError as exc:    # h5py: "Can't open attribute (can't locate attribute: 'units')"
+            quoted = re.findall(r"'([^']+)'", str(exc))
+            what = ("the attribute " if "attribute" in str(exc) else "the dataset ") + (quoted[-1] if quoted else str(exc))
+            raise LayerFileError(f"{path}: the layer file lacks {what} (damaged, or not written by fix "
+                                 "layers/hdf5)") from None
         except OSError as exc:
             raise LayerFileError(f"{path}: unreadable layer data (truncated or corrupt?): {exc}") from None

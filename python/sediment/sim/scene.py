@@ -11,6 +11,7 @@ cleared of the grains fast enough to need the smaller one (steps per doubling: l
 from __future__ import annotations
 
 import math
+import os
 from dataclasses import dataclass, field
 from datetime import datetime, timezone
 from pathlib import Path
@@ -314,8 +315,29 @@ def plan(psd: PSD, *, geometry: str = "column", cylinder: Cylinder = Cylinder(),
                          "simulate parcels (--particles) or a smaller sub-volume (--width, --height)")
     scene = Scene(psd, size_classes, suspension, cylinder, geometry, width, thickness, mass, effects, layers, t_end,
                   courant, seed)
+    _check_runnable(scene)
     place(scene)
     return scene
+
+
+LAMMPS_MAX_STEPS = 2**31 - 1    # LAMMPS's largest run (and restart or thermo interval), in steps
+
+
+def _check_runnable(scene: Scene) -> None:
+    """Refuses a scene whose deck LAMMPS cannot run: a stage or an interval beyond its step limit."""
+    every = scene.frame_steps()
+    stages = scene.stages() if every <= LAMMPS_MAX_STEPS else [(0.0, every)]
+    longest = max(max(n for _, n in stages), every)
+    if longest <= LAMMPS_MAX_STEPS:
+        return
+    if scene.effects.interacting:
+        fix = (f"contacts set a step of {scene.contact_time_step():.3g} s (a fifth of the smallest grain's Rayleigh "
+               "time): shorten --t-end, or measure what contacts change with `sediment plan --measure-contacts` (a "
+               "reduced scene)")
+    else:
+        fix = f"--courant {scene.courant:g} is far too small: raise it (the default is 4)"
+    raise ValueError(f"this scene needs {longest:.3g} steps in one run, beyond LAMMPS's {LAMMPS_MAX_STEPS} (and "
+                     f"beyond any computer's time): {fix}")
 
 
 def place(scene: Scene) -> None:
@@ -390,8 +412,9 @@ def _periodic_delta(delta: np.ndarray, box: list[float]) -> np.ndarray:
     return delta - box * np.rint(delta / box)
 
 
-def write(scene: Scene, out: Path, layer_file: str = "layers.h5") -> list[Path]:
-    """Writes the scene: data file, deck and PSD tables.
+def write(scene: Scene, out: Path, layer_file: str = "layers.h5", force: bool = False) -> list[Path]:
+    """Writes the scene: data file, deck and PSD tables, together (under the folder's lock, staged and
+    then moved into place).
 
     Parameters
     ----------
@@ -401,17 +424,49 @@ def write(scene: Scene, out: Path, layer_file: str = "layers.h5") -> list[Path]:
         Output folder (created).
     layer_file : str
         Name of the layer file the deck writes.
+    force : bool
+        Delete the files of a run in `out` whose inputs this scene changes (its layer file, restart
+        files, logs), instead of refusing.
 
     Returns
     -------
     list of Path
         The files written.
     """
+    import shutil
+
+    from .run import RUN_OUTPUTS, folder_lock, inputs_id
+
     if out.exists() and not out.is_dir():
         raise ValueError(f"{out} exists and is not a folder")
-    out.mkdir(parents=True, exist_ok=True)
-    paths = [out / "sample.data", out / "in.sedimentation", out / "input_psd.csv", out / "simulated_psd.csv",
-             out / "classes.csv"]
+    names = ["sample.data", "in.sedimentation", "input_psd.csv", "simulated_psd.csv", "classes.csv"]
+    with folder_lock(out, "sample"):
+        stage = out / f".sample.{os.getpid()}"
+        shutil.rmtree(stage, ignore_errors=True)
+        stage.mkdir()
+        try:
+            _write_files(scene, [stage / n for n in names], layer_file)
+            # A run here read the deck and data file now in place: new ones would leave its frames
+            # beside tables of another test.
+            results = [p.name for p in (out / layer_file, out / (layer_file + ".partial"),
+                                        *(out / n for n in RUN_OUTPUTS)) if p.exists()]
+            deck = out / names[1]
+            if results and (not deck.is_file() or inputs_id(deck) != inputs_id(stage / names[1])):
+                if not force:
+                    raise ValueError(f"{out} holds a run of another scene ({', '.join(results)}): its frames would "
+                                     "stand beside tables of this one; sample into another --out, or give --force "
+                                     "to delete that run's files")
+                for name in results:
+                    (out / name).unlink()
+            for name in names:
+                os.replace(stage / name, out / name)
+        finally:
+            shutil.rmtree(stage, ignore_errors=True)
+    return [out / n for n in names]
+
+
+def _write_files(scene: Scene, paths: list[Path], layer_file: str) -> None:
+    """sample.data, in.sedimentation, input_psd.csv, simulated_psd.csv and classes.csv, at `paths`."""
     write_data(scene, paths[0])
     write_text(paths[1], _deck(scene, paths[0].name, layer_file))
     _write_psd(scene.psd, paths[2])
@@ -420,12 +475,14 @@ def write(scene: Scene, out: Path, layer_file: str = "layers.h5") -> list[Path]:
     write_text(paths[4], "diameter_um,input_mass_fraction,simulated_mass_fraction,particles,weight\n" + "".join(
         f"{d * 1e6:.6g},{m:.6g},{s:.6g},{n},{w:.6g}\n"
         for d, m, s, n, w in zip(c.diameter, c.mass_fraction, c.simulated_mass_fraction(), c.count, c.weight)))
-    return paths
 
 
 def _write_psd(psd: PSD, path: Path) -> None:
+    """The table as read_psd reads it: 12 digits, or 17 where 12 would merge two diameters."""
+    diameter = psd.diameter * 1e6
+    digits = 12 if len(np.unique([f"{d:.12g}" for d in diameter])) == len(diameter) else 17
     write_text(path, "diameter_um,percent_finer\n" + "".join(
-        f"{d * 1e6:.8g},{p:.8g}\n" for d, p in zip(psd.diameter, psd.percent_finer)))
+        f"{d:.{digits}g},{p:.12g}\n" for d, p in zip(diameter, psd.percent_finer)))
 
 
 def write_data(scene: Scene, path: Path) -> None:
@@ -526,7 +583,8 @@ def _deck(scene: Scene, data: str, layer_file: str) -> str:
         lines.append(f"fix             step all nve/sphere/fluid floor {up} 0.0")
     lines += [
         f"fix             layers all layers/hdf5 $(round({frames_every}/v_dt_scale)+(round({frames_every}/v_dt_scale)<1)) "
-        f"${{layers_file}} c_conc fluid water particle_density {f.particle_density:.12g} overwrite ${{overwrite}}",
+        f"${{layers_file}} c_conc fluid water particle_density {f.particle_density:.12g} overwrite ${{overwrite}} &",
+        "                end_time ${t_end}    # complete only when the frames reach the end of the test",
         "",
         "thermo_style    custom step time dt f_layers" + (" c_overlap" if e.interacting else ""),
         f"thermo          {frames_every * 5}",
