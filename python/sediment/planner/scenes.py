@@ -55,21 +55,30 @@ class Outcome:
     printed: dict[str, float] = field(default_factory=dict)    # SCREEN numbers a deck printed
 
 
-def prepare(folder: Path) -> Path:
-    """A folder the planner writes (its runs, its decision), emptied if a previous plan left it (it
-    carries the planner's marker). Refused rather than emptied: a folder the planner did not write,
-    and one where a run has since left its results (a layer file or log beside the deck)."""
-    folder = Path(folder)
-    if folder.exists() and any(folder.iterdir()):
-        if not (folder / MARKER).is_file():
-            raise ValueError(f"{folder} exists and was not written by sediment plan: choose another --out")
-        results = sorted(p.name for p in folder.iterdir() if p.suffix == ".h5" or p.name.startswith("log.lammps"))
+def check_plan_folder(out: Path) -> None:
+    """Refuses, before anything is written, an --out the planner may not replace: one it did not write
+    (no marker), and one where a run has since left its results beside a deck (a layer file or log in
+    it, its runs/ or its decision/)."""
+    out = Path(out)
+    if not out.exists() or (out.is_dir() and not any(out.iterdir())):
+        return
+    if not out.is_dir():
+        raise ValueError(f"{out} exists and is not a folder: choose another --out")
+    if not ((out / MARKER).is_file() or (out / "runs" / MARKER).is_file()):
+        names = sorted(p.name for p in out.iterdir())[:5]
+        raise ValueError(f"{out} holds files sediment plan did not write ({', '.join(names)}): choose another --out")
+    for folder in (out, out / "runs", out / "decision"):
+        results = sorted(p.name for p in folder.glob("*") if p.suffix == ".h5" or p.name.startswith("log.lammps"))
         if results:
             raise ValueError(f"{folder} holds the results of a run ({', '.join(results)}): move them or choose "
                              "another --out")
-        shutil.rmtree(folder)
-    folder.mkdir(parents=True)
-    (folder / MARKER).write_text("runs of sediment plan; emptied by the next plan in this folder\n")
+
+
+def prepare(folder: Path) -> Path:
+    """A new folder of the planner's (its runs, its decision), with its marker."""
+    folder = Path(folder)
+    folder.mkdir(parents=True, exist_ok=True)
+    (folder / MARKER).write_text("written by sediment plan; replaced whole by the next plan in this folder\n")
     return folder
 
 
@@ -138,7 +147,8 @@ class SampleScene:
         """The test besides the knobs, as `sediment sample --plan` checks it."""
         t = self.test
         return dict(self.options, mass=t.mass, particle_density=t.suspension.particle_density,
-                    cylinder_area=t.cylinder.area, height=t.cylinder.height, temperature=t.suspension.temperature)
+                    cylinder_area=t.cylinder.area, height=t.cylinder.height, temperature=t.suspension.temperature,
+                    psd={"diameter_um": (t.psd.diameter * 1e6).tolist(), "percent_finer": t.psd.percent_finer.tolist()})
 
     def _scene(self, settings: dict, seed: int):
         from ..sim.scene import Effects, plan
