@@ -11,6 +11,7 @@
 #include "fix_fluid.h"
 
 #include "atom.h"
+#include "comm.h"
 #include "compute.h"
 #include "error.h"
 #include "group.h"
@@ -18,6 +19,7 @@
 #include "update.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstring>
 #include <mpi.h>
 
@@ -105,6 +107,30 @@ void FixFluidBuoyancy::init()
   int dim = 0;
   gravity = static_cast<double *>(gravity_fix->extract("gvec", dim));
   if (!gravity) error->all(FLERR, "Fix fluid/buoyancy: fix gravity does not expose its vector");
+  if (!fluid->fills_space()) warn_of_bobbing();
+}
+
+void FixFluidBuoyancy::warn_of_bobbing()
+{
+  // A sphere lighter than the fluid floats at the free surface, held there by the buoyancy of its
+  // waterline: it bobs at omega^2 = 3 rho_f g / (4 rho_p r). With dt omega above 1 the explicit
+  // buoyancy makes it bounce or rest off its level (millimetres for a 1 cm ball at dt 0.05 s).
+  if (!atom->rmass) return;
+  const double rho = fluid->properties().density;
+  const double g = std::sqrt(gravity[0] * gravity[0] + gravity[1] * gravity[1] + gravity[2] * gravity[2]);
+  double omega = 0.0;
+  for (int i = 0; i < atom->nlocal; ++i) {
+    if (!(atom->mask[i] & groupbit) || atom->radius[i] <= 0.0) continue;
+    const double r = atom->radius[i];
+    const double density = atom->rmass[i] / (4.0 / 3.0 * M_PI * r * r * r);
+    if (density < rho) omega = std::max(omega, std::sqrt(3.0 * rho * g / (4.0 * density * r)));
+  }
+  double omega_all = 0.0;
+  MPI_Allreduce(&omega, &omega_all, 1, MPI_DOUBLE, MPI_MAX, world);
+  if (comm->me == 0 && omega_all * update->dt > 1.0)
+    error->warning(FLERR, "Fix fluid/buoyancy: a sphere lighter than fluid {} floats at its surface and bobs with "
+                   "period {:.4g}; the time step {:.4g} is too long for it (it would bounce, or rest off its level): "
+                   "use a time step up to {:.3g}", fluid_id, 2.0 * M_PI / omega_all, update->dt, 0.5 / omega_all);
 }
 
 void FixFluidBuoyancy::setup(int vflag)

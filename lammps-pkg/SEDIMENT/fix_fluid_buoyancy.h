@@ -29,6 +29,7 @@ class FixFluidBuoyancy : public Fix {
   class FixFluid *fluid_fix() const { return fluid; }
 
  private:
+  void warn_of_bobbing();    // a floating sphere's time step against its bobbing period
   char *fluid_id, *gravity_id, *mixture_id;
   class Compute *mixture;       // per-atom local solid fraction: buoyancy of the suspension
   double solid_density;         // density of the suspended solids, for the mixture density
