@@ -210,15 +210,15 @@ def test_an_interrupted_plan_stops_every_run_and_says_so(tmp_path):
     out = tmp_path / "plan"
     plan = subprocess.Popen([str(REPO / "bin" / "sediment"), "plan", str(SAMPLE5), "--out", str(out), "--particles",
                              "40000,20000", "--courant", "1,2", "--t-end", "7200"], stderr=subprocess.PIPE, text=True)
-    def busy() -> list[Path]:
-        return [f for f in (out / "runs").glob("*") if f.is_dir() and processes_in(f)]
+    def busy() -> list[Path]:    # the plan works in a new folder beside --out until it is done
+        return [f for f in tmp_path.glob(".plan.new-*/runs/*") if f.is_dir() and processes_in(f)]
 
     wait_for(lambda: len(busy()) == 2)      # two trials at once (--jobs 2)
     plan.send_signal(signal.SIGINT)
     _, err = plan.communicate(timeout=20)     # not after the runs end (about 40 s each)
     assert plan.returncode == 130 and "Traceback" not in err and "interrupted" in err
     wait_for(lambda: not busy(), seconds=10)
-    assert not (out / "report.json").exists()
+    assert not (out / "report.json").exists() and not list(tmp_path.glob(".plan.new-*"))
 
 
 def _narrow_psd(tmp_path: Path) -> Path:

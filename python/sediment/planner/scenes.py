@@ -75,8 +75,18 @@ def check_plan_folder(out: Path) -> None:
 
 
 def prepare(folder: Path) -> Path:
-    """A new folder of the planner's (its runs, its decision), with its marker."""
+    """A folder the planner writes (its runs, its decision, a contact measurement), emptied if the
+    planner left it. Refused rather than emptied: a folder the planner did not write, and one where a
+    run has since left its results (a layer file or log beside the deck)."""
     folder = Path(folder)
+    if folder.exists() and any(folder.iterdir()):
+        if not (folder / MARKER).is_file():
+            raise ValueError(f"{folder} exists and was not written by sediment plan: choose another --out")
+        results = sorted(p.name for p in folder.iterdir() if p.suffix == ".h5" or p.name.startswith("log.lammps"))
+        if results:
+            raise ValueError(f"{folder} holds the results of a run ({', '.join(results)}): move them or choose "
+                             "another --out")
+        shutil.rmtree(folder)
     folder.mkdir(parents=True, exist_ok=True)
     (folder / MARKER).write_text("written by sediment plan; replaced whole by the next plan in this folder\n")
     return folder

@@ -328,6 +328,8 @@ def run_deck(deck: Path, ranks: int = 1, variables: dict[str, str] | None = None
             launch = dict(variables, sediment_run_id=identity, resume="yes", restart_file=restart.name)
             try:
                 return _run_recorded(deck, ranks, variables, launch, progress)
+            except RunInterrupted:    # a stop asked for, not a restart file that failed
+                raise
             except RuntimeError as exc:
                 failures.append(f"{restart.name}: {exc}")
                 if k + 1 == len(restarts) or [p.stat().st_mtime_ns for p in restarts] != stamps:
@@ -335,8 +337,9 @@ def run_deck(deck: Path, ranks: int = 1, variables: dict[str, str] | None = None
                 print(f"resuming from {restart.name} failed ({str(exc).splitlines()[0]}); trying {restarts[k + 1].name}",
                       file=sys.stderr)
         if all("written by run" in f for f in failures):
-            raise RuntimeError(f"the restart files in {folder} are of an earlier run, not of the interrupted run "
-                               f"{identity} (it stopped before it wrote one): start it anew with --force")
+            raise RuntimeError(f"the restart files in {folder} are of another run (an earlier one, or copied from "
+                               f"elsewhere), not of the interrupted run {identity}, which stopped before it wrote "
+                               "one: start it anew with --force")
         reasons = dict.fromkeys(f.split(": ", 1)[1] for f in failures)    # the same reason once
         raise RuntimeError(f"cannot resume from {' or '.join(f.split(':')[0] for f in failures)}: " + "; ".join(reasons))
 
