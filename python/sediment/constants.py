@@ -11,3 +11,20 @@ D422_CYLINDER_AREA = 27.8e-4      # m2, ASTM D422 cylinder (inner diameter 5.95 
 D422_CYLINDER_HEIGHT = 0.36       # m, the 1000 mL mark
 BRAVO_CYLINDER_WIDTH = 0.0635     # m, Bravo et al. (2015)
 BRAVO_CYLINDER_HEIGHT = 0.457     # m
+
+# Names the command line offers before the C++ core is loaded (its --help works before a build);
+# tests/python/test_cli.py checks them against the core's own lists.
+DRAG_LAWS = ("stokes", "schiller-naumann", "dallavalle", "zhang-li", "zhang-li/smooth", "difelice", "standard")
+# The single-sphere drag of a test: the measured standard drag curve (the default), Schiller &
+# Naumann's, Dallavalle's, Stokes' law; and Bravo et al.'s model, Dallavalle's curve under Di Felice's
+# hindrance, named difelice as in the paper (docs/physics.md).
+DRAGS = ("standard", "schiller-naumann", "dallavalle", "stokes", "difelice")
+# How the local concentration hinders the drag: Richardson & Zaki's measured exponent (Rowe's smooth
+# fit, the default: left out, the hindrance moves the readings of Bravo et al.'s five samples at 60 g/L
+# by 2.1 to 18.9 points of percent finer, docs/effects.md), Garside & Al-Dibouni's, Di Felice's, none.
+HINDRANCES = ("richardson-zaki", "garside", "difelice", "none")
+SCHEDULES = {              # hydrometer reading times [min]
+    "d422": [2, 5, 15, 30, 60, 250, 1440],
+    "d7928": [1, 2, 4, 15, 30, 60, 240, 1440],
+    "bravo": [0.5, 1, 2, 4, 15, 30, 60, 120, 240, 480],
+}

@@ -1,6 +1,8 @@
 # SPDX-License-Identifier: GPL-2.0-or-later
 """The sediment command line."""
 import argparse
+import shlex
+import shutil
 import subprocess
 from pathlib import Path
 
@@ -117,3 +119,53 @@ def test_psd_in_metres_is_refused(tmp_path, capsys):
     psd.write_text("diameter_um,percent_finer\n2.5e-6,0\n7e-5,100\n")
     assert cli.main(["sample", str(psd), "--out", str(tmp_path / "out")]) == 2
     assert "write micrometres, not metres" in capsys.readouterr().err
+
+
+def test_every_help_works_before_the_core_is_built_and_a_command_says_what_to_build(tmp_path):
+    shutil.copytree(REPO / "python" / "sediment", tmp_path / "sediment",
+                    ignore=shutil.ignore_patterns("_core*.so", "__pycache__"))
+    def bare(*args: str) -> subprocess.CompletedProcess:
+        return subprocess.run(["/usr/bin/python3", "-m", "sediment", *args], capture_output=True, text=True,
+                              cwd=tmp_path, env={"PATH": "/usr/bin:/bin", "PYTHONPATH": str(tmp_path)})
+    for command in [[]] + [[c] for c in cli.build_parser()._subparsers._group_actions[0].choices]:
+        done = bare(*command, "--help")
+        assert done.returncode == 0 and "Traceback" not in done.stderr, (command, done.stderr)
+    done = bare("terminal", "--diameter", "1e-4", "--particle-density", "2650")
+    assert done.returncode == 2 and done.stderr.count("\n") == 1 and "not built: run `make build`" in done.stderr
+
+
+def test_the_commands_come_in_the_order_of_the_work_with_examples_that_parse(capsys):
+    parser = cli.build_parser()
+    names = list(parser._subparsers._group_actions[0].choices)
+    assert names[:6] == ["plan", "sample", "run", "readout", "budget", "invert"]
+    with pytest.raises(SystemExit) as done:
+        parser.parse_args(["--version"])
+    assert done.value.code == 0 and capsys.readouterr().out.strip() == "sediment 0.1.0"
+    for command in cli.COMMANDS:
+        assert command.EXAMPLES
+        for line in command.EXAMPLES:
+            words = shlex.split(line.split("#")[0])
+            assert words[0] == "sediment"
+            parser.parse_args(words[1:])    # exits with the reason if an example does not parse
+            for word in words:
+                if word.startswith(("examples/", "tests/data/")):
+                    assert (REPO / word).exists(), line
+    text = parser._subparsers._group_actions[0].choices["sample"].format_help()
+    assert "(default: 0.06)" in text and "(default: None)" not in text and "examples:\n  sediment sample" in text
+
+
+def test_the_names_the_help_offers_are_the_cores():
+    from sediment import _core
+    from sediment.constants import DRAG_LAWS
+
+    assert list(DRAG_LAWS) == _core.drag_law_names()
+
+
+def test_the_core_stub_matches_the_built_module():
+    import runpy
+
+    from sediment import _core
+
+    stub = runpy.run_path(str(REPO / "scripts" / "core-stub.py"))["stub_text"](_core)
+    assert (REPO / "python" / "sediment" / "_core.pyi").read_text() == stub, "run scripts/core-stub.py"
+    assert (REPO / "python" / "sediment" / "py.typed").is_file()

@@ -1,24 +1,48 @@
 # SPDX-License-Identifier: GPL-2.0-or-later
-"""The `sediment` command line: one module per command, each with ``add_parser(commands)`` and
-``run(args)``; results are printed with their ``table()`` and written with their ``save(folder)``."""
+"""The `sediment` command line: one module per command, each with ``add_parser(commands)``,
+``run(args)`` and ``EXAMPLES`` (shown under its --help); results are printed with their ``table()``
+and written with their ``save(folder)``. Every --help works before the C++ core is built."""
 from __future__ import annotations
 
 import argparse
 import sys
 
+from .. import __version__
 from ..sim.run import RunInterrupted
 from . import budget, calibrate, case_a, invert, paste, plan, readout, run, sample, spheres, sweep, terminal
 
-COMMANDS = (terminal, case_a, sample, plan, run, readout, budget, invert, calibrate, paste, spheres, sweep)
+# In the order of the work: plan a test, sample it, run it, read it; the physics' uncertainty; a
+# laboratory's sheets in; then the single-sphere, accuracy and paste studies.
+COMMANDS = (plan, sample, run, readout, budget, invert, terminal, sweep, case_a, spheres, paste, calibrate)
+
+
+class HelpFormatter(argparse.RawDescriptionHelpFormatter):
+    """Examples kept as written; each option's default shown where it has one that says something
+    (not None, False or one its help already names)."""
+
+    def _get_help_string(self, action: argparse.Action) -> str:
+        text = action.help or ""
+        if (action.default in (None, False, argparse.SUPPRESS) or "default" in text or not action.option_strings
+                or isinstance(action.default, (list, dict)) and not action.default):
+            return text
+        return text + " (default: %(default)s)"
 
 
 def build_parser() -> argparse.ArgumentParser:
     """The parser of every command."""
-    parser = argparse.ArgumentParser(prog="sediment", description="SEDIMENT: settling of DEM spheres in "
-                                     "fluids with LAMMPS, and sedimentation-test readouts.")
-    commands = parser.add_subparsers(dest="command", required=True)
+    parser = argparse.ArgumentParser(prog="sediment", formatter_class=HelpFormatter,
+                                     description="SEDIMENT: settling of DEM spheres in fluids with LAMMPS, and "
+                                     "sedimentation-test readouts.",
+                                     epilog="a test end to end:\n" + "\n".join(f"  {line}" for line in (
+                                         plan.EXAMPLES[0], sample.EXAMPLES[1], run.EXAMPLES[0], readout.EXAMPLES[0])) +
+                                     "\n\n`sediment COMMAND --help` for a command's options and examples")
+    parser.add_argument("--version", action="version", version=f"sediment {__version__}")
+    commands = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
     for command in COMMANDS:
-        command.add_parser(commands).set_defaults(func=command.run)
+        sub = command.add_parser(commands)
+        sub.formatter_class = HelpFormatter
+        sub.epilog = "examples:\n" + "\n".join(f"  {line}" for line in command.EXAMPLES)
+        sub.set_defaults(func=command.run)
     return parser
 
 
@@ -26,6 +50,12 @@ def main(argv: list[str] | None = None) -> int:
     """Runs one command. Errors end with one line on stderr: exit status 2 for a problem with the
     input or the files, 130 when interrupted (Ctrl-C or SIGTERM; a run stops every rank first)."""
     args = build_parser().parse_args(argv)
+    try:
+        from .. import _core    # noqa: F401  (every command but --help needs it)
+    except ImportError:
+        print(f"sediment {args.command}: the C++ core (sediment._core) is not built: run `make build` in the "
+              "repository, or install the package (README, Python route)", file=sys.stderr)
+        return 2
     try:
         return args.func(args)
     except RunInterrupted as exc:    # says what the run left
@@ -35,6 +65,6 @@ def main(argv: list[str] | None = None) -> int:
         print(f"sediment {args.command}: interrupted; files being written were left as *.partial or not written",
               file=sys.stderr)
         return 130
-    except (ValueError, OSError, RuntimeError) as exc:    # SheetError is a ValueError    # OSError: missing, read-only or full files and folders
+    except (ValueError, OSError, RuntimeError) as exc:    # SheetError is a ValueError; OSError: missing, read-only or full files
         print(f"sediment {args.command}: error: {exc}", file=sys.stderr)
         return 2

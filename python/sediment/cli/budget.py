@@ -9,6 +9,11 @@ from ..constants import LAB_TEMPERATURE
 from .types import count, positive, temperature
 
 
+EXAMPLES = [
+    'sediment budget examples/granulometry/psd/sample5.csv --out out/budget',
+]
+
+
 def add_parser(commands) -> argparse.ArgumentParser:
     """Adds the command and its options."""
     parser = commands.add_parser(

@@ -8,6 +8,12 @@ from pathlib import Path
 from .types import positive
 
 
+EXAMPLES = [
+    'sediment calibrate slump --slump 0.102 0.103 0.100 --height 0.152 --density 1843',
+    'sediment calibrate tilt --lift 205 205 202 202 208 --length 600',
+]
+
+
 def add_parser(commands) -> argparse.ArgumentParser:
     """Adds the command, its three tests and their options."""
     parser = commands.add_parser("calibrate", help="paste and contact parameters from a slump, drop or tilt test")

@@ -6,6 +6,11 @@ import argparse
 from pathlib import Path
 
 
+EXAMPLES = [
+    'sediment case-a --out out/case_a',
+]
+
+
 def add_parser(commands) -> argparse.ArgumentParser:
     """Adds the command and its options."""
     parser = commands.add_parser("case-a", help="single-sphere validation (case A): velocity curves and error vs "

@@ -9,6 +9,12 @@ from ..constants import D422_CYLINDER_AREA, D422_CYLINDER_HEIGHT, SOIL_PARTICLE_
 from .types import count, finite, positive, positive_list
 
 
+EXAMPLES = [
+    'sediment invert examples/inverse/hydrometer.csv examples/inverse/pipette.csv --mass 0.06 --out out/invert',
+    'sediment invert --design examples/granulometry/psd/sample5.csv --out out/design',
+]
+
+
 def add_parser(commands) -> argparse.ArgumentParser:
     """Adds the command and its options."""
     parser = commands.add_parser(

@@ -8,6 +8,12 @@ from pathlib import Path
 from .types import count, nonnegative, positive, setting
 
 
+EXAMPLES = [
+    'sediment paste drop-test --out out/paste',
+    'sediment paste funnel --runs 15 --jobs 2 --out out/paste',
+]
+
+
 def add_parser(commands) -> argparse.ArgumentParser:
     """Adds the command, its studies and their options."""
     parser = commands.add_parser("paste", help="steel balls and paste backfill (cases D-F): drop test, single "

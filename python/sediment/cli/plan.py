@@ -18,6 +18,12 @@ def _ladder(text: str) -> tuple[str, list[str]]:
     return name, [v.strip() for v in values.split(",")]
 
 
+EXAMPLES = [
+    'sediment plan examples/granulometry/psd/sample5.csv --out out/plan',
+    'sediment plan --deck examples/planner/in.suspension --observe speed --out out/plan-deck',
+]
+
+
 def add_parser(commands) -> argparse.ArgumentParser:
     """Adds the command and its options."""
     parser = commands.add_parser(

@@ -8,9 +8,14 @@ from pathlib import Path
 
 import numpy as np
 
-from ..constants import D422_CYLINDER_AREA, D422_CYLINDER_HEIGHT, SOIL_PARTICLE_DENSITY
-from ..lab.readout import SCHEDULES
+from ..constants import D422_CYLINDER_AREA, D422_CYLINDER_HEIGHT, SCHEDULES, SOIL_PARTICLE_DENSITY
 from .types import finite, positive, temperature
+
+
+EXAMPLES = [
+    'sediment readout out/sample5/layers.h5 --out out/sample5/readout',
+    'sediment readout --psd examples/granulometry/psd/sample5.csv --stokes-preview --out out/preview',
+]
 
 
 def add_parser(commands) -> argparse.ArgumentParser:

@@ -8,6 +8,12 @@ from pathlib import Path
 from .types import count
 
 
+EXAMPLES = [
+    'sediment run out/sample5/in.sedimentation --np 2',
+    'sediment run out/sample5/in.sedimentation --resume    # after a kill: continues from its restart file',
+]
+
+
 def add_parser(commands) -> argparse.ArgumentParser:
     """Adds the command and its options."""
     parser = commands.add_parser("run", help="run a deck with lmp_sediment (serial or mpirun) with a progress bar")

@@ -5,9 +5,14 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from ..constants import LAB_TEMPERATURE, SOIL_PARTICLE_DENSITY
-from ..sim.scene import DRAGS, HINDRANCES
+from ..constants import DRAGS, HINDRANCES, LAB_TEMPERATURE, SOIL_PARTICLE_DENSITY
 from .types import count, positive, temperature
+
+
+EXAMPLES = [
+    'sediment sample examples/granulometry/psd/sample5.csv --out out/sample5',
+    'sediment sample examples/granulometry/psd/sample5.csv --plan out/plan/report.json --out out/sample5',
+]
 
 
 def add_parser(commands) -> argparse.ArgumentParser:

@@ -6,6 +6,11 @@ import argparse
 from pathlib import Path
 
 
+EXAMPLES = [
+    'sediment spheres tests/data/vw1965_dev.csv --out out/spheres',
+]
+
+
 def add_parser(commands) -> argparse.ArgumentParser:
     """Adds the command and its options."""
     parser = commands.add_parser("spheres", help="terminal velocities of spheres in Bingham suspensions, simulated "

@@ -8,6 +8,11 @@ from pathlib import Path
 from .types import count, positive, positive_list
 
 
+EXAMPLES = [
+    'sediment sweep out/sample5/in.sedimentation --parameter dt_scale --dt 0.5,1,2 --observe hydrometer pipette --out out/sweep',
+]
+
+
 def add_parser(commands) -> argparse.ArgumentParser:
     """Adds the command and its options."""
     parser = commands.add_parser(

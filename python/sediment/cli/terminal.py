@@ -6,9 +6,13 @@ import argparse
 
 import math
 
-from .. import _core
-from ..constants import GRAVITY, WATER_20C_DENSITY, WATER_20C_VISCOSITY
+from ..constants import DRAG_LAWS, GRAVITY, WATER_20C_DENSITY, WATER_20C_VISCOSITY
 from .types import finite, nonnegative, positive, temperature
+
+
+EXAMPLES = [
+    'sediment terminal --law standard --diameter 50e-6 --particle-density 2650 --temperature 20',
+]
 
 
 def add_parser(commands) -> argparse.ArgumentParser:
@@ -16,7 +20,7 @@ def add_parser(commands) -> argparse.ArgumentParser:
     parser = commands.add_parser("terminal", help="terminal velocity of a sphere under a drag law",
                                  description="Example: sediment terminal --law standard --diameter 70e-6 "
                                  "--particle-density 2650 --temperature 18")
-    parser.add_argument("--law", default="stokes", choices=_core.drag_law_names())
+    parser.add_argument("--law", default="stokes", choices=DRAG_LAWS)
     parser.add_argument("--diameter", type=positive, required=True, help="sphere diameter [m]")
     parser.add_argument("--particle-density", type=positive, required=True, help="[kg/m3]")
     parser.add_argument("--fluid-density", type=positive, help="[kg/m3] (default water at 20 C)")
@@ -37,6 +41,8 @@ def add_parser(commands) -> argparse.ArgumentParser:
 
 def run(args: argparse.Namespace) -> int:
     """Prints the terminal velocity, the relaxation time and explicit limit, t99 and the Rayleigh time."""
+    from .. import _core
+
     if args.temperature is not None:
         if args.fluid_density is not None or args.viscosity is not None:
             raise ValueError("--temperature sets the water's density and viscosity: give it or them, not both")

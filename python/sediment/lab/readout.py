@@ -15,17 +15,10 @@ import numpy as np
 
 from .. import _core
 from ..results import Table, write_text
-from ..constants import (D422_CYLINDER_AREA, GRAVITY, LAB_TEMPERATURE, SOIL_PARTICLE_DENSITY, WATER_20C_DENSITY,
-                         WATER_20C_VISCOSITY)
+from ..constants import (D422_CYLINDER_AREA, GRAVITY, LAB_TEMPERATURE, SCHEDULES, SOIL_PARTICLE_DENSITY,
+                         WATER_20C_DENSITY, WATER_20C_VISCOSITY)
 
 R_FACTOR = 1 - 1 / 2.65    # 152H: R = (rho_s - rho_w) / 0.6226 in g/L, calibrated for Gs = 2.65
-
-SCHEDULES = {              # reading times [min]
-    "d422": [2, 5, 15, 30, 60, 250, 1440],
-    "d7928": [1, 2, 4, 15, 30, 60, 240, 1440],
-    "bravo": [0.5, 1, 2, 4, 15, 30, 60, 120, 240, 480],
-}
-
 
 @dataclass(frozen=True)
 class Suspension:

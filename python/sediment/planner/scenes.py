@@ -23,7 +23,7 @@ import numpy as np
 from ..results import write_text
 from ..sim.deck import deck_text, index_variables
 from ..sim.run import run_batch
-from ..sim.scene import DRAGS, HINDRANCES
+from ..constants import DRAGS, HINDRANCES
 from .screening import INCLUDE, MEASURE, OMIT, Screen, SedimentationTest, screen, verdict_of
 
 MARKER = ".sediment-plan"    # in a folder of trial runs: the planner owns it and may empty it

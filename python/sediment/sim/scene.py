@@ -19,7 +19,8 @@ from pathlib import Path
 import numpy as np
 
 from .. import _core
-from ..constants import BRAVO_CYLINDER_HEIGHT, BRAVO_CYLINDER_WIDTH, D422_CYLINDER_AREA, D422_CYLINDER_HEIGHT
+from ..constants import (BRAVO_CYLINDER_HEIGHT, BRAVO_CYLINDER_WIDTH, D422_CYLINDER_AREA, D422_CYLINDER_HEIGHT,
+                         DRAGS, HINDRANCES)
 from ..lab.psd import PSD, SizeClasses, class_edges, discretise
 from ..lab.readout import Suspension
 from ..results import write_text
@@ -45,14 +46,6 @@ class Cylinder:
         return math.sqrt(4 * self.area / math.pi)
 
 
-# The single-sphere drag of a test: the measured standard drag curve (the default), Schiller &
-# Naumann's, Dallavalle's, Stokes' law; and Bravo et al.'s model, Dallavalle's curve under Di Felice's
-# hindrance, named difelice as in the paper (docs/physics.md).
-DRAGS = ("standard", "schiller-naumann", "dallavalle", "stokes", "difelice")
-# How the local concentration hinders the drag: Richardson & Zaki's measured exponent (Rowe's smooth
-# fit, the default: left out, the hindrance moves the readings of Bravo et al.'s five samples at 60 g/L
-# by 2.1 to 18.9 points of percent finer, docs/effects.md), Garside & Al-Dibouni's, Di Felice's, none.
-HINDRANCES = ("richardson-zaki", "garside", "difelice", "none")
 
 
 @dataclass(frozen=True)
