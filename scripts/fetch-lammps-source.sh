@@ -5,6 +5,8 @@
 # (e.g. bookworm with the version of the installed liblammps-dev, or sid latest). The deb-src entry
 # and its package lists are kept in DIR: the machine's apt configuration is not changed. apt checks
 # the tarball against the signed index. Skipped when DIR already holds a tarball of that version.
+# The Debian mirror is the machine's own (the archive apt installs Debian's main from; a proxy in
+# apt's configuration applies too), SEDIMENT_DEBIAN_MIRROR if set, deb.debian.org otherwise.
 set -euo pipefail
 suite=${1:?usage: fetch-lammps-source.sh SUITE VERSION|latest DIR}
 version=${2:?usage: fetch-lammps-source.sh SUITE VERSION|latest DIR}
@@ -18,9 +20,12 @@ if [ "$version" != latest ] && ls "$dir/lammps_$(upstream "$version").orig.tar."
     ls "$dir/lammps_$(upstream "$version").orig.tar."*
     exit 0
 fi
+mirror=${SEDIMENT_DEBIAN_MIRROR:-$(apt-get indextargets --format '$(REPO_URI) $(RELEASE) $(COMPONENT)' 2>/dev/null |
+                                    awk '$3 == "main" && $2 !~ /-/ {print $1; exit}')}
+mirror=${mirror:-http://deb.debian.org/debian/}
 cat > "$sources" <<SRC
 Types: deb-src
-URIs: http://deb.debian.org/debian
+URIs: $mirror
 Suites: $suite
 Components: main
 Signed-By: /usr/share/keyrings/debian-archive-keyring.gpg
