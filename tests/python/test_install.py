@@ -1,9 +1,9 @@
 # SPDX-License-Identifier: GPL-2.0-or-later
 """`pip install .` in a virtual environment: the package, its console script and a `_core` that
 links no LAMMPS (Debian's build backend; no network, so no build isolation)."""
+import os
 import shutil
 import subprocess
-import sys
 from pathlib import Path
 
 REPO = Path(__file__).resolve().parents[2]
@@ -16,10 +16,11 @@ def test_pip_install_gives_the_package_and_the_command(tmp_path):
         shutil.copy(REPO / name, source / name)
     shutil.copytree(REPO / "core", source / "core")
     shutil.copytree(REPO / "python", source / "python", ignore=shutil.ignore_patterns("_core*.so", "__pycache__"))
-    venv = tmp_path / "venv"
-    subprocess.run([sys.executable, "-m", "venv", "--system-site-packages", str(venv)], check=True)
-    subprocess.run([venv / "bin" / "pip", "install", "--no-build-isolation", "--no-deps", "-q", str(source)],
-                   check=True, cwd=tmp_path)
+    # the README's command, as written, in the source folder
+    command = next(line.strip() for line in (REPO / "README.md").read_text().splitlines()
+                   if "pip install" in line and line.strip().startswith("/usr/bin/python3 -m venv"))
+    subprocess.run(["bash", "-c", command], check=True, cwd=source, capture_output=True)
+    venv = source / ".venv"
     out = subprocess.run([venv / "bin" / "sediment", "terminal", "--diameter", "1e-4", "--particle-density", "2700",
                           "--fluid-density", "1000", "--viscosity", "1e-3"], capture_output=True, text=True,
                          check=True, cwd=tmp_path).stdout
@@ -29,3 +30,29 @@ def test_pip_install_gives_the_package_and_the_command(tmp_path):
     assert where.startswith(str(venv))
     linked = subprocess.run(["ldd", where], capture_output=True, text=True, check=True).stdout
     assert "lammps" not in linked and "sediment_lammps" not in linked
+    # the main job with the installed package, LAMMPS from the build
+    env = dict(os.environ, SEDIMENT_LMP=str(REPO / "build" / "lmp_sediment"), PYTHONPATH="")
+    sediment = venv / "bin" / "sediment"
+    for args in (["sample", REPO / "examples" / "granulometry" / "psd" / "sample5.csv", "--out", "s", "--particles",
+                  "2000", "--t-end", "7200"], ["run", "s/in.sedimentation", "--quiet"],
+                 ["readout", "s/layers.h5", "--out", "s/readout"]):
+        done = subprocess.run([sediment, *map(str, args)], capture_output=True, text=True, cwd=tmp_path, env=env)
+        assert done.returncode == 0, done.stderr
+    assert (tmp_path / "s" / "readout" / "granulometry.png").is_file()
+    assert list((venv / "lib").glob("python3*/site-packages/sediment/py.typed"))
+
+
+def test_the_plugin_builds_alone_against_the_headers(tmp_path):
+    """The README's plugin command: LAMMPS's headers only, no liblammps; a library that does not
+    exist is refused at configure."""
+    headers = REPO / "build" / "lammps-headers"
+    command = next(line.strip() for line in (REPO / "README.md").read_text().splitlines()
+                   if "SEDIMENT_PLUGIN_ONLY=ON" in line and line.strip().startswith("cmake"))
+    command = command.replace("/path/to/lammps/src", str(headers)).replace("build-plugin", str(tmp_path / "plugin"))
+    subprocess.run(["bash", "-c", command], check=True, cwd=REPO, capture_output=True)
+    plugin = tmp_path / "plugin" / "sedimentplugin.so"
+    assert plugin.is_file() and not list((tmp_path / "plugin").glob("lmp_sediment"))
+    assert "lammps" not in subprocess.run(["ldd", plugin], capture_output=True, text=True, check=True).stdout
+    refused = subprocess.run(["cmake", "-S", REPO, "-B", tmp_path / "lib", f"-DLAMMPS_SOURCE_DIR={headers}",
+                              "-DLAMMPS_LIBRARY=/nowhere/liblammps.so"], capture_output=True, text=True)
+    assert refused.returncode != 0 and "LAMMPS_LIBRARY=/nowhere/liblammps.so does not exist" in refused.stderr
