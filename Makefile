@@ -72,6 +72,10 @@ test-lammps-current: build
 	$(PYTHON) $(CURRENT)/lammps/doc/utils/check-styles.py > $(CURRENT)/check-styles.txt
 	@! grep -E "missing|incomplete" $(CURRENT)/check-styles.txt
 	@echo "check-styles: $$(grep 'Total number' $(CURRENT)/check-styles.txt)"
+	@# and the package in LAMMPS's package lists
+	$(PYTHON) $(CURRENT)/lammps/doc/utils/check-packages.py > $(CURRENT)/check-packages.txt
+	@! grep -E "missing" $(CURRENT)/check-packages.txt
+	@echo "check-packages: $$(head -1 $(CURRENT)/check-packages.txt), none missing"
 
 test: test-cpp test-python check-sanitize test-lammps-current
 

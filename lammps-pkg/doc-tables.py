@@ -1,8 +1,10 @@
 #!/usr/bin/env python3
 # SPDX-License-Identifier: GPL-2.0-or-later
 """Lists the SEDIMENT styles in a LAMMPS tree's command tables (doc/src/Commands_*.rst, fix.rst,
-compute.rst, pair_style.rst), in alphabetical place, so that doc/utils/check-styles.py finds them:
-    lammps-pkg/doc-tables.py LAMMPS/doc/src
+compute.rst, pair_style.rst) and the package in its package lists (Packages.rst or
+Packages_list.rst, Packages_details.rst), in alphabetical place, so that doc/utils/check-styles.py
+and check-packages.py find them; --check only checks that every place exists:
+    lammps-pkg/doc-tables.py [--check] LAMMPS/doc/src
 The styles and their one-line descriptions are read from lammps-pkg/SEDIMENT/sediment_styles.cpp,
 the doc page of each from its name (fix_fluid_drag.rst for fix fluid/drag). Idempotent."""
 from __future__ import annotations
@@ -33,14 +35,18 @@ def styles() -> list[tuple[str, str, str, str]]:
     return found
 
 
-def insert(path: Path, name: str, page: str, suffix: str) -> None:
-    """Adds ':doc:`name <page>`' + suffix to the alphabetical list of `path`, unless it is there."""
-    lines = path.read_text().splitlines(keepends=True)
+class Missing(Exception):
+    """A LAMMPS doc file lacks what SEDIMENT's entry is placed by."""
+
+
+def insert(text: str, path: Path, name: str, page: str, suffix: str) -> str:
+    """`text` with ':doc:`name <page>`' + suffix in its alphabetical list, unless it is there."""
+    lines = text.splitlines(keepends=True)
     if any(f":doc:`{name} <{page}>`" in line for line in lines):
-        return
+        return text
     entries = [(k, m) for k, m in ((k, ENTRY.match(line)) for k, line in enumerate(lines)) if m]
     if not entries:
-        sys.exit(f"doc-tables.py: {path} has no :doc: list")
+        raise Missing(f"{path} has no :doc: list")
     # The list the style belongs to: the longest run of consecutive entries (the tables also hold
     # short lists of general commands before the styles).
     runs: list[list] = []
@@ -53,17 +59,102 @@ def insert(path: Path, name: str, page: str, suffix: str) -> None:
     after = next((k for k, m in run if m.group(2) > name), run[-1][0] + 1)
     indent = run[0][1].group(1)
     lines.insert(after, f"{indent}:doc:`{name} <{page}>`{suffix}\n")
-    path.write_text("".join(lines))
+    return "".join(lines)
+
+
+# The package's entries in the package lists that LAMMPS's doc/utils/check-packages.py reads: a row of
+# the table in Packages.rst (Packages_list.rst before 2023), a line of the list in Packages_details.rst
+# and its section there, each in alphabetical place.
+PACKAGE = "SEDIMENT"
+ROW = f"""   * - :ref:`{PACKAGE} <PKG-{PACKAGE}>`
+     - fluid forces for settling spheres
+     - :doc:`fix fluid <fix_fluid>`
+     - ``PACKAGES/sediment``
+     - sys
+"""
+SECTION = f""".. _PKG-{PACKAGE}:
+
+{PACKAGE} package
+{"-" * (len(PACKAGE) + 8)}
+
+**Contents:**
+
+Fluid forces for finite-size spheres settling in a fluid, without CFD coupling: buoyancy with partial
+submergence at a free surface, Newtonian and Bingham-plastic drag laws with hindered settling,
+squeeze-film lubrication, a drag-implicit sphere integrator, a concentration grid and its layer
+profiles written to HDF5.
+
+**Install:**
+
+Needs the HDF5 library, which CMake finds on the system.
+
+**Supporting info:**
+
+* ``src/{PACKAGE}``: filenames -> commands
+* :doc:`fix fluid <fix_fluid>`
+* :doc:`fix fluid/drag <fix_fluid_drag>`
+* :doc:`fix nve/sphere/fluid <fix_nve_sphere_fluid>`
+* :doc:`compute concentration/grid <compute_concentration_grid>`
+* ``examples/PACKAGES/sediment``
+
+----------
+
+"""
+
+
+def before_first_after(text: str, path: Path, pattern: str, entry: str) -> str:
+    """`text` with `entry` inserted before the first line matching `pattern` (whose group 1 is a
+    package name) that sorts after SEDIMENT, unless `entry`'s first line is there."""
+    if entry.splitlines()[0] in text.splitlines():
+        return text
+    lines = text.splitlines(keepends=True)
+    names = [(k, m.group(1)) for k, m in ((k, re.match(pattern, line)) for k, line in enumerate(lines)) if m]
+    if not names:
+        raise Missing(f"{path} has no entry like {pattern!r}")
+    after = next((k for k, name in names if name > PACKAGE), None)
+    if after is None:
+        raise Missing(f"{path}: no package after {PACKAGE} to place it before")
+    lines.insert(after, entry)
+    return "".join(lines)
+
+
+def package_lists(doc: Path) -> dict[Path, str]:
+    """The package lists' new texts."""
+    listing = next((doc / n for n in ("Packages.rst", "Packages_list.rst")
+                    if (doc / n).is_file() and ":ref:`GRANULAR <PKG-GRANULAR>`" in (doc / n).read_text()), None)
+    if listing is None:
+        raise Missing(f"{doc} has no package table (Packages.rst or Packages_list.rst)")
+    details = doc / "Packages_details.rst"
+    if not details.is_file():
+        raise Missing(f"{details} does not exist")
+    text = details.read_text()
+    text = before_first_after(text, details, r"^   \* :ref:`([A-Z0-9-]+) <PKG-", f"   * :ref:`{PACKAGE} <PKG-{PACKAGE}>`\n")
+    text = before_first_after(text, details, r"^\.\. _PKG-([A-Z0-9-]+):", SECTION)
+    return {listing: before_first_after(listing.read_text(), listing, r"^   \* - :ref:`([A-Z0-9-]+) <PKG-", ROW),
+            details: text}
 
 
 def main() -> None:
-    if len(sys.argv) != 2 or not Path(sys.argv[1]).is_dir():
-        sys.exit("usage: doc-tables.py LAMMPS/doc/src")
-    doc = Path(sys.argv[1])
-    for kind, name, page, info in styles():
-        table, listing = KINDS[kind]
-        insert(doc / table, name, page, "")
-        insert(doc / listing, name, page, f" - {info}")
+    check = "--check" in sys.argv[1:]
+    folders = [a for a in sys.argv[1:] if a != "--check"]
+    if len(folders) != 1 or not Path(folders[0]).is_dir():
+        sys.exit("usage: doc-tables.py [--check] LAMMPS/doc/src")
+    doc = Path(folders[0])
+    # Every new text is made before any file is written: a tree whose docs lack an anchor is left as it was.
+    try:
+        texts = package_lists(doc)
+        for kind, name, page, info in styles():
+            for table, suffix in zip(KINDS[kind], ("", f" - {info}")):
+                path = doc / table
+                if not path.is_file():
+                    raise Missing(f"{path} does not exist")
+                texts[path] = insert(texts.get(path, path.read_text()), path, name, page, suffix)
+    except Missing as exc:
+        sys.exit(f"doc-tables.py: {exc}")
+    if not check:
+        for path, text in texts.items():
+            if path.read_text() != text:
+                path.write_text(text)
 
 
 if __name__ == "__main__":

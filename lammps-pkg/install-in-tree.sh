@@ -7,13 +7,28 @@
 # Copies the styles and the physics core to src/SEDIMENT, the CMake module to
 # cmake/Modules/Packages/SEDIMENT.cmake, the doc pages to doc/src and the examples to
 # examples/PACKAGES/sediment, and adds SEDIMENT to the package lists of cmake/CMakeLists.txt and to
-# the doc's command tables. Running it again refreshes the files and changes nothing else.
+# the doc's command tables and package lists. It checks every place first and changes nothing if one
+# is missing. Running it again refreshes the files and changes nothing else. Tested on the LAMMPS
+# of Debian 12's source package (6 Jan 2022) and of Debian sid's (4 Jul 2026).
 set -eu
 here=$(dirname "$(readlink -f "$0")")
 repo=$(dirname "$here")
 lammps=${1:?usage: install-in-tree.sh LAMMPS_DIR (with src/ and cmake/)}
 [ -f "$lammps/src/lammps.h" ] && [ -f "$lammps/cmake/CMakeLists.txt" ] ||
     { echo "install-in-tree.sh: $lammps is not a LAMMPS source tree (no src/lammps.h, cmake/CMakeLists.txt)" >&2; exit 2; }
+
+cmakelists="$lammps/cmake/CMakeLists.txt"
+fail() { echo "install-in-tree.sh: $*; nothing was changed" >&2; exit 1; }
+
+# Checks first: the tree is changed only if every place the package goes into exists.
+[ -d "$lammps/cmake/Modules/Packages" ] || fail "no cmake/Modules/Packages in $lammps"
+grep -q '^  SEDIMENT$' "$cmakelists" || grep -q '^  GRANULAR$' "$cmakelists" ||
+    fail "no GRANULAR in $cmakelists's package list to place SEDIMENT beside"
+grep -q '^foreach(PKG_WITH_INCL ' "$cmakelists" ||
+    fail "no 'foreach(PKG_WITH_INCL' list in $cmakelists for the packages with a CMake module"
+if [ -d "$lammps/doc/src" ]; then
+    "$repo/lammps-pkg/doc-tables.py" --check "$lammps/doc/src" || fail "the doc pages do not have the lists above"
+fi
 
 pkg="$lammps/src/SEDIMENT"
 rm -rf "$pkg"
@@ -27,19 +42,14 @@ for f in "$repo"/core/src/*.cpp; do cp "$f" "$pkg/sediment_core_$(basename "$f")
 cp "$repo"/core/include/sediment/*.hpp "$pkg/sediment/"
 cp "$here/cmake/SEDIMENT.cmake" "$lammps/cmake/Modules/Packages/SEDIMENT.cmake"
 
-# Package lists of the CMake build: the standard packages, and those with a Packages/*.cmake.
-cmakelists="$lammps/cmake/CMakeLists.txt"
-grep -q '^  SEDIMENT$' "$cmakelists" || {
-    grep -q '^  GRANULAR$' "$cmakelists" || { echo "install-in-tree.sh: no GRANULAR in $cmakelists's package list" >&2; exit 1; }
-    sed -i 's/^  GRANULAR$/  GRANULAR\n  SEDIMENT/' "$cmakelists"
-}
-grep -q '^foreach(PKG_WITH_INCL SEDIMENT ' "$cmakelists" || {
-    grep -q '^foreach(PKG_WITH_INCL GRAPHICS ' "$cmakelists" ||
-        { echo "install-in-tree.sh: cannot find the PKG_WITH_INCL list in $cmakelists" >&2; exit 1; }
-    sed -i 's/^foreach(PKG_WITH_INCL GRAPHICS /foreach(PKG_WITH_INCL SEDIMENT GRAPHICS /' "$cmakelists"
-}
+# Package lists of the CMake build: the standard packages, and the first list of those with a
+# Packages/*.cmake (it starts with GRAPHICS on recent releases, KSPACE on 2022's).
+grep -q '^  SEDIMENT$' "$cmakelists" || sed -i 's/^  GRANULAR$/  GRANULAR\n  SEDIMENT/' "$cmakelists"
+grep -q '^foreach(PKG_WITH_INCL SEDIMENT ' "$cmakelists" ||
+    sed -i '0,/^foreach(PKG_WITH_INCL /s//foreach(PKG_WITH_INCL SEDIMENT /' "$cmakelists"
 
-# Doc pages and the command tables (doc/utils/check-styles.py looks for every style there).
+# Doc pages, the command tables and the package lists (doc/utils/check-styles.py and
+# check-packages.py look for every style and package there).
 if [ -d "$lammps/doc/src" ]; then
     cp "$here"/SEDIMENT/doc/*.rst "$lammps/doc/src/"
     "$repo/lammps-pkg/doc-tables.py" "$lammps/doc/src"

@@ -56,3 +56,40 @@ def test_the_plugin_builds_alone_against_the_headers(tmp_path):
     refused = subprocess.run(["cmake", "-S", REPO, "-B", tmp_path / "lib", f"-DLAMMPS_SOURCE_DIR={headers}",
                               "-DLAMMPS_LIBRARY=/nowhere/liblammps.so"], capture_output=True, text=True)
     assert refused.returncode != 0 and "LAMMPS_LIBRARY=/nowhere/liblammps.so does not exist" in refused.stderr
+
+
+def test_the_in_tree_install_on_debian_12s_lammps_checks_first_and_lists_the_package(tmp_path):
+    """install-in-tree.sh on the LAMMPS source that `make build` fetched (Debian 12's, 6 Jan 2022):
+    LAMMPS's own check-packages.py and check-styles.py find the package and every style; a second
+    run changes nothing; a tree that lacks a place changes in nothing."""
+    import tarfile
+
+    tarball = next((REPO / "build" / "lammps-source-bookworm").glob("lammps_*.orig.tar.*"))
+    with tarfile.open(tarball) as archive:
+        members = [m for m in archive.getmembers() if "/cmake/" in m.name or "/doc/" in m.name
+                   or m.name.endswith("/src/lammps.h") or m.name.endswith("/src/GRANULAR/fix_wall_gran.h")]
+        archive.extractall(tmp_path, members)
+    tree = next(tmp_path.iterdir())
+    install = REPO / "lammps-pkg" / "install-in-tree.sh"
+    subprocess.run([install, tree], check=True, capture_output=True)
+
+    def check(script: str) -> str:
+        return subprocess.run(["/usr/bin/python3", tree / "doc" / "utils" / script, "-s", tree / "src", "-d",
+                               tree / "doc" / "src"], capture_output=True, text=True, check=True).stdout
+    assert "missing" not in check("check-packages.py") and "Found 2 packages" in check("check-packages.py")
+    styles = check("check-styles.py")
+    assert "missing" not in styles.lower() and "incomplete" not in styles.lower()
+
+    def files(root: Path) -> dict[str, bytes]:
+        return {str(p.relative_to(root)): p.read_bytes() for p in sorted(root.rglob("*")) if p.is_file()}
+    before = files(tree)
+    subprocess.run([install, tree], check=True, capture_output=True)
+    assert files(tree) == before
+    broken = tmp_path / "broken"
+    shutil.copytree(tree, broken)
+    shutil.rmtree(broken / "src" / "SEDIMENT")
+    (broken / "doc" / "src" / "Packages_details.rst").unlink()
+    before = files(broken)
+    refused = subprocess.run([install, broken], capture_output=True, text=True)
+    assert refused.returncode == 1 and "nothing was changed" in refused.stderr and "Packages_details.rst" in refused.stderr
+    assert files(broken) == before
