@@ -40,6 +40,17 @@ def test_pip_install_gives_the_package_and_the_command(tmp_path):
         assert done.returncode == 0, done.stderr
     assert (tmp_path / "s" / "readout" / "granulometry.png").is_file()
     assert list((venv / "lib").glob("python3*/site-packages/sediment/py.typed"))
+    # the notebook in Jupyter with the installed package: a kernel of the venv, as a user would add it
+    subprocess.run([venv / "bin" / "python", "-m", "ipykernel", "install", "--prefix", venv, "--name", "sediment-venv"],
+                   check=True, capture_output=True)
+    notebook = REPO / "notebooks" / "sedimentation_test.ipynb"
+    runner = ("import sys, nbformat; from nbclient import NotebookClient; nb = nbformat.read(sys.argv[1], 4); "
+              "NotebookClient(nb, timeout=300, kernel_name='sediment-venv', resources={'metadata': {'path': sys.argv[2]}})"
+              ".execute(); print(''.join(o.get('text', '') for c in nb.cells for o in c.get('outputs', [])))")
+    done = subprocess.run([venv / "bin" / "python", "-c", runner, notebook, notebook.parent], capture_output=True,
+                          text=True, env=dict(env, SEDIMENT_NOTEBOOK_OUT=str(tmp_path / "nb")))
+    assert done.returncode == 0, done.stderr[-2000:]
+    assert f"from {venv}" in done.stdout and "sediment 0.1.0" in done.stdout
 
 
 def test_the_plugin_builds_alone_against_the_headers(tmp_path):
