@@ -2,7 +2,8 @@
 # SEDIMENT: the two commands of the README, and their steps.
 #   make demo   installs what is missing, builds, runs the main example and says where its output is
 #   make test   installs what is missing, builds, runs every test (also under the sanitizers, and the
-#               deck tests on the current LAMMPS release)
+#               deck tests on the current LAMMPS release, and the documentation site)
+#   make docs   the documentation site in build/docs (Sphinx, warnings as errors)
 BUILD   ?= build
 PYTHON  := /usr/bin/python3
 JOBS    ?= 2
@@ -11,7 +12,7 @@ export OMPI_ALLOW_RUN_AS_ROOT := 1
 export OMPI_ALLOW_RUN_AS_ROOT_CONFIRM := 1
 export OMP_NUM_THREADS := 1
 
-.PHONY: deps build demo test test-cpp test-python check-sanitize test-lammps-current bench clean
+.PHONY: deps build demo docs test test-cpp test-python check-sanitize test-lammps-current bench clean
 
 deps:
 	@scripts/install-deps.sh
@@ -77,7 +78,14 @@ test-lammps-current: build
 	@! grep -E "missing" $(CURRENT)/check-packages.txt
 	@echo "check-packages: $$(head -1 $(CURRENT)/check-packages.txt), none missing"
 
-test: test-cpp test-python check-sanitize test-lammps-current
+# The documentation site (Sphinx from Debian's packages, warnings as errors): the README and docs/,
+# the style pages, the notebook as a tutorial and the Python API from its docstrings.
+docs: build
+	$(PYTHON) scripts/docs-stage.py $(BUILD)/docs-src
+	SEDIMENT_PYTHON=$(abspath python) $(PYTHON) -m sphinx -W --keep-going -q -b html $(BUILD)/docs-src $(BUILD)/docs
+	@echo "docs: $(BUILD)/docs/index.html"
+
+test: test-cpp test-python docs check-sanitize test-lammps-current
 
 # Cost of each effect per particle-step, as ratios measured in one run, then the core's per-atom
 # kernels (grid deposit and interpolation, Di Felice curve, phi functions; not part of make test).
