@@ -104,3 +104,21 @@ def test_the_in_tree_install_on_debian_12s_lammps_checks_first_and_lists_the_pac
     refused = subprocess.run([install, broken], capture_output=True, text=True)
     assert refused.returncode == 1 and "nothing was changed" in refused.stderr and "Packages_details.rst" in refused.stderr
     assert files(broken) == before
+
+
+def test_the_example_readme_commands_run_in_sequence(tmp_path):
+    """lammps-pkg/examples/README's serial and 2-rank commands, one after the other in one folder
+    (lmp_sediment standing for an lmp built with the package)."""
+    lmp = os.environ["SEDIMENT_LMP"]
+    shutil.copy(REPO / "lammps-pkg" / "examples" / "in.settling", tmp_path)
+    commands = [line.split("(")[0].split() for line in (REPO / "lammps-pkg" / "examples" / "README").read_text().splitlines()
+                if line.strip().startswith(("lmp ", "mpirun "))]
+    assert len(commands) == 2
+    env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
+    for words in commands:
+        words = [lmp if w == "lmp" else w for w in words]
+        if words[0] == "mpirun":
+            words[1:1] = ["--oversubscribe"]
+        done = subprocess.run(words + ["-log", "none"], cwd=tmp_path, capture_output=True, text=True, env=env)
+        assert done.returncode == 0 and "ERROR" not in done.stdout, done.stdout[-800:]
+    assert (tmp_path / "layers.h5").is_file() and (tmp_path / "layers.np2.h5").is_file()
