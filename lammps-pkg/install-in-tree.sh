@@ -9,7 +9,8 @@
 # examples/PACKAGES/sediment, and adds SEDIMENT to the package lists of cmake/CMakeLists.txt and to
 # the doc's command tables and package lists. It checks every place first and changes nothing if one
 # is missing. Running it again refreshes the files and changes nothing else. Tested on the LAMMPS
-# of Debian 12's source package (6 Jan 2022) and of Debian sid's (4 Jul 2026).
+# of Debian 12's source package (6 Jan 2022, by make test), of Debian 13's (4 Feb 2025, the lists
+# and LAMMPS's check-packages.py by hand) and of Debian sid's (4 Jul 2026, built and every deck run).
 set -eu
 here=$(dirname "$(readlink -f "$0")")
 repo=$(dirname "$here")
