@@ -57,13 +57,13 @@ SCENES = {"plain": "nve/sphere + gravity (reference)",
           "lubricated": "as drag + pair lubricate/fluid"}
 
 
-def loop_time(scene: str, particles: int, steps: int, lmp: Path | None = None) -> float:
+def loop_time(scene: str, particles: int, steps: int, lmp: Path | None = None, dt: float = 1e-4) -> float:
     """Loop time of the scene, with `lmp` instead of the lmp_sediment in use when given."""
     previous = os.environ.get("SEDIMENT_LMP")
     if lmp is not None:
         os.environ["SEDIMENT_LMP"] = str(lmp)
     try:
-        return run_batch(HERE / "in.cost", {"scene": scene, "n": particles, "steps": steps}).loops[0][0]
+        return run_batch(HERE / "in.cost", {"scene": scene, "n": particles, "steps": steps, "dt": dt}).loops[0][0]
     finally:
         if previous is None:
             os.environ.pop("SEDIMENT_LMP", None)
@@ -187,11 +187,18 @@ def main() -> None:
                         help="comma-separated scenes to run (default: all; plain and peer always run, the ratios need them)")
     parser.add_argument("--counts", action="store_true",
                         help="instructions and cache misses under cachegrind instead of the clock (see above)")
+    parser.add_argument("--dt", type=float, default=1e-4,
+                        help="time step of the scenes [s] (default 1e-4: dt/tau = 0.76 for their 30 um grains)")
+    parser.add_argument("--sweep", action="store_true",
+                        help="the cost at every dt/tau from 1e-4 to 1e4 against the peer at each (see sweep())")
     args = parser.parse_args()
     args.steps_given = args.steps is not None
     scenes = {s: SCENES[s] for s in SCENES if s in args.scenes or s in ("plain", "peer")}
     if args.counts:
         report_counts(scenes, args)
+        return
+    if args.sweep:
+        sweep([s for s in args.scenes if s in SWEPT] or list(SWEPT), args.particles, args.steps or 1000, args.repeats)
         return
     args.steps = args.steps or 2000
     rounds: list[dict[str, float]] = []
@@ -200,15 +207,16 @@ def main() -> None:
     for _ in range(args.repeats):
         rounds.append({})
         for s in scenes:
-            mine = loop_time(s, args.particles, args.steps)
+            mine = loop_time(s, args.particles, args.steps, dt=args.dt)
             rounds[-1][s] = mine
             if args.baseline:
-                theirs = loop_time(s, args.particles, args.steps, args.baseline)
+                theirs = loop_time(s, args.particles, args.steps, args.baseline, dt=args.dt)
                 baseline[s] = min(baseline[s], theirs)
                 pair_ratios[s].append(mine / theirs)
     times = {s: min(r[s] for r in rounds) for s in scenes}
     per = {s: t / (args.particles * args.steps) * 1e9 for s, t in times.items()}
-    print(f"{args.particles} particles x {args.steps} steps, best of {args.repeats}, 1 rank")
+    print(f"{args.particles} particles x {args.steps} steps at dt {args.dt:g} s (dt/tau {args.dt / TAU:.3g}), best of "
+          f"{args.repeats}, 1 rank")
     against = f" {'baseline ns':>12s} {'this/baseline':>14s} {'median of pairs':>16s}" if args.baseline else ""
     print(f"{'scene':10s} {'ns/particle-step':>17s} {'ratio to plain':>15s}{against}  what")
     for s, what in scenes.items():
@@ -220,6 +228,36 @@ def main() -> None:
         print(f"baseline: {args.baseline}; the peer and plain scenes run the same code in both builds, so "
               "their ratios show this machine's noise")
     report_targets(times, rounds)
+
+
+# Relaxation time of the scene's grains (30 um quartz in water, Stokes): the step's regime is dt/tau.
+TAU = 2650 * 3e-5 ** 2 / (18 * 1.002e-3)
+SWEPT = ("drag", "nonlinear", "standard", "richardson", "hindered")
+RATIOS = (1e-4, 1e-3, 1e-2, 1e-1, 1.0, 10.0, 100.0, 1e3, 1e4)
+
+
+def sweep(scenes: list[str], particles: int, steps: int, repeats: int) -> None:
+    """The step's cost at each dt/tau against the peer's at the same dt (best of `repeats`, the scenes
+    of a ratio taking turns). Above dt/tau = 2 the explicit peer is unstable: there its cost at
+    dt/tau = 1 stands in, as its cost per particle-step does not depend on the step."""
+    peer_at_one = None
+    rows = []
+    for ratio in RATIOS:
+        dt = ratio * TAU
+        runs = (["peer"] if ratio <= 1 else []) + scenes
+        best = {s: min(loop_time(s, particles, steps, dt=dt) for _ in range(repeats)) for s in runs}
+        per = {s: t / (particles * steps) * 1e9 for s, t in best.items()}
+        if ratio == 1.0:
+            peer_at_one = per["peer"]
+        rows.append((ratio, per))
+    print(f"{particles} particles x {steps} steps, best of {repeats}, 1 rank; tau = {TAU:.3g} s; ratios to the peer "
+          "at the same dt (its cost at dt/tau = 1 above 2, where it is unstable)")
+    print(f"{'dt/tau':>8s} {'peer ns':>9s} " + " ".join(f"{s:>11s}" for s in scenes))
+    for ratio, per in rows:
+        peer = per.get("peer", peer_at_one)
+        mark = "" if "peer" in per else "*"
+        print(f"{ratio:8.0e} {peer:8.2f}{mark or ' '} " + " ".join(f"{per[s] / peer:10.2f}x" for s in scenes))
+    print("* the peer's cost at dt/tau = 1")
 
 
 def report_targets(times: dict[str, float], rounds: list[dict[str, float]]) -> None:

@@ -45,15 +45,17 @@ constexpr double decay_limit = 745.2;
 // (subnormal or zero) the vector exp falls back to the scalar exp, lane by lane, and its slow path.
 constexpr double normal_decay_limit = 708.0;
 
+// As many terms of the series as round-off needs at this |z| < 0.5 (the first one left out is below
+// 1e-19 of the sum): steps limited by contacts are far below the relaxation time, and z is tiny there.
+inline int series_terms(double z) { return std::abs(z) < 0x1p-10 ? 6 : std::abs(z) < 0.0625 ? 10 : 18; }
+
 }    // namespace
 
 Phi phis(double z)
 {
   if (z == 0.0) return {1.0, 1.0, 0.5};
   if (std::abs(z) < 0.5) {
-    // As many terms as round-off needs at this |z| (the first one left out is below 1e-19 of the
-    // sum): steps limited by contacts are far below the relaxation time, and z is tiny there.
-    const int terms = std::abs(z) < 0x1p-10 ? 6 : std::abs(z) < 0.0625 ? 10 : 18;
+    const int terms = series_terms(z);
     double p1 = series.phi1[terms - 1], p2 = series.phi2[terms - 1];
     for (int n = terms - 2; n >= 0; --n) {
       p1 = p1 * z + series.phi1[n];
@@ -66,29 +68,56 @@ Phi phis(double z)
 
 namespace {
 
-// Where phis_many's direct forms do not hold and phis() takes over: near zero (cancellation) and past
-// the normal range of e^-z (subnormal, or 0 beyond the decay limit). Both tests are evaluated, without
-// a branch, so that the loop finding any such rate vectorises.
-inline bool beyond_direct_forms(double z) { return (std::abs(z) < 0.5) | (z > normal_decay_limit); }
-
 // The body of phis_many, inlined into the block's step of each instruction set.
 [[gnu::always_inline]] inline void fill_phis(const double *z, double *decay, double *phi1, double *phi2, int n,
                                              BatchMath kind)
 {
   for (int k = 0; k < n; ++k) decay[k] = -std::min(z[k], normal_decay_limit);
   exp_many(decay, decay, n, kind);
-  // The direct forms for all (one vector loop), then phis() where they do not hold.
+  // The direct forms for all (one vector loop), then the series or phis() where they do not hold.
   for (int k = 0; k < n; ++k) {
     const double inverse = 1.0 / z[k];
     phi1[k] = (1.0 - decay[k]) * inverse;
     phi2[k] = (z[k] - 1.0 + decay[k]) * inverse * inverse;
   }
-  // Found first in one vector loop: a scalar test per rate cost more than the rest of this stage.
-  std::int64_t any_outside = 0;    // 64 bits, as a lane of doubles: a bool does not vectorise
-  for (int k = 0; k < n; ++k) any_outside |= beyond_direct_forms(z[k]);
-  if (!any_outside) return;
-  for (int k = 0; k < n; ++k)
-    if (beyond_direct_forms(z[k])) {
+  // Where the direct forms do not hold: near zero (cancellation: the series) and past the normal range
+  // of e^-z (subnormal, or 0 beyond the decay limit: phis()). Found first in one vector loop, each
+  // test without a branch: a scalar test per rate cost more than the rest of this stage.
+  std::int64_t any_small = 0, any_large = 0;    // 64 bits, as a lane of doubles: a bool does not vectorise
+  for (int k = 0; k < n; ++k) {
+    any_small |= std::abs(z[k]) < 0.5;
+    any_large |= z[k] > normal_decay_limit;
+  }
+  // The series where |z| < 0.5, for every rate at once (at dt/tau near 0.1 every sphere takes it, and
+  // phis() one by one was a third of the step): a vector loop over the rates per term. Each rate's
+  // Horner sum runs over all 18 terms with the coefficients past its own count at zero, so it stays
+  // exactly 0 until its count's last term and then is phis()'s sum, bit for bit.
+  constexpr int chunk = 64;
+  for (int start = 0; any_small && start < n; start += chunk) {
+    const int m = std::min(chunk, n - start);
+    const double *zc = z + start;
+    double terms[chunk], p1[chunk], p2[chunk];
+    for (int k = 0; k < m; ++k) {
+      terms[k] = series_terms(zc[k]);
+      p1[k] = p2[k] = 0.0;
+    }
+    for (int t = 17; t >= 0; --t) {
+      const double c1 = series.phi1[t], c2 = series.phi2[t], index = t;
+      for (int k = 0; k < m; ++k) {
+        const bool used = index < terms[k];
+        p1[k] = p1[k] * zc[k] + (used ? c1 : 0.0);
+        p2[k] = p2[k] * zc[k] + (used ? c2 : 0.0);
+      }
+    }
+    for (int k = 0; k < m; ++k) {
+      const bool small = std::abs(zc[k]) < 0.5;
+      decay[start + k] = small ? 1.0 - zc[k] * p1[k] : decay[start + k];
+      phi1[start + k] = small ? p1[k] : phi1[start + k];
+      phi2[start + k] = small ? p2[k] : phi2[start + k];
+    }
+  }
+  for (int k = 0; any_large && k < n; ++k)
+    if (z[k] > normal_decay_limit) {
       const Phi p = phis(z[k]);
       decay[k] = p.decay;
       phi1[k] = p.phi1;

@@ -111,7 +111,11 @@ TEST(BatchMath, AValueDoesNotDependOnItsPlaceOrOnTheOthersInTheBatch)
 TEST(BatchMath, PhisManyFollowPhisOnBothSidesOfTheSeriesAndTheUnderflow)
 {
   std::vector<double> z = uniform(-0.6, 4.0, 2000, 4);
-  for (double extra : {0.0, 0.5, 1e-12, 707.9, 708.0, 708.1, 745.0, 745.3, 5000.0, 1e-300}) z.push_back(extra);
+  for (double extra : {0.0, -0.0, 0.5, 1e-12, 707.9, 708.0, 708.1, 745.0, 745.3, 5000.0, 1e-300}) z.push_back(extra);
+  // every count of the series' terms, on both sides of its limits (6 below 2^-10, 10 below 1/16, 18)
+  for (double extra : {1e-5, -1e-5, 0x1p-10, std::nextafter(0x1p-10, 0.0), 0.03, 0.0625, std::nextafter(0.0625, 0.0),
+                       0.1, 0.3, std::nextafter(0.5, 0.0), -0.49})
+    z.push_back(extra);
   const size_t n = z.size();
   std::vector<double> decay(n), p1(n), p2(n);
   phis_many(z.data(), decay.data(), p1.data(), p2.data(), static_cast<int>(n));
@@ -123,7 +127,7 @@ TEST(BatchMath, PhisManyFollowPhisOnBothSidesOfTheSeriesAndTheUnderflow)
     EXPECT_NEAR(decay[k], one.decay, 1e-15 * one.decay + 1e-300);
     EXPECT_NEAR(p1[k], one.phi1, 1e-15 * one.phi1);
     EXPECT_NEAR(p2[k], one.phi2, 4e-15 * one.phi2);
-    if (std::abs(z[k]) < 0.5 || z[k] > 708.0) {    // the same code there
+    if (std::abs(z[k]) < 0.5 || z[k] > 708.0) {    // the same sums there (the series vectorised), bit for bit
       EXPECT_EQ(decay[k], one.decay);
       EXPECT_EQ(p1[k], one.phi1);
       EXPECT_EQ(p2[k], one.phi2);
