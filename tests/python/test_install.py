@@ -1,6 +1,7 @@
 # SPDX-License-Identifier: GPL-2.0-or-later
 """`pip install .` in a virtual environment: the package, its console script and a `_core` that
-links no LAMMPS (Debian's build backend; no network, so no build isolation)."""
+links no LAMMPS (Debian's build backend; no network, so no build isolation). The notebooks run with
+the installed package too (test_notebooks.py)."""
 import os
 import shutil
 import subprocess
@@ -9,18 +10,8 @@ from pathlib import Path
 REPO = Path(__file__).resolve().parents[2]
 
 
-def test_pip_install_gives_the_package_and_the_command(tmp_path):
-    source = tmp_path / "src"
-    source.mkdir()
-    for name in ("pyproject.toml", "setup.py", "README.md", "LICENSE"):
-        shutil.copy(REPO / name, source / name)
-    shutil.copytree(REPO / "core", source / "core")
-    shutil.copytree(REPO / "python", source / "python", ignore=shutil.ignore_patterns("_core*.so", "__pycache__"))
-    # the README's command, as written, in the source folder
-    command = next(line.strip() for line in (REPO / "README.md").read_text().splitlines()
-                   if "pip install" in line and line.strip().startswith("/usr/bin/python3 -m venv"))
-    subprocess.run(["bash", "-c", command], check=True, cwd=source, capture_output=True)
-    venv = source / ".venv"
+def test_pip_install_gives_the_package_and_the_command(installed, tmp_path):
+    venv = installed    # the README's command, as written (conftest.py)
     out = subprocess.run([venv / "bin" / "sediment", "terminal", "--diameter", "1e-4", "--particle-density", "2700",
                           "--fluid-density", "1000", "--viscosity", "1e-3"], capture_output=True, text=True,
                          check=True, cwd=tmp_path).stdout
@@ -40,17 +31,6 @@ def test_pip_install_gives_the_package_and_the_command(tmp_path):
         assert done.returncode == 0, done.stderr
     assert (tmp_path / "s" / "readout" / "granulometry.png").is_file()
     assert list((venv / "lib").glob("python3*/site-packages/sediment/py.typed"))
-    # the notebook in Jupyter with the installed package: a kernel of the venv, as a user would add it
-    subprocess.run([venv / "bin" / "python", "-m", "ipykernel", "install", "--prefix", venv, "--name", "sediment-venv"],
-                   check=True, capture_output=True)
-    notebook = REPO / "notebooks" / "sedimentation_test.ipynb"
-    runner = ("import sys, nbformat; from nbclient import NotebookClient; nb = nbformat.read(sys.argv[1], 4); "
-              "NotebookClient(nb, timeout=300, kernel_name='sediment-venv', resources={'metadata': {'path': sys.argv[2]}})"
-              ".execute(); print(''.join(o.get('text', '') for c in nb.cells for o in c.get('outputs', [])))")
-    done = subprocess.run([venv / "bin" / "python", "-c", runner, notebook, notebook.parent], capture_output=True,
-                          text=True, env=dict(env, SEDIMENT_NOTEBOOK_OUT=str(tmp_path / "nb")))
-    assert done.returncode == 0, done.stderr[-2000:]
-    assert f"from {venv}" in done.stdout and "sediment 0.1.0" in done.stdout
 
 
 def test_the_plugin_builds_alone_against_the_headers(tmp_path):
