@@ -122,7 +122,7 @@ void FixFluidBuoyancy::warn_of_bobbing()
   for (int i = 0; i < atom->nlocal; ++i) {
     if (!(atom->mask[i] & groupbit) || atom->radius[i] <= 0.0) continue;
     const double r = atom->radius[i];
-    const double density = atom->rmass[i] / (4.0 / 3.0 * M_PI * r * r * r);
+    const double density = atom->rmass[i] / sediment::sphere_volume(2.0 * r);
     if (density < rho) omega = std::max(omega, std::sqrt(3.0 * rho * g / (4.0 * density * r)));
   }
   double omega_all = 0.0;
@@ -130,7 +130,7 @@ void FixFluidBuoyancy::warn_of_bobbing()
   if (comm->me == 0 && omega_all * update->dt > 1.0)
     error->warning(FLERR, "Fix fluid/buoyancy: a sphere lighter than fluid {} floats at its surface and bobs with "
                    "period {:.4g}; the time step {:.4g} is too long for it (it would bounce, or rest off its level): "
-                   "use a time step up to {:.3g}", fluid_id, 2.0 * M_PI / omega_all, update->dt, 0.5 / omega_all);
+                   "use a time step up to {:.3g}", fluid_id, 2.0 * sediment::pi / omega_all, update->dt, 0.5 / omega_all);
 }
 
 void FixFluidBuoyancy::setup(int vflag)

@@ -169,16 +169,23 @@ bool file_exists(const std::string &name)
   return probe != nullptr;
 }
 
-long long frames_before(hid_t handle, LAMMPS_NS::bigint step)
+// A one-value-per-frame dataset (time or step) whole.
+template <typename T> std::vector<T> read_frames(hid_t handle, const char *name, hid_t type)
 {
-  Handle set(H5Dopen2(handle, "step", H5P_DEFAULT), H5Dclose, "dataset step");
+  Handle set(H5Dopen2(handle, name, H5P_DEFAULT), H5Dclose, std::string("dataset ") + name);
   Handle space(H5Dget_space(set), H5Sclose, "dataspace");
   hsize_t count = 0;
   H5Sget_simple_extent_dims(space, &count, nullptr);
-  std::vector<long long> steps(count);
-  if (count > 0) check(H5Dread(set, H5T_NATIVE_LLONG, H5S_ALL, H5S_ALL, H5P_DEFAULT, steps.data()), "step");
+  std::vector<T> values(count);
+  if (count > 0) check(H5Dread(set, type, H5S_ALL, H5S_ALL, H5P_DEFAULT, values.data()), name);
+  return values;
+}
+
+long long frames_before(hid_t handle, LAMMPS_NS::bigint step)
+{
+  const std::vector<long long> steps = read_frames<long long>(handle, "step", H5T_NATIVE_LLONG);
   long long kept = 0;
-  while (kept < static_cast<long long>(count) && steps[kept] < step) ++kept;
+  while (kept < static_cast<long long>(steps.size()) && steps[kept] < step) ++kept;
   return kept;
 }
 
@@ -527,21 +534,15 @@ std::string FixLayersHDF5::incomplete_reason(long long file_id) const
 {
   // The frames must follow each other every nevery steps (a gap means frames of two runs were
   // spliced, or lost) and, with end_time, reach it (a deck that stopped early is not the test).
-  Handle set(H5Dopen2(file_id, "step", H5P_DEFAULT), H5Dclose, "dataset step");
-  Handle space(H5Dget_space(set), H5Sclose, "dataspace");
-  hsize_t count = 0;
-  H5Sget_simple_extent_dims(space, &count, nullptr);
-  if (count == 0) return "no frames";
-  std::vector<long long> steps(count);
-  check(H5Dread(set, H5T_NATIVE_LLONG, H5S_ALL, H5S_ALL, H5P_DEFAULT, steps.data()), "step");
-  for (hsize_t k = 1; k < count; ++k)
+  const std::vector<long long> steps = read_frames<long long>(file_id, "step", H5T_NATIVE_LLONG);
+  if (steps.empty()) return "no frames";
+  for (size_t k = 1; k < steps.size(); ++k)
     if (steps[k] <= steps[k - 1] || steps[k] - steps[k - 1] > nevery)
       return fmt::format("the frames jump from step {} to step {} (frames of two runs, or frames lost)", steps[k - 1],
                          steps[k]);
   if (end_time > 0.0) {
-    Handle times(H5Dopen2(file_id, "time", H5P_DEFAULT), H5Dclose, "dataset time");
-    std::vector<double> time(count);
-    check(H5Dread(times, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, time.data()), "time");
+    const std::vector<double> time = read_frames<double>(file_id, "time", H5T_NATIVE_DOUBLE);
+    if (time.size() != steps.size()) return "the frames' times and steps differ in number";
     if (!(time.back() >= end_time * (1.0 - 1e-9)))
       return fmt::format("the frames end at time {:.6g}, before end_time {:.6g} (the input stopped early)",
                          time.back(), end_time);

@@ -99,6 +99,7 @@ def run(args: argparse.Namespace) -> int:
     from ..lab.psd import read_psd
     from ..sim.scene import describe, plan, write
 
+    psd = read_psd(args.psd)
     if args.plan is not None:
         from ..planner.scenes import decided_options
 
@@ -112,7 +113,6 @@ def run(args: argparse.Namespace) -> int:
                     t_end=args.t_end, mass=args.mass, particle_density=args.particle_density,
                     cylinder_area=cylinder.area, height=cylinder.height, temperature=args.temperature)
         differ = [f"{k} {planned[k]} (here {v})" for k, v in here.items() if k in planned and planned[k] != v]
-        psd = read_psd(args.psd)
         if "psd" not in planned:
             print(f"warning: {args.plan} does not record the PSD it was made for (a plan of an earlier version)")
         elif not _same_psd(planned["psd"], psd):
@@ -123,7 +123,7 @@ def run(args: argparse.Namespace) -> int:
         print(f"the plan's decision ({args.plan}): --drag {args.drag} --hindrance {args.hindrance} "
               f"--particles {args.particles} --courant {args.courant:g}")
 
-    scene = plan(read_psd(args.psd), geometry=args.geometry, cylinder=cylinder_of(args), mass=args.mass,
+    scene = plan(psd, geometry=args.geometry, cylinder=cylinder_of(args), mass=args.mass,
                  suspension=suspension_of(args), width=args.width,
                  classes=args.classes, particles=None if args.real_grains else args.particles,
                  effects=effects_of(args, args.contacts, args.lubrication),

@@ -68,10 +68,15 @@ def check_plan_folder(out: Path) -> None:
         names = sorted(p.name for p in out.iterdir())[:5]
         raise ValueError(f"{out} holds files sediment plan did not write ({', '.join(names)}): choose another --out")
     for folder in (out, out / "runs", out / "decision"):
-        results = sorted(p.name for p in folder.glob("*") if p.suffix == ".h5" or p.name.startswith("log.lammps"))
-        if results:
-            raise ValueError(f"{folder} holds the results of a run ({', '.join(results)}): move them or choose "
-                             "another --out")
+        _refuse_run_results(folder)
+
+
+def _refuse_run_results(folder: Path) -> None:
+    """Refuses a folder where a run has left its results beside a deck (a layer file or log)."""
+    results = sorted(p.name for p in folder.glob("*") if p.suffix == ".h5" or p.name.startswith("log.lammps"))
+    if results:
+        raise ValueError(f"{folder} holds the results of a run ({', '.join(results)}): move them or choose "
+                         "another --out")
 
 
 def prepare(folder: Path) -> Path:
@@ -82,10 +87,7 @@ def prepare(folder: Path) -> Path:
     if folder.exists() and any(folder.iterdir()):
         if not (folder / MARKER).is_file():
             raise ValueError(f"{folder} exists and was not written by sediment plan: choose another --out")
-        results = sorted(p.name for p in folder.iterdir() if p.suffix == ".h5" or p.name.startswith("log.lammps"))
-        if results:
-            raise ValueError(f"{folder} holds the results of a run ({', '.join(results)}): move them or choose "
-                             "another --out")
+        _refuse_run_results(folder)
         shutil.rmtree(folder)
     folder.mkdir(parents=True, exist_ok=True)
     (folder / MARKER).write_text("written by sediment plan; replaced whole by the next plan in this folder\n")

@@ -220,7 +220,7 @@ def _write_record(folder: Path, **record) -> None:
     write_text(folder / RECORD, json.dumps(record, indent=1) + "\n")
 
 
-def _resume_id(deck: Path, variables: dict[str, object]) -> str:
+def _resume_id(deck: Path, variables: dict[str, str]) -> str:
     """The identity of the interrupted run in the deck's folder, after checking that it can be resumed:
     it did not finish, it ran this deck, and what the deck reads has not changed since."""
     folder = deck.parent
@@ -234,9 +234,9 @@ def _resume_id(deck: Path, variables: dict[str, object]) -> str:
         raise ValueError(f"{deck.name} or a file it reads ({', '.join(p.name for p in input_files(deck)) or 'none'}) "
                          "changed since the interrupted run: its restart files are of other inputs; start the run "
                          "anew with --force")
-    if record.get("variables", {}) != {k: str(v) for k, v in variables.items()}:
-        raise ValueError(f"the interrupted run had the variables {record.get('variables')}, this one "
-                         f"{ {k: str(v) for k, v in variables.items()} }: resume it with the same --var options")
+    if record.get("variables", {}) != variables:
+        raise ValueError(f"the interrupted run had the variables {record.get('variables')}, this one {variables}: "
+                         "resume it with the same --var options")
     return record["run_id"]
 
 
@@ -376,27 +376,31 @@ def _run(deck: Path, ranks: int, variables: dict[str, str], progress: bool) -> R
     errors: list[str] = []
     tail: deque = deque(maxlen=5)
     bar = None
-    state = dict(total_steps=0, t_end=0.0, step=0, now=0.0)
+    total_steps, t_end, step, now = 0, 0.0, 0, 0.0
 
     def take(line: str) -> None:
-        nonlocal bar
+        nonlocal bar, total_steps, t_end, step, now
         tail.append(line.rstrip())
         words = line.split()
         if line.startswith("ERROR"):
             errors.append(line.strip())
         elif line.startswith("SEDIMENT plan") and len(words) >= 6:
-            state.update(total_steps=int(words[3]), t_end=float(words[5]))
+            total_steps, t_end = int(words[3]), float(words[5])
             if progress:
                 from tqdm import tqdm
-                bar = tqdm(total=state["t_end"], unit="s", desc="simulated", file=sys.stderr, dynamic_ncols=True,
+                bar = tqdm(total=t_end, unit="s", desc="simulated", file=sys.stderr, dynamic_ncols=True,
                            mininterval=0.5, bar_format="{desc}: {percentage:3.0f}%|{bar}| "
                                                        "{n:.4g}/{total:.4g} s [{elapsed}{postfix}]")
         elif len(words) >= 2 and words[0].isdigit() and _is_float(words[1]):
-            state.update(step=int(words[0]), now=float(words[1]))
-            if bar is not None and state["step"]:
-                left = (time.monotonic() - start) * (state["total_steps"] - state["step"]) / state["step"]
+            step, now = int(words[0]), float(words[1])
+            if bar is not None and step:
+                left = (time.monotonic() - start) * (total_steps - step) / step
                 bar.set_postfix_str(f"ETA {_clock(left)}", refresh=False)
-                bar.update(min(state["now"], state["t_end"]) - bar.n)
+                bar.update(min(now, t_end) - bar.n)
+
+    def keep_failed_log() -> None:
+        if partial_log.exists():
+            os.replace(partial_log, failed_log)
 
     proc = _start(cmd, env, folder, stdout=subprocess.PIPE, stderr=subprocess.STDOUT)
     try:
@@ -412,32 +416,28 @@ def _run(deck: Path, ranks: int, variables: dict[str, str], progress: bool) -> R
             print(f"({exc} as the run finished: its results are complete)", file=sys.stderr)
             code = 0
         else:
-            if partial_log.exists():
-                os.replace(partial_log, failed_log)
+            keep_failed_log()
             left = "no layer file"
             if layers is not None:
                 partial = layers.with_name(layers.name + ".partial")
                 left = f"its frames so far are in {partial.name}" if partial.exists() else "it wrote no frames"
-            raise RunInterrupted(f"{exc} at step {state['step']} of {state['total_steps'] or '?'} (t = "
-                                 f"{state['now']:.6g} s): every rank was stopped; {left}, an earlier result is "
-                                 "untouched; sediment run --resume continues it from its last restart file") from None
+            raise RunInterrupted(f"{exc} at step {step} of {total_steps or '?'} (t = {now:.6g} s): every rank was "
+                                 f"stopped; {left}, an earlier result is untouched; sediment run --resume continues "
+                                 "it from its last restart file") from None
     except BaseException:
-        if partial_log.exists():
-            os.replace(partial_log, failed_log)
+        keep_failed_log()
         raise
     finally:
         _release(proc)
         if bar is not None:
             bar.close()
     if code != 0 or errors:
-        if partial_log.exists():
-            os.replace(partial_log, failed_log)
+        keep_failed_log()
         message = errors[0] if errors else "\n".join(tail)
         raise RuntimeError(f"{deck.name} failed (exit {code}): {message} (see {failed_log})")
-    step, now = state["step"], state["now"]
-    if state["total_steps"] and step < state["total_steps"]:
-        os.replace(partial_log, failed_log)
-        raise RuntimeError(f"{deck.name} ended at step {step} of the {state['total_steps']} it announced (t = {now:.6g} s): "
+    if total_steps and step < total_steps:
+        keep_failed_log()
+        raise RuntimeError(f"{deck.name} ended at step {step} of the {total_steps} it announced (t = {now:.6g} s): "
                            f"the deck is cut short or stops early (see {failed_log})")
     os.replace(partial_log, log)
     return RunResult(deck, log, time.monotonic() - start, step, now)
