@@ -138,17 +138,17 @@ void Phis(benchmark::State &state) { phi_functions(state, false); }
 void PhisMany(benchmark::State &state) { phi_functions(state, true); }
 
 // The drag step of a nonlinear law (30 um quartz in water, slips around the terminal speed of
-// 0.74 mm/s, the step 1e-4 s): a block of one sphere at a time (nonlinear_step_initial), blocks of
+// 0.74 mm/s, the step 1e-4 s, or dt = 10^k tau with the argument k): a block of one sphere at a time (nonlinear_step_initial), blocks of
 // DragBlock::capacity (as fix nve/sphere/fluid steps them) on the fastest kind here, on AVX2 or on
 // SSE2 (the default build's 2-wide arithmetic and exponentials), or the step in pieces one sphere at
 // a time (set_valued_step_initial, which a law with a Cd jump or a yield stress took before blocks).
 enum class Stepping { OneByOne, Blocks, InPieces };
 void nonlinear_step(benchmark::State &state, sediment::DragLaw law, sediment::Fluid fluid, Stepping stepping,
-                    sediment::BatchMath kind = sediment::batch_math_kind())
+                    sediment::BatchMath kind = sediment::batch_math_kind(), double dt = 1e-4)
 {
   const sediment::DragModel model(law, fluid);
   const double diameter = 2 * radius, inverse_mass = 1.0 / (2650 * sediment::pi / 6 * diameter * diameter * diameter);
-  const double dt = 1e-4, flow[3] = {0.0, 0.0, 0.0};
+  const double flow[3] = {0.0, 0.0, 0.0};
   std::mt19937_64 random(5);
   std::uniform_real_distribution<double> slip(-1e-3, 1e-3), accel(-6.0, 0.0);
   std::vector<std::array<double, 3>> v(spheres), a(spheres), dx(spheres);
@@ -192,6 +192,14 @@ constexpr sediment::Fluid water{998.2, 1.002e-3, 0.0};
 constexpr sediment::Fluid bingham{998.2, 1.002e-3, 0.01};
 void SmoothStepOneByOne(benchmark::State &state) { nonlinear_step(state, sediment::DragLaw::Dallavalle, water, Stepping::OneByOne); }
 void SmoothStepBlocks(benchmark::State &state) { nonlinear_step(state, sediment::DragLaw::Dallavalle, water, Stepping::Blocks); }
+// The blocks at dt/tau = 10^k (tau = m / (3 pi mu d), 132 us): the regimes users run, from a bed's
+// contact-limited steps (k = -4) to the fine grains of a sedimentation test (k = 4).
+void SmoothStepBlocksAtRatio(benchmark::State &state)
+{
+  const double tau = 2650 * (2 * radius) * (2 * radius) / (18 * water.viscosity);
+  nonlinear_step(state, sediment::DragLaw::Dallavalle, water, Stepping::Blocks, sediment::batch_math_kind(),
+                 tau * std::pow(10.0, static_cast<double>(state.range(0))));
+}
 void SmoothStepBlocksAVX2(benchmark::State &state)
 {
   nonlinear_step(state, sediment::DragLaw::Dallavalle, water, Stepping::Blocks, sediment::BatchMath::AVX2);
@@ -224,6 +232,7 @@ BENCHMARK(Phis);
 BENCHMARK(PhisMany);
 BENCHMARK(SmoothStepOneByOne);
 BENCHMARK(SmoothStepBlocks);
+BENCHMARK(SmoothStepBlocksAtRatio)->DenseRange(-4, 4, 1);
 BENCHMARK(SmoothStepBlocksAVX2);
 BENCHMARK(SmoothStepBlocksSSE2);
 BENCHMARK(SchillerNaumannInPieces);

@@ -68,40 +68,61 @@ Phi phis(double z)
 
 namespace {
 
-// The body of phis_many, inlined into the block's step of each instruction set.
+// The body of phis_many, inlined into the block's step of each instruction set. Where the rates fall
+// sets the work: at dt/tau below about 0.1 every rate takes the series (no exponential is taken), and
+// beyond the normal range of e^-z (dt/tau above about 1e3) every rate's e^-z is 0.
 [[gnu::always_inline]] inline void fill_phis(const double *z, double *decay, double *phi1, double *phi2, int n,
                                              BatchMath kind)
 {
-  for (int k = 0; k < n; ++k) decay[k] = -std::min(z[k], normal_decay_limit);
-  exp_many(decay, decay, n, kind);
-  // The direct forms for all (one vector loop), then the series or phis() where they do not hold.
+  // Which forms the rates need, found first in one vector loop, each test without a branch (a scalar
+  // test per rate cost more than the rest of this stage): the series near zero (the direct forms
+  // lose digits to cancellation there), the direct forms with an exponential, or past the normal
+  // range of e^-z the direct forms with e^-z = 0, except in the narrow band where e^-z is subnormal.
+  std::int64_t any_small = 0, any_direct = 0, any_large = 0, any_subnormal = 0;    // 64 bits, as a lane of doubles
+  for (int k = 0; k < n; ++k) {
+    const bool small = std::abs(z[k]) < 0.5, large = z[k] > normal_decay_limit;
+    any_small |= small;
+    any_direct |= !small & !large;
+    any_large |= large;
+    any_subnormal |= large & (z[k] <= decay_limit);
+  }
+  if (any_direct) {
+    for (int k = 0; k < n; ++k) decay[k] = -std::min(z[k], normal_decay_limit);
+    exp_many(decay, decay, n, kind);
+    for (int k = 0; any_large && k < n; ++k) decay[k] = z[k] > normal_decay_limit ? 0.0 : decay[k];
+  } else {
+    std::fill(decay, decay + n, 0.0);
+  }
+  // The direct forms for all (one vector loop); the series and the subnormal band replace theirs below.
   for (int k = 0; k < n; ++k) {
     const double inverse = 1.0 / z[k];
     phi1[k] = (1.0 - decay[k]) * inverse;
     phi2[k] = (z[k] - 1.0 + decay[k]) * inverse * inverse;
   }
-  // Where the direct forms do not hold: near zero (cancellation: the series) and past the normal range
-  // of e^-z (subnormal, or 0 beyond the decay limit: phis()). Found first in one vector loop, each
-  // test without a branch: a scalar test per rate cost more than the rest of this stage.
-  std::int64_t any_small = 0, any_large = 0;    // 64 bits, as a lane of doubles: a bool does not vectorise
-  for (int k = 0; k < n; ++k) {
-    any_small |= std::abs(z[k]) < 0.5;
-    any_large |= z[k] > normal_decay_limit;
-  }
   // The series where |z| < 0.5, for every rate at once (at dt/tau near 0.1 every sphere takes it, and
-  // phis() one by one was a third of the step): a vector loop over the rates per term. Each rate's
-  // Horner sum runs over all 18 terms with the coefficients past its own count at zero, so it stays
-  // exactly 0 until its count's last term and then is phis()'s sum, bit for bit.
-  constexpr int chunk = 64;
+  // phis() one by one was a third of the step): a vector loop over the rates per term, from the most
+  // terms any rate needs. Each rate's Horner sum runs over those terms with the coefficients past its
+  // own count at zero, so it stays exactly 0 until its count's last term and then is phis()'s sum,
+  // bit for bit.
+  constexpr int chunk = 32;    // a block's rates, in registers
   for (int start = 0; any_small && start < n; start += chunk) {
     const int m = std::min(chunk, n - start);
     const double *zc = z + start;
     double terms[chunk], p1[chunk], p2[chunk];
+    std::int64_t any_ten = 0, any_eighteen = 0;    // the most terms a rate needs, from two vector tests
     for (int k = 0; k < m; ++k) {
-      terms[k] = series_terms(zc[k]);
-      p1[k] = p2[k] = 0.0;
+      const double size = std::abs(zc[k]);
+      terms[k] = size < 0.5 ? series_terms(zc[k]) : 0.0;
+      any_ten |= size >= 0x1p-10;
+      any_eighteen |= (size >= 0.0625) & (size < 0.5);
     }
-    for (int t = 17; t >= 0; --t) {
+    const int most = any_eighteen ? 18 : any_ten ? 10 : 6;
+    for (int k = 0; k < m; ++k) {    // the first term of the sum from zero: 0 z + c is c
+      const bool used = most - 1 < terms[k];
+      p1[k] = used ? series.phi1[most - 1] : 0.0;
+      p2[k] = used ? series.phi2[most - 1] : 0.0;
+    }
+    for (int t = most - 2; t >= 0; --t) {
       const double c1 = series.phi1[t], c2 = series.phi2[t], index = t;
       for (int k = 0; k < m; ++k) {
         const bool used = index < terms[k];
@@ -110,19 +131,16 @@ namespace {
       }
     }
     for (int k = 0; k < m; ++k) {
-      const bool small = std::abs(zc[k]) < 0.5;
+      const bool small = terms[k] > 0.0;
       decay[start + k] = small ? 1.0 - zc[k] * p1[k] : decay[start + k];
       phi1[start + k] = small ? p1[k] : phi1[start + k];
       phi2[start + k] = small ? p2[k] : phi2[start + k];
     }
   }
-  for (int k = 0; any_large && k < n; ++k)
-    if (z[k] > normal_decay_limit) {
-      const Phi p = phis(z[k]);
-      decay[k] = p.decay;
-      phi1[k] = p.phi1;
-      phi2[k] = p.phi2;
-    }
+  // e^-z subnormal: phis(), whose phi1 and phi2 equal the direct forms' with 0 (1 - e^-z rounds to 1
+  // and z - 1 + e^-z to z - 1 there), and whose decay is the subnormal e^-z.
+  for (int k = 0; any_subnormal && k < n; ++k)
+    if (z[k] > normal_decay_limit && z[k] <= decay_limit) decay[k] = phis(z[k]).decay;
 }
 
 }    // namespace

@@ -135,6 +135,31 @@ TEST(BatchMath, PhisManyFollowPhisOnBothSidesOfTheSeriesAndTheUnderflow)
   }
 }
 
+// A block's rates often all fall in one regime (every z tiny in a bed's short steps, every e^-z
+// underflowing in a sedimentation test's long ones), where phis_many skips the forms none needs.
+TEST(BatchMath, PhisManyOfOneRegimeFollowPhis)
+{
+  const std::vector<std::vector<double>> groups = {
+      {1e-5, -3e-4, 2e-6, 1e-12},                              // six terms
+      {1e-5, 0.03, -0.05, 0x1p-10},                            // six and ten
+      {0.3, -0.2, 1e-7, 0.49},                                 // up to eighteen
+      {800.0, 708.5, 745.0, 1e6, 5000.0},                      // e^-z subnormal or zero
+      {0.01, 900.0, 720.0},                                    // series and underflow, no direct form
+  };
+  for (const std::vector<double> &z : groups) {
+    const int n = static_cast<int>(z.size());
+    std::vector<double> decay(n), p1(n), p2(n);
+    phis_many(z.data(), decay.data(), p1.data(), p2.data(), n);
+    for (int k = 0; k < n; ++k) {
+      const Phi one = phis(z[k]);
+      SCOPED_TRACE(z[k]);
+      EXPECT_EQ(decay[k], one.decay);
+      EXPECT_EQ(p1[k], one.phi1);
+      EXPECT_EQ(p2[k], one.phi2);
+    }
+  }
+}
+
 TEST(BatchMath, DragCurvesFollowTheCurveOfEachSphere)
 {
   const Fluid water{998.2, 1.002e-3, 0.0};
