@@ -12,7 +12,7 @@ import pytest
 from sediment import _core, cli
 from sediment.lab.psd import discretise, read_psd
 from sediment.sim.run import run_batch
-from sediment.sim.scene import Cylinder, Effects, plan, terminal_speed, write
+from sediment.sim.scene import Cylinder, Effects, meeting_modulus, plan, terminal_speed, write
 
 PSDS = Path(__file__).resolve().parents[2] / "examples" / "granulometry" / "psd"
 
@@ -84,6 +84,31 @@ def test_the_deck_prints_where_the_time_goes_when_asked(tmp_path):
     timed = run_batch(tmp_path / "in.sedimentation", {"timing": "yes", "overwrite": "yes"})
     assert len(quiet.loops) == len(timed.loops) == stages > 1
     assert quiet.text.count("Modify  |") == 0 and timed.text.count("Modify  |") == stages
+
+
+def test_contacts_without_a_floor_hold_the_grains_meetings():
+    """In a triply periodic box grains meet only each other. Two sizes 1:3 settling in Stokes' regime
+    (speeds 1:9): the modulus is the larger of the head-on impact at the difference of their speeds and
+    the coarse grain riding on the fine one, both from Hertz's laws for the pair's reduced mass and
+    radius (E* = E / (2 (1 - nu^2)), overlap 1 % of the fine diameter)."""
+    from sediment.lab.readout import Suspension
+    f = Suspension()
+    d_s, v_s, nu, overlap = 20e-6, 1e-4, 0.3, 0.01
+    d, v = np.array([d_s, 3 * d_s]), np.array([v_s, 9 * v_s])
+    mass = f.particle_density * math.pi / 6 * d ** 3
+    reduced_mass, reduced_radius = mass[0] * mass[1] / mass.sum(), (d[0] / 2) * (d[1] / 2) / (d.sum() / 2)
+    delta = overlap * d_s
+    youngs = 2 * (1 - nu ** 2)
+    # head on: m* v^2 / 2 = (8/15) E* sqrt(R*) delta^(5/2) at the speed between them
+    impact = youngs * 15 * reduced_mass * (v[1] - v[0]) ** 2 / (16 * math.sqrt(reduced_radius) * delta ** 2.5)
+    # riding: the pair falls at 7 v_s (their Stokes drags carry both weights), the coarse one pressing with
+    # 27 W_s (1 - 7/9) = 6 W_s, F = (4/3) E* sqrt(R*) delta^(3/2)
+    weight = (f.particle_density - f.fluid_density) * f.gravity * math.pi / 6 * d_s ** 3
+    riding = youngs * 3 * 6 * weight / (4 * math.sqrt(reduced_radius) * delta ** 1.5)
+    assert meeting_modulus(f, d, v) == pytest.approx(max(impact, riding), rel=1e-9)
+    assert meeting_modulus(f, d[::-1], v[::-1]) == meeting_modulus(f, d, v)
+    # one size settling at one speed meets nothing head on and rides on nothing
+    assert meeting_modulus(f, d[:1], v[:1]) == 0.0
 
 
 def test_contacts_need_real_grains_and_set_the_step(tmp_path):

@@ -23,7 +23,7 @@ prediction, reported beside it.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Callable
 
@@ -114,6 +114,7 @@ def measure_contacts(test: SedimentationTest, setup: ReducedScene, folder: Path,
                  width=setup.width, classes=setup.classes, particles=None, seed=setup.seed,
                  effects=Effects("standard", contacts=True, lubrication=setup.lubrication, hindrance="none"),
                  t_end=1.0)
+    scene = replace(scene, floor=False)    # a triply periodic box: the contacts hold the grains' meetings only
     dt = scene.contact_time_step()
     slowest = float(terminal_speeds(s, np.array([scene.diameter.min()]))[0])
     steps = math.ceil(setup.fall * setup.height / slowest / dt)
@@ -198,7 +199,7 @@ def _deck(scene, dt: float, steps: int) -> str:
         "fix             weights all property/atom d_weight",
         "read_data       reduced.data fix weights NULL Weights",
         f"neighbor        {0.5 * d_max:.6g} bin",
-        f"comm_modify     vel yes cutoff {3 * d_max:.6g}",
+        "comm_modify     vel yes    # ghosts within the pair reach and the skin, as LAMMPS finds them",
         f"fix             grav all gravity {s.gravity:.12g} vector 0 0 -1",
         f"fix             water all fluid density {s.fluid_density:.12g} viscosity {s.viscosity:.12g}",
         "fix             buoy all fluid/buoyancy water",

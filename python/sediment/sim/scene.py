@@ -117,6 +117,9 @@ class Scene:
     # diameters [m] splitting the layers into size classes (the grid's `classes`): the layer file then
     # holds each class's fraction too, as the inverse model reads them
     tag_classes: tuple[float, ...] = ()
+    # whether grains land on a floor and build a deposit there (the test's column); False for a triply
+    # periodic box, where grains meet only each other (the reduced scene of --measure-contacts)
+    floor: bool = True
     diameter: np.ndarray = field(default_factory=lambda: np.empty(0))    # per atom [m]
     weight: np.ndarray = field(default_factory=lambda: np.empty(0))
     position: np.ndarray = field(default_factory=lambda: np.empty((0, 3)))
@@ -180,11 +183,18 @@ class Scene:
         return terminal_speed(self.suspension, self.classes.diameter[self.classes.count > 0].max(), self.effects.drag)
 
     def contact_modulus(self) -> float:
-        """Young's modulus of the grains' contacts [Pa]: `contact_modulus` for the fastest grain at its
-        terminal speed and the whole deposit's buoyant weight (docs/effects.md section 5). The largest
-        overlap is measured during the run (compute contact/overlap) and the run stops at twice the
-        tolerance."""
+        """Young's modulus of the grains' contacts [Pa]: with a floor, `contact_modulus` for the fastest
+        grain at its terminal speed and the whole deposit's buoyant weight (docs/effects.md section 5);
+        without one, `meeting_modulus` for the grains' meetings in suspension. The largest overlap is
+        measured during the run (compute contact/overlap) and the run stops at twice the tolerance."""
         f = self.suspension
+        if not self.floor:
+            present = self.classes.diameter[self.classes.count > 0]
+            modulus = meeting_modulus(f, present, np.array([terminal_speed(f, d, self.effects.drag) for d in present]))
+            if not modulus > 0:
+                raise ValueError(f"the grains of this box ({present.min() * 1e6:.4g} um) settle at one speed and never "
+                                 "meet: there are no contacts to resolve")
+            return modulus
         pressure = self.initial_concentration * self.height * (1 - f.fluid_density / f.particle_density) * f.gravity
         return contact_modulus(f.particle_density, self.largest_terminal_speed(), pressure)
 
@@ -224,6 +234,33 @@ def contact_modulus(particle_density: float, fastest_speed: float, deposit_press
                                              POISSON_RATIO)
     load = _core.hertz_modulus_for_load(LOAD_CONCENTRATION * deposit_pressure, OVERLAP_TOLERANCE, POISSON_RATIO)
     return max(impact, load)
+
+
+def meeting_modulus(suspension: Suspension, diameter: np.ndarray, speed: np.ndarray) -> float:
+    """Young's modulus [Pa] of the softest Hertz contact keeping the overlap within OVERLAP_TOLERANCE of
+    the smaller diameter where grains settling at their terminal speeds `speed` meet, with no floor and
+    no deposit (a triply periodic suspension), for every pair of sizes d_s and d_b = b d_s, b >= 1:
+    - head on at the difference of their speeds: as much, relative to d_s, as a grain landing on a
+      wall at that speed with its mass over the square root of its radius scaled by
+      b^3 / (1 + b^3) sqrt((1 + b) / b), the ratio for the pair's reduced mass and radius (0.71 for
+      equal grains, at most 1.11 near b = 3);
+    - the larger riding on the smaller, the two falling together at the speed where their drags carry
+      both weights (each drag taken linear in the speed, W v / v_t: exact in Stokes' regime), which
+      leaves the larger pressing with F = W_b (1 - v_c / v_b): as much as the smaller pressed on a wall
+      by F, with the pair's radius, sqrt((1 + b) / b) times stiffer."""
+    order = np.argsort(diameter)
+    d, v = np.asarray(diameter, float)[order], np.asarray(speed, float)[order]
+    small, large = np.triu_indices(len(d))
+    ratio = d[large] / d[small]
+    f = suspension
+    wall_per_speed2 = _core.hertz_modulus_for_overlap("wall", f.particle_density, 1.0, OVERLAP_TOLERANCE, POISSON_RATIO)
+    impact = wall_per_speed2 * (v[large] - v[small]) ** 2 * ratio ** 3 / (1 + ratio ** 3) * np.sqrt((1 + ratio) / ratio)
+    weight = (f.particle_density - f.fluid_density) * f.gravity * math.pi / 6 * d ** 3
+    together = (weight[large] + weight[small]) / (weight[large] / v[large] + weight[small] / v[small])
+    pressing = weight[large] * (1 - together / v[large])
+    wall_per_pressure = _core.hertz_modulus_for_load(1.0, OVERLAP_TOLERANCE, POISSON_RATIO)
+    riding = wall_per_pressure * pressing / d[small] ** 2 * np.sqrt((1 + ratio) / ratio)
+    return float(max(impact.max(), riding.max()))
 
 
 def terminal_speed(suspension: Suspension, diameter: float, law: str) -> float:
@@ -547,8 +584,8 @@ def _deck(scene: Scene, data: str, layer_file: str) -> str:
         f"neighbor        {d_max:.6g} bin",
         f"atom_modify     sort 1000 {scene.height / scene.layers:.6g}    # neighbours in memory, layer by layer",
     ]
-    if e.interacting:    # pair forces need ghosts within a contact or film reach
-        lines.append(f"comm_modify     cutoff {3 * d_max:.6g} vel yes")
+    if e.interacting:    # pair forces need ghosts within a contact or film reach and the skin, as LAMMPS finds them
+        lines.append("comm_modify     vel yes")
     else:                # no pair forces, no ghosts needed: a cutoff far below any grain copies none
         # (each ghost is sent to the next rank every step) and keeps LAMMPS from warning of a zero one
         lines.append(f"comm_modify     cutoff {1e-9 * min(scene.width, scene.thickness):.6g}")
