@@ -23,7 +23,7 @@ SPLITS = {"z": "LAMMPS's default split (along z, the tall axis)",
           "balance": "default split moved by fix balance (shift z) every 200 steps"}
 
 
-LAWS = ("standard", "dallavalle", "stokes", "schiller-naumann")
+LAWS = ("standard", "dallavalle", "stokes")    # one word each: the deck compares law with LAMMPS's if
 
 
 def law_list(text: str) -> list[str]:
