@@ -154,7 +154,9 @@ def test_5_the_planner_replaces_its_folder_whole_or_not_at_all(tmp_path):
     plan = subprocess.Popen(SEDIMENT + ["plan", str(SAMPLE1), "--out", str(out), "--particles", "2000,1000",
                                         "--courant", "4", "--t-end", "7200", "--replicas", "1", "--no-models"],
                             stderr=subprocess.PIPE, text=True)
-    wait_for(lambda: list(tmp_path.glob(".plan.new-*/runs/*/layers.h5.partial")))
+    # as soon as its first run has a folder (a run's layers.h5.partial lives a fraction of a second,
+    # between two looks when the machine is busy; the folder stays until the plan is swapped in)
+    wait_for(lambda: [run for run in tmp_path.glob(".plan.new-*/runs/*") if run.is_dir()])
     plan.send_signal(signal.SIGINT)
     plan.communicate(timeout=30)
     assert plan.returncode == 130
