@@ -109,6 +109,12 @@ def test_contacts_without_a_floor_hold_the_grains_meetings():
     assert meeting_modulus(f, d[::-1], v[::-1]) == meeting_modulus(f, d, v)
     # one size settling at one speed meets nothing head on and rides on nothing
     assert meeting_modulus(f, d[:1], v[:1]) == 0.0
+    # grains lighter than the fluid rise, the larger pushing the smaller up: riding as hard as grains as
+    # much heavier than the fluid (a plastic of 1200 kg/m3 against one of 796.4), head on by their own mass
+    heavy, light = Suspension(particle_density=1200.0), Suspension(particle_density=2 * f.fluid_density - 1200.0)
+    assert meeting_modulus(light, d, -v) == pytest.approx(
+        max(impact * light.particle_density / f.particle_density,
+            riding * (heavy.particle_density - f.fluid_density) / (f.particle_density - f.fluid_density)), rel=1e-9)
 
 
 def test_contacts_need_real_grains_and_set_the_step(tmp_path):
