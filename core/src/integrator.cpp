@@ -47,14 +47,19 @@ constexpr double normal_decay_limit = 708.0;
 
 // As many terms of the series as round-off needs at this |z| < 0.5 (the first one left out is below
 // 1e-19 of the sum): steps limited by contacts are far below the relaxation time, and z is tiny there.
-inline int series_terms(double z) { return std::abs(z) < 0x1p-10 ? 6 : std::abs(z) < 0.0625 ? 10 : 18; }
+// Below series_limit the series replaces the direct forms; six terms do below 2^-10, ten below 1/16.
+constexpr double series_limit = 0.5, six_terms_limit = 0x1p-10, ten_terms_limit = 0.0625;
+inline int series_terms(double z)
+{
+  return std::abs(z) < six_terms_limit ? 6 : std::abs(z) < ten_terms_limit ? 10 : 18;
+}
 
 }    // namespace
 
 Phi phis(double z)
 {
   if (z == 0.0) return {1.0, 1.0, 0.5};
-  if (std::abs(z) < 0.5) {
+  if (std::abs(z) < series_limit) {
     const int terms = series_terms(z);
     double p1 = series.phi1[terms - 1], p2 = series.phi2[terms - 1];
     for (int n = terms - 2; n >= 0; --n) {
@@ -80,7 +85,7 @@ namespace {
   // range of e^-z the direct forms with e^-z = 0, except in the narrow band where e^-z is subnormal.
   std::int64_t any_small = 0, any_direct = 0, any_large = 0, any_subnormal = 0;    // 64 bits, as a lane of doubles
   for (int k = 0; k < n; ++k) {
-    const bool small = std::abs(z[k]) < 0.5, large = z[k] > normal_decay_limit;
+    const bool small = std::abs(z[k]) < series_limit, large = z[k] > normal_decay_limit;
     any_small |= small;
     any_direct |= !small & !large;
     any_large |= large;
@@ -112,9 +117,9 @@ namespace {
     std::int64_t any_ten = 0, any_eighteen = 0;    // the most terms a rate needs, from two vector tests
     for (int k = 0; k < m; ++k) {
       const double size = std::abs(zc[k]);
-      terms[k] = size < 0.5 ? series_terms(zc[k]) : 0.0;
-      any_ten |= size >= 0x1p-10;
-      any_eighteen |= (size >= 0.0625) & (size < 0.5);
+      terms[k] = size < series_limit ? series_terms(zc[k]) : 0.0;
+      any_ten |= size >= six_terms_limit;
+      any_eighteen |= (size >= ten_terms_limit) & (size < series_limit);
     }
     const int most = any_eighteen ? 18 : any_ten ? 10 : 6;
     for (int k = 0; k < m; ++k) {    // the first term of the sum from zero: 0 z + c is c
