@@ -138,10 +138,11 @@ void Phis(benchmark::State &state) { phi_functions(state, false); }
 void PhisMany(benchmark::State &state) { phi_functions(state, true); }
 
 // The drag step of a nonlinear law (30 um quartz in water, slips around the terminal speed of
-// 0.74 mm/s, the step 1e-4 s, or dt = 10^k tau with the argument k): a block of one sphere at a time (nonlinear_step_initial), blocks of
-// DragBlock::capacity (as fix nve/sphere/fluid steps them) on the fastest kind here, on AVX2 or on
-// SSE2 (the default build's 2-wide arithmetic and exponentials), or the step in pieces one sphere at
-// a time (set_valued_step_initial, which a law with a Cd jump or a yield stress took before blocks).
+// 0.74 mm/s, the step 1e-4 s, or dt = 10^k tau with the argument k): a block of one sphere at a
+// time (nonlinear_step_initial), blocks of DragBlock::capacity (as fix nve/sphere/fluid steps them)
+// on the fastest kind here, on AVX2 or on SSE2 (the default build's 2-wide arithmetic and
+// exponentials), or the step in pieces one sphere at a time (set_valued_step_initial, which a law
+// with a Cd jump or a yield stress took before blocks).
 enum class Stepping { OneByOne, Blocks, InPieces };
 void nonlinear_step(benchmark::State &state, sediment::DragLaw law, sediment::Fluid fluid, Stepping stepping,
                     sediment::BatchMath kind = sediment::batch_math_kind(), double dt = 1e-4)
@@ -196,7 +197,7 @@ void SmoothStepBlocks(benchmark::State &state) { nonlinear_step(state, sediment:
 // contact-limited steps (k = -4) to the fine grains of a sedimentation test (k = 4).
 void SmoothStepBlocksAtRatio(benchmark::State &state)
 {
-  const double tau = 2650 * (2 * radius) * (2 * radius) / (18 * water.viscosity);
+  const double tau = sediment::relaxation_time(sediment::DragModel(sediment::DragLaw::Stokes, water), 2 * radius, 2650);
   nonlinear_step(state, sediment::DragLaw::Dallavalle, water, Stepping::Blocks, sediment::batch_math_kind(),
                  tau * std::pow(10.0, static_cast<double>(state.range(0))));
 }

@@ -37,6 +37,7 @@ from typing import Callable
 
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE.parent / "python"))
+from sediment import _core  # noqa: E402
 from sediment.cli.types import count  # noqa: E402
 from sediment.sim.paths import lmp_executable  # noqa: E402
 from sediment.sim.run import run_batch  # noqa: E402
@@ -193,9 +194,8 @@ def main() -> None:
                         help="the cost at every dt/tau from 1e-4 to 1e4 against the peer at each (see sweep())")
     args = parser.parse_args()
     args.steps_given = args.steps is not None
-    # The references run where they can: past dt/tau = 2 the peer's explicit drag is unstable and the plain
-    # scene's free fall crosses the box in a step (--sweep takes their cost at dt/tau = 1 there).
-    references = ("plain", "peer") if args.counts or args.sweep or args.dt <= 2 * TAU else ()
+    # The references run where they can (EXPLICIT_LIMIT; --sweep takes the peer's cost at dt/tau = 1 past it).
+    references = ("plain", "peer") if args.counts or args.sweep or args.dt <= EXPLICIT_LIMIT * TAU else ()
     scenes = {s: SCENES[s] for s in SCENES if s in args.scenes or s in references}
     if args.counts:
         report_counts(scenes, args)
@@ -229,7 +229,7 @@ def main() -> None:
         to_plain = f"{per[s] / per['plain']:15.2f}" if "plain" in per else f"{'-':>15s}"
         print(f"{s:10s} {per[s]:17.2f} {to_plain}{against}  {what}")
     if not references:
-        print(f"no plain or peer scene at dt/tau {args.dt / TAU:.3g} > 2 (explicit, they cannot run there); "
+        print(f"no plain or peer scene at dt/tau {args.dt / TAU:.3g} > {EXPLICIT_LIMIT:g} (explicit, they cannot run there); "
               "their cost per particle-step at dt/tau = 1, which does not depend on the step, is --sweep's reference")
     if args.baseline:
         print(f"baseline: {args.baseline}; the peer and plain scenes run the same code in both builds, so "
@@ -238,7 +238,10 @@ def main() -> None:
 
 
 # Relaxation time of the scene's grains (30 um quartz in water, Stokes): the step's regime is dt/tau.
-TAU = 2650 * 3e-5 ** 2 / (18 * 1.002e-3)
+TAU = _core.relaxation_time("stokes", 998.2, 1.002e-3, 3e-5, 2650)
+# Past this dt/tau the explicit references cannot run: the peer's explicit drag is unstable, and the
+# plain scene's free fall crosses the box in a step.
+EXPLICIT_LIMIT = 2.0
 SWEPT = ("drag", "nonlinear", "standard", "richardson", "hindered")
 RATIOS = (1e-4, 1e-3, 1e-2, 1e-1, 1.0, 10.0, 100.0, 1e3, 1e4)
 
@@ -251,7 +254,7 @@ def sweep(scenes: list[str], particles: int, steps: int, repeats: int) -> None:
     rows = []
     for ratio in RATIOS:
         dt = ratio * TAU
-        runs = (["peer"] if ratio <= 1 else []) + scenes
+        runs = (["peer"] if ratio <= EXPLICIT_LIMIT else []) + scenes
         best = {s: min(loop_time(s, particles, steps, dt=dt) for _ in range(repeats)) for s in runs}
         per = {s: t / (particles * steps) * 1e9 for s, t in best.items()}
         if ratio == 1.0:
