@@ -8,6 +8,7 @@ the solid volume fraction per layer. Each instrument turns it into a `Readings` 
 """
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -47,6 +48,10 @@ class Suspension:
     def specific_gravity(self) -> float:
         """Gs = rho_p / 1000 kg/m3 (the hydrometer's definition)."""
         return self.particle_density / 1000.0
+
+    def buoyant_weight(self, diameter: float | np.ndarray) -> float | np.ndarray:
+        """(rho_p - rho_f) g pi D^3 / 6 [N]: a grain's weight less its buoyancy, fully immersed."""
+        return (self.particle_density - self.fluid_density) * self.gravity * math.pi / 6 * diameter ** 3
 
     def stokes_speed(self, diameter) -> np.ndarray:
         """Stokes' law, (rho_p - rho_f) g D^2 / (18 mu) [m/s]."""

@@ -76,8 +76,7 @@ def terminal_speeds(suspension: Suspension, diameter: np.ndarray, law: str = "st
     """Terminal speed [m/s] of each diameter under a drag law (hindered, or law difelice: in a suspension
     of fluid fraction `voidage`, with plain buoyancy)."""
     model = _core.DragModel(law, suspension.fluid_density, suspension.viscosity, hindrance=hindrance)
-    weight = (suspension.particle_density - suspension.fluid_density) * suspension.gravity * math.pi / 6
-    return np.array([model.steady_speed(float(d), weight * float(d) ** 3, voidage)[0] for d in diameter])
+    return np.array([model.steady_speed(float(d), suspension.buoyant_weight(float(d)), voidage)[0] for d in diameter])
 
 
 class ReadingModel:

@@ -255,7 +255,7 @@ def meeting_modulus(suspension: Suspension, diameter: np.ndarray, speed: np.ndar
     f = suspension
     wall_per_speed2 = _core.hertz_modulus_for_overlap("wall", f.particle_density, 1.0, OVERLAP_TOLERANCE, POISSON_RATIO)
     impact = wall_per_speed2 * (v[large] - v[small]) ** 2 * ratio ** 3 / (1 + ratio ** 3) * np.sqrt((1 + ratio) / ratio)
-    weight = (f.particle_density - f.fluid_density) * f.gravity * math.pi / 6 * d ** 3
+    weight = f.buoyant_weight(d)
     together = (weight[large] + weight[small]) / (weight[large] / v[large] + weight[small] / v[small])
     pressing = np.abs(weight[large] * (1 - together / v[large]))    # rising grains (lighter than the fluid) push up
     wall_per_pressure = _core.hertz_modulus_for_load(1.0, OVERLAP_TOLERANCE, POISSON_RATIO)
