@@ -191,6 +191,27 @@ def test_two_runs_in_one_folder_and_signals(tmp_path):
     assert not (deck.parent / "layers.h5").exists() and (deck.parent / "log.failed.lammps").is_file()
 
 
+def test_a_signal_while_the_run_is_launched_stops_it(tmp_path, monkeypatch):
+    # The signal comes after LAMMPS was spawned but before the launch returned its process: the run is
+    # stopped all the same and the caller hears RunInterrupted, not a bare KeyboardInterrupt
+    from sediment.sim import run as run_module
+
+    spawned = []
+
+    def start_then_signal(*args, **kwargs):
+        spawned.append(subprocess.Popen(["sleep", "60"], start_new_session=True))
+        spawned[-1].guard = None
+        os.kill(os.getpid(), signal.SIGINT)
+        return spawned[-1]
+
+    monkeypatch.setattr(run_module, "_start", start_then_signal)
+    with pytest.raises(run_module.RunInterrupted, match="stopped by SIGINT"):
+        with run_module._signals_stop() as launch:
+            launch.start(["sleep"], {}, tmp_path)
+            pytest.fail("the launch returned despite the signal")
+    assert spawned[0].poll() is not None    # stopped, not left running
+
+
 @pytest.mark.parametrize("args, message", [
     (["run", "in.sedimentation", "--np", "1000"], "more ranks than the"),
     (["sample", PSD, "--particle-density", "998.2"], "do not settle in water"),

@@ -106,17 +106,39 @@ class RunInterrupted(RuntimeError):
     """The run was stopped by SIGINT or SIGTERM; every rank has been stopped."""
 
 
+class _Launch:
+    """The run a `_signals_stop` block starts: `start` launches it and keeps its process for the stop."""
+
+    def __init__(self) -> None:
+        self.proc: subprocess.Popen | None = None
+        self.signal: int | None = None    # a signal that came before the process was known
+
+    def start(self, cmd: list[str], env: dict[str, str], cwd: Path, **kwargs) -> subprocess.Popen:
+        self.proc = _start(cmd, env, cwd, **kwargs)
+        if self.signal is not None:
+            raise RunInterrupted(f"stopped by {signal.Signals(self.signal).name}")
+        return self.proc
+
+
 @contextmanager
-def _signals_stop(proc: subprocess.Popen):
-    """While the run goes on, SIGINT and SIGTERM stop it (every rank) and raise RunInterrupted."""
+def _signals_stop():
+    """From before the run is launched (`_Launch.start`) until it ends, SIGINT and SIGTERM stop it (every
+    rank) and raise RunInterrupted. A signal that comes while it is being launched is kept until its
+    process is known, so that the run is stopped all the same."""
+    launch = _Launch()
+
     def handler(signum, _frame):
+        if launch.proc is None:
+            launch.signal = signum
+            return
         raise RunInterrupted(f"stopped by {signal.Signals(signum).name}")
 
     previous = {sig: signal.signal(sig, handler) for sig in (signal.SIGINT, signal.SIGTERM)}
     try:
-        yield
+        yield launch
     except BaseException:
-        _stop(proc)
+        if launch.proc is not None:
+            _stop(launch.proc)
         raise
     finally:
         for sig, old in previous.items():
@@ -402,9 +424,10 @@ def _run(deck: Path, ranks: int, variables: dict[str, str], progress: bool) -> R
         if partial_log.exists():
             os.replace(partial_log, failed_log)
 
-    proc = _start(cmd, env, folder, stdout=subprocess.PIPE, stderr=subprocess.STDOUT)
+    proc = None
     try:
-        with _signals_stop(proc):
+        with _signals_stop() as launch:
+            proc = launch.start(cmd, env, folder, stdout=subprocess.PIPE, stderr=subprocess.STDOUT)
             assert proc.stdout is not None
             for line in proc.stdout:
                 take(line)
@@ -428,7 +451,8 @@ def _run(deck: Path, ranks: int, variables: dict[str, str], progress: bool) -> R
         keep_failed_log()
         raise
     finally:
-        _release(proc)
+        if proc is not None:
+            _release(proc)
         if bar is not None:
             bar.close()
     if code != 0 or errors:
