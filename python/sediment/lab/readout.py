@@ -137,11 +137,17 @@ class Column:
     def mass_above(self, depth, t: float) -> np.ndarray:
         """Integral of the suspension density from the surface to `depth` [kg/m2], exact for
         layer-wise constant density (linear inside a layer); clear fluid below the column."""
-        rho = self.density(t)
-        cumulative = np.concatenate([[0.0], np.cumsum(rho * np.diff(self.depth_edges))])
-        depth = np.asarray(depth, float)
-        inside = np.interp(depth, self.depth_edges, cumulative)
-        return inside + np.maximum(depth - self.height, 0.0) * self.suspension.fluid_density
+        return self.mass_profile(t)(depth)
+
+    def mass_profile(self, t: float):
+        """`mass_above` at time t as a function of depth alone (the profile summed once)."""
+        cumulative = np.concatenate([[0.0], np.cumsum(self.density(t) * np.diff(self.depth_edges))])
+
+        def above(depth):
+            depth = np.asarray(depth, float)
+            inside = np.interp(depth, self.depth_edges, cumulative)
+            return inside + np.maximum(depth - self.height, 0.0) * self.suspension.fluid_density
+        return above
 
     def weighted_mean(self, t: float, centre: float, radius: float, disc: bool = False) -> float:
         """Mean solid fraction over a sphere (or, in a 2d slab, a disc) centred at `centre` depth,
@@ -218,21 +224,25 @@ class Hydrometer:
 
     def bulb_top_depth(self, column: Column, t: float) -> float:
         """Depth of the bulb top where the hydrostatic force on the immersed stem and bulb equals
-        the weight (bisection on the exact mass profile)."""
+        the weight. The force is linear in the depth between the layer edges and the edges one bulb
+        length up: the first of those points where it reaches the weight brackets the root exactly."""
         bulb_area = self.bulb_volume / self.bulb_length
+        above = column.mass_profile(t)
 
         def excess(y):
-            above = column.mass_above(y, t)
-            return self.stem_area * above + bulb_area * (column.mass_above(y + self.bulb_length, t) - above) - self.mass
-        lo, hi = 0.0, column.height
-        if excess(lo) > 0:
+            return self.stem_area * above(y) + bulb_area * (above(y + self.bulb_length) - above(y)) - self.mass
+        points = np.unique(np.clip(np.concatenate([column.depth_edges, column.depth_edges - self.bulb_length]),
+                                   0.0, column.height))
+        force = excess(points)
+        if force[0] > 0:
             raise ValueError("the hydrometer would float with its bulb out of the suspension")
-        if excess(hi) < 0:
+        if force[-1] < 0:
             raise ValueError("the hydrometer sinks to the bottom: column too short or suspension too light")
-        for _ in range(100):
-            mid = 0.5 * (lo + hi)
-            lo, hi = (mid, hi) if excess(mid) < 0 else (lo, mid)
-        return 0.5 * (lo + hi)
+        k = int(np.argmax(force >= 0))
+        if k == 0:
+            return float(points[0])
+        share = -force[k - 1] / (force[k] - force[k - 1])
+        return float(points[k - 1] + share * (points[k] - points[k - 1]))
 
     def stokes_depth(self, top, cylinder_area: float = D422_CYLINDER_AREA, level_rise: bool = True):
         """The depth Stokes' law takes for a bulb whose top is at `top`: its centre, with `level_rise`
