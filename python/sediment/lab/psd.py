@@ -128,6 +128,7 @@ class SizeClasses:
     mass_fraction: np.ndarray   # of the input PSD, sums to the fraction of mass within the classes
     count: np.ndarray           # simulated particles per class (>= 1 where mass > 0)
     weight: np.ndarray          # real particles per simulated one, per class
+    edges: np.ndarray           # [m] the classes' bounds (one more than classes)
 
     def represented_grains(self) -> float:
         """Real grains the simulated particles stand for."""
@@ -140,27 +141,23 @@ class SizeClasses:
 
     def simulated_psd(self) -> PSD:
         """The PSD the particles actually have: percent finer at the upper edge of each class."""
-        edges = class_edges(self.diameter)
         cumulative = 100 * np.concatenate([[0.0], np.cumsum(self.simulated_mass_fraction())])
-        return PSD(edges, np.minimum(cumulative, 100.0), name="simulated")
-
-
-def class_edges(diameter: np.ndarray) -> np.ndarray:
-    """Geometric mid-points between class diameters, with the outer edges mirrored."""
-    d = np.log(diameter)
-    mid = 0.5 * (d[1:] + d[:-1])
-    first, last = d[0] - (mid[0] - d[0]), d[-1] + (d[-1] - mid[-1])
-    return np.exp(np.concatenate([[first], mid, [last]]))
+        return PSD(self.edges, np.minimum(cumulative, 100.0), name="simulated")
 
 
 def log_classes(psd: PSD, lo: float, hi: float, classes: int) -> tuple[np.ndarray, np.ndarray]:
     """Diameters at the centres of `classes` log-equal bins between lo and hi, and the mass fraction
     of the PSD in each bin."""
-    bins = np.exp(np.linspace(np.log(lo), np.log(hi), classes + 1))
-    return np.sqrt(bins[1:] * bins[:-1]), np.diff(psd.at(bins)) / 100.0
+    return classes_between(psd, np.exp(np.linspace(np.log(lo), np.log(hi), classes + 1)))
 
 
-def discretise(psd: PSD, classes: int, sample_mass: float, particle_density: float,
+def classes_between(psd: PSD, bounds: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Diameters at the log centres of the classes between increasing `bounds`, and the mass fraction of
+    the PSD in each."""
+    return np.sqrt(bounds[1:] * bounds[:-1]), np.diff(psd.at(bounds)) / 100.0
+
+
+def discretise(psd: PSD, classes: int | np.ndarray, sample_mass: float, particle_density: float,
                volume_fraction: float, particles: int | None = None) -> SizeClasses:
     """Bravo et al. eq. 15 on `classes` log-spaced diameters spanning the PSD: class k holds the mass
     between its lower and upper mid-points, n_k = 6 M dw_k / (rho_p pi phi_k^3) scaled by the
@@ -174,8 +171,8 @@ def discretise(psd: PSD, classes: int, sample_mass: float, particle_density: flo
     ----------
     psd : PSD
         The input distribution.
-    classes : int
-        Number of log-spaced size classes.
+    classes : int or array
+        Number of log-spaced size classes spanning the PSD, or the classes' bounds [m] (increasing).
     sample_mass : float
         Dry mass of the whole sample [kg].
     particle_density : float
@@ -190,17 +187,25 @@ def discretise(psd: PSD, classes: int, sample_mass: float, particle_density: flo
     SizeClasses
         Diameter, real and simulated counts and weight per class.
     """
-    if classes < 2:
-        raise PSDError("need at least 2 size classes")
+    if np.ndim(classes) == 0:
+        if classes < 2:
+            raise PSDError("need at least 2 size classes")
+        lo, hi = psd.span()
+        bounds = np.exp(np.linspace(np.log(lo), np.log(hi), int(classes) + 1))
+    else:
+        bounds = np.asarray(classes, float)
+        if len(bounds) < 3 or not np.all(np.diff(bounds) > 0) or bounds[0] <= 0:
+            raise PSDError("class bounds must be at least 3 increasing diameters > 0")
+    classes = len(bounds) - 1
     if not (sample_mass > 0 and particle_density > 0 and 0 < volume_fraction <= 1):
         raise PSDError("sample mass and particle density must be > 0, the simulated fraction within (0, 1]")
     if particles is not None and particles < classes:
         raise PSDError(f"{particles} particles cannot sample {classes} size classes: give at least one per class")
-    diameter, fraction = log_classes(psd, *psd.span(), classes)
+    diameter, fraction = classes_between(psd, bounds)
     exact = 6 * sample_mass * fraction / (particle_density * np.pi * diameter ** 3) * volume_fraction
     if particles is None:
         count = np.where(fraction > 0, np.maximum(np.rint(exact), 1), 0).astype(np.int64)
     else:
         count = np.where(fraction > 0, np.maximum(np.rint(particles * fraction / fraction.sum()), 1), 0).astype(np.int64)
     weight = np.divide(exact, count, out=np.ones_like(exact), where=count > 0) if particles else np.ones_like(exact)
-    return SizeClasses(diameter=diameter, mass_fraction=fraction, count=count, weight=weight)
+    return SizeClasses(diameter=diameter, mass_fraction=fraction, count=count, weight=weight, edges=bounds)

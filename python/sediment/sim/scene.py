@@ -21,7 +21,7 @@ import numpy as np
 from .. import _core
 from ..constants import (BRAVO_CYLINDER_HEIGHT, BRAVO_CYLINDER_WIDTH, D422_CYLINDER_AREA, D422_CYLINDER_HEIGHT,
                          DRAGS, HINDRANCES)
-from ..lab.psd import PSD, SizeClasses, class_edges, discretise
+from ..lab.psd import PSD, SizeClasses, discretise
 from ..lab.readout import Suspension
 from ..results import write_text
 
@@ -120,6 +120,10 @@ class Scene:
     # whether grains land on a floor and build a deposit there (the test's column); False for a triply
     # periodic box, where grains meet only each other (the reduced scene of --measure-contacts)
     floor: bool = True
+    # the water's temperature over the test, (time [s], temperature [C]) pairs, linear between them:
+    # the run re-issues the fluid at each frame where it has moved by more than DRIFT_STEP since the
+    # last (a laboratory's day); empty: the suspension's water throughout
+    water_record: tuple[tuple[float, float], ...] = ()
     diameter: np.ndarray = field(default_factory=lambda: np.empty(0))    # per atom [m]
     weight: np.ndarray = field(default_factory=lambda: np.empty(0))
     position: np.ndarray = field(default_factory=lambda: np.empty((0, 3)))
@@ -272,7 +276,7 @@ def terminal_speed(suspension: Suspension, diameter: float, law: str) -> float:
 
 
 def plan(psd: PSD, *, geometry: str = "column", cylinder: Cylinder = Cylinder(), mass: float = 0.060,
-         suspension: Suspension = Suspension(), width: float | None = None, classes: int = 40, particles: int | None = 20000,
+         suspension: Suspension = Suspension(), width: float | None = None, classes: int | np.ndarray = 40, particles: int | None = 20000,
          effects: Effects = Effects(), layers: int = 400, t_end: float = 86400.0, courant: float = 4.0,
          seed: int = 1) -> Scene:
     """The scene of a test: sub-volume, classes, particles and their placement.
@@ -291,8 +295,8 @@ def plan(psd: PSD, *, geometry: str = "column", cylinder: Cylinder = Cylinder(),
         Water and solids.
     width : float, optional
         Column side or slab width [m]; default two largest diameters (the slab: the cylinder).
-    classes : int
-        Size classes (Bravo et al. eq. 15).
+    classes : int or array
+        Size classes (Bravo et al. eq. 15) spanning the PSD, or their bounds [m].
     particles : int or None
         Equal-mass parcels to simulate (compute concentration/grid weight); None: real grains at the
         real concentration of the sub-volume (required with contacts or lubrication).
@@ -555,7 +559,8 @@ def _deck(scene: Scene, data: str, layer_file: str) -> str:
         f"{scene.cylinder.area * 1e4:.4g} cm2 x {scene.cylinder.height:.4g} m (fraction {scene.volume_fraction:.3g}),",
         f"# {len(scene.diameter)} atoms in {int(np.sum(c.count > 0))} size classes standing for {c.represented_grains():.4g} grains "
         f"({scene.mass * 1e3:.4g} g sample, c0 = {scene.initial_concentration:.4g} kg/m3).",
-        f"# Water at {f.temperature_text()}; effects: drag ({e.describe()}), buoyancy"
+        f"# Water at {f.temperature_text() if not scene.water_record else _record_text(scene.water_record)}; "
+        f"effects: drag ({e.describe()}), buoyancy"
         f"{', contacts' if e.contacts or e.lubrication else ', deposit on the floor (no contacts)'}"
         f"{', lubrication' if e.lubrication else ''}.",
         f"# {len(stages)} stages, {total_steps} steps to {scene.t_end:g} s; layer frames every {frames_every} steps.",
@@ -592,7 +597,7 @@ def _deck(scene: Scene, data: str, layer_file: str) -> str:
     lines += [
         "",
         f"fix             grav all gravity {f.gravity:.12g} vector {gravity}",
-        f"fix             water all fluid density {f.fluid_density:.12g} viscosity {f.viscosity:.12g}",
+        _fluid_line(f if not scene.water_record else _segments(scene, stages[:1], frames_every)[0][2]),
         f"compute         conc all concentration/grid layers {up} {scene.layers} bounds 0 {scene.height:.12g}"
         f"{f' thickness {scene.thickness:.12g}' if slab else ''} weight d_weight every ${{field_every}}"
         + (" classes " + " ".join(f"{d:.12g}" for d in scene.tag_classes) if scene.tag_classes else ""),
@@ -629,10 +634,51 @@ def _deck(scene: Scene, data: str, layer_file: str) -> str:
         "restart.a.bin restart.b.bin",
         "variable        stage_end equal 0",
     ]
-    for k, (dt, steps) in enumerate(stages, start=1):
+    for dt, steps, water in _segments(scene, stages, frames_every):
+        fluid = "" if water is None else f'"{_fluid_line(water)}" '
         lines += [f"variable        stage_end equal $(v_stage_end+ceil({steps}/v_dt_scale))",
-                  f'if "$(step) < ${{stage_end}}" then "timestep $({dt:.17g}*v_dt_scale)" "run ${{stage_end}} upto post ${{timing}}"']
+                  f'if "$(step) < ${{stage_end}}" then {fluid}"timestep $({dt:.17g}*v_dt_scale)" '
+                  '"run ${stage_end} upto post ${timing}"']
     return "\n".join(lines) + "\n"
+
+
+DRIFT_STEP = 0.05    # C: the water's record is followed in steps of this
+
+
+def _record_text(record: tuple[tuple[float, float], ...]) -> str:
+    temperatures = [t for _, t in record]
+    return (f"{min(temperatures):g}-{max(temperatures):g} C as its record over {record[-1][0] / 3600:.3g} h goes (the fluid "
+            f"re-issued as it moves by {DRIFT_STEP:g} C)")
+
+
+def _fluid_line(water: Suspension) -> str:
+    return f"fix             water all fluid density {water.fluid_density:.12g} viscosity {water.viscosity:.12g}"
+
+
+def _segments(scene: Scene, stages: list[tuple[float, int]], every: int) -> list[tuple[float, int, Suspension | None]]:
+    """The deck's runs: each stage whole, or, with a water record, split at the frames where the record
+    has moved by more than DRIFT_STEP since the last change, each part with the water at its middle."""
+    if not scene.water_record:
+        return [(dt, steps, None) for dt, steps in stages]
+    times, temperatures = (np.array(v, float) for v in zip(*scene.water_record))
+
+    def water_at(t: float) -> Suspension:
+        return Suspension.at_temperature(float(np.interp(t, times, temperatures)), scene.suspension.particle_density,
+                                         scene.suspension.gravity)
+
+    out, start = [], 0.0
+    for dt, steps in stages:
+        frames = np.arange(0, steps, every)
+        middle = start + (frames + 0.5 * every) * dt
+        level = np.interp(middle, times, temperatures)
+        first = 0
+        for k in range(1, len(frames) + 1):
+            if k == len(frames) or abs(level[k] - level[first]) > DRIFT_STEP:
+                end = steps if k == len(frames) else frames[k]
+                out.append((dt, int(end - frames[first]), water_at(start + 0.5 * (frames[first] + end) * dt)))
+                first = k
+        start += steps * dt
+    return out
 
 
 def contact_model(scene: Scene) -> str:
@@ -654,8 +700,7 @@ def describe(scene: Scene) -> str:
     c = scene.classes
     stages = scene.stages()
     sim = scene.simulated_psd()
-    edges = class_edges(c.diameter)
-    worst = float(np.max(np.abs(sim.percent_finer - scene.psd.at(edges))))
+    worst = float(np.max(np.abs(sim.percent_finer - scene.psd.at(c.edges))))
     lines = [f"{len(scene.diameter)} particles in {int(np.sum(c.count > 0))} size classes "
              f"({c.diameter[0] * 1e6:.3g}-{c.diameter[-1] * 1e6:.3g} um), standing for {c.represented_grains():.4g} real grains "
              f"({'weights ' + f'{c.weight.min():.3g}-{c.weight.max():.3g}' if not np.all(c.weight == 1) else 'real grains'})",
