@@ -62,8 +62,9 @@ def add_parser(commands) -> argparse.ArgumentParser:
 
 def run(args: argparse.Namespace) -> int:
     """Reads the sheets, inverts, prints the PSD and the verdict, writes the report."""
-    from ..lab.inverse import LabTest, invert
+    from ..lab.inverse import LabTest
     from ..lab.sheet import read_sheet
+    from ..sim.run import folder_lock
 
     if (args.design is None) == (not args.sheets):
         raise ValueError("give the sheets of a sample, or --design PSD to plan a test (not both)")
@@ -72,9 +73,15 @@ def run(args: argparse.Namespace) -> int:
     test = LabTest(args.mass, args.particle_density, args.cylinder_area, args.height, zero_correction=args.zero_correction,
                    meniscus=args.meniscus, sphere_depth=args.sphere_depth, sphere_diameter=args.sphere_diameter,
                    sphere_mass=args.sphere_mass, noise=noise, thermometer=args.thermometer)
-    if args.design is not None:
-        return _design(args, test)
     sheets = [read_sheet(p, args.pipette_volume) for p in args.sheets]
+    with folder_lock(args.out, "invert"):    # its forward runs and report: one inversion per folder at a time
+        return _design(args, test) if args.design is not None else _invert(args, test, sheets)
+
+
+def _invert(args: argparse.Namespace, test, sheets) -> int:
+    """Inverts the sheets; prints the PSD and the verdict, writes the report (exit 3: no PSD fits)."""
+    from ..lab.inverse import invert
+
     band = 0.0
     if args.budget is not None:
         from ..studies.budget import band_of

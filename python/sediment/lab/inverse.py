@@ -42,6 +42,8 @@ from .readout import BuoyancySphere, Column, Hydrometer, Pipette, Suspension, gs
 from .sheet import Sheet, check_sheet, standard_reduction
 
 CONVERGED = 0.2           # points of percent finer between rounds
+MERGE = 1.03              # readings' cut diameters closer than this ratio share a bin edge
+SUBCLASSES = 3            # the forward run's size classes per bin, even in log across it
 SMOOTHNESS = np.geomspace(1e-6, 1e2, 17)    # penalty weights tried, largest that still fits the noise
 
 
@@ -116,14 +118,15 @@ class ForwardRun:
     """One DEM run of the test with the bins' layers: their columns scale into the column of any split."""
 
     layers: object                       # LayerFile
-    bins: list[np.ndarray]               # fraction [frames, layers] of each bin, the file's order
+    bins: np.ndarray                     # fraction [bins, frames, layers] of each bin, the file's order
     masses: np.ndarray                   # each bin's share of the run's solids
     water: Suspension
     test: LabTest
 
     def column(self, shares: np.ndarray) -> Column:
         """The column of a split of the sample's mass among the bins (shares summing to about 1)."""
-        fraction = sum(s / m * b for s, m, b in zip(shares, self.masses, self.bins) if m > 0)
+        scale = np.divide(shares, self.masses, out=np.zeros(len(shares)), where=self.masses > 0)
+        fraction = np.tensordot(scale, self.bins, axes=1)
         column = Column.from_layers(self.layers, fraction=fraction)
         return replace(column, suspension=self.water)
 
@@ -167,16 +170,25 @@ def run_forward(psd: PSD, edges: np.ndarray, test: LabTest, water: Suspension, t
     from ..sim.scene import Cylinder, Effects, plan, write
 
     scene = plan(psd, cylinder=Cylinder(test.cylinder_area, test.height), mass=test.mass, suspension=water,
-                 particles=particles, courant=courant, seed=seed, effects=Effects(), t_end=t_end)
+                 classes=class_bounds(edges), particles=particles, courant=courant, seed=seed, effects=Effects(),
+                 t_end=t_end)
     scene.tag_classes = tuple(float(d) for d in edges)
-    write(scene, folder)
+    write(scene, folder, force=True)    # the inverse's own working run: a new inversion replaces it
     out = run_batch(folder / "in.sedimentation", {"overwrite": "yes"}, check=False)
     if out.error:
         raise RuntimeError(f"the forward run in {folder} failed: {out.error}")
     layers = read_layers(folder / "layers.h5")
-    bins = [layers.column(f"class_{k}") for k in range(len(edges) + 1)]
-    solids = np.array([b[0].sum() for b in bins])
+    bins = np.stack([layers.column(f"class_{k}") for k in range(len(edges) + 1)])
+    solids = bins[:, 0].sum(axis=1)
     return ForwardRun(layers, bins, solids / solids.sum(), water, test)
+
+
+def class_bounds(edges: np.ndarray) -> np.ndarray:
+    """The forward run's size classes: each bin of `psd_of` split into SUBCLASSES even in log, so that
+    every bin has grains across its width and none of another bin."""
+    outer = np.concatenate([[edges[0] / 3], edges, [edges[-1] ** 2 / edges[-2]]])
+    parts = [np.geomspace(a, b, SUBCLASSES + 1)[:-1] for a, b in zip(outer[:-1], outer[1:])]
+    return np.concatenate(parts + [outer[-1:]])
 
 
 def psd_of(shares: np.ndarray, edges: np.ndarray, name: str = "") -> PSD:
@@ -199,31 +211,89 @@ def first_guess(points_d: np.ndarray, points_p: np.ndarray, edges: np.ndarray) -
     return 0.9 * shares / shares.sum() + 0.1 / len(shares)
 
 
-def _penalty(n: int) -> np.ndarray:
-    """Second differences of the interior bins' shares (the tails are free)."""
-    interior = n - 2
-    rows = np.zeros((max(interior - 2, 0), n))
-    for r in range(interior - 2):
-        rows[r, 1 + r:4 + r] = (1.0, -2.0, 1.0)
+def cut_diameters(sheets: list[Sheet], readings: list[np.ndarray], times: list[np.ndarray], test: LabTest,
+                  water: Suspension) -> np.ndarray:
+    """The diameter each reading cuts in the forward model: the grains whose hindered terminal speed (the
+    standard drag curve, Richardson & Zaki at the solids finer than them, the reading's own percent
+    finer) takes them past the instrument's depth by the reading's time in the run's water. The
+    standard reduction's Stokes diameter at the effective time gives that speed."""
+    from ..planner.screening import terminal_speeds
+
+    out = []
+    for sheet, reading, t in zip(sheets, readings, times):
+        run_sheet = replace(sheet, time=t, reading=reading, temperature=np.full(len(t), np.nan))
+        stokes, percent = standard_reduction(run_sheet, water, test.initial_concentration, test.hydrometer,
+                                             test.cylinder_area, test.sphere, test.meniscus)
+        for d_stokes, p in zip(stokes, np.clip(percent, 0.0, 100.0)):
+            speed = water.stokes_speed(d_stokes)
+            voidage = 1.0 - test.initial_concentration / test.particle_density * p / 100.0
+            low, high = math.log(0.5 * d_stokes), math.log(2.0 * d_stokes)
+            for _ in range(40):    # bisection in log d: the hindered speed rises with the diameter
+                middle = 0.5 * (low + high)
+                moving = terminal_speeds(water, np.array([math.exp(middle)]), "standard", voidage, "richardson-zaki")[0]
+                low, high = (middle, high) if moving < speed else (low, middle)
+            out.append(math.exp(0.5 * (low + high)))
+    return np.array(out)
+
+
+def bin_edges(cuts: np.ndarray, bins: int) -> tuple[np.ndarray, np.ndarray]:
+    """Bin edges at the readings' cut diameters, so that a reading takes whole bins whatever the PSD's
+    shape within them (cuts closer than MERGE share their geometric mean), gaps wider than a `bins`-point
+    log grid from the finest to the coarsest cut filled evenly in log, and one more edge above the
+    coarsest (the earliest readings see the grains just coarser than their own cut pass). Returns the
+    edges and whether each is a cut."""
+    cuts = np.sort(cuts)
+    ratio = (cuts[-1] / cuts[0]) ** (1.0 / max(bins - 1, 1))
+    clusters = [[cuts[0]]]
+    for d in cuts[1:]:
+        if d > clusters[-1][0] * MERGE:
+            clusters.append([d])
+        else:
+            clusters[-1].append(d)
+    kept = [float(np.exp(np.mean(np.log(c)))) for c in clusters]
+    edges, cut = [kept[0]], [True]
+    for a, b in zip(kept[:-1], kept[1:]):
+        parts = max(int(math.ceil(math.log(b / a) / math.log(ratio) - 1e-9)), 1)
+        edges += list(np.geomspace(a, b, parts + 1)[1:])
+        cut += [False] * (parts - 1) + [True]
+    return np.array(edges + [edges[-1] * ratio]), np.array(cut + [False])
+
+
+def _penalty(edges: np.ndarray) -> np.ndarray:
+    """Second derivatives in log d of the interior bins' mass densities (share per log width; the tails
+    are free), scaled by the mean log width cubed: second differences of the shares for even bins."""
+    x = np.log(edges)
+    width = np.diff(x)
+    centre = 0.5 * (x[1:] + x[:-1])
+    scale = width.mean() ** 3
+    rows = np.zeros((max(len(width) - 2, 0), len(width) + 2))
+    for r in range(len(width) - 2):
+        left, right = centre[r + 1] - centre[r], centre[r + 2] - centre[r + 1]
+        weights = (2 / (left * (left + right)), -2 / (left * right), 2 / (right * (left + right)))
+        for j, w in enumerate(weights):
+            rows[r, 1 + r + j] = scale * w / width[r + j]
     return rows
 
 
 def fit(jacobian: np.ndarray, base: np.ndarray, shares0: np.ndarray, data: np.ndarray, sigma: np.ndarray,
-        smoothness: float | None = None) -> tuple[np.ndarray, float, float]:
+        edges: np.ndarray, smoothness: float | None = None,
+        prior_draw: np.ndarray | None = None) -> tuple[np.ndarray, float, float]:
     """The shares that fit the linearised readings, >= 0, summing to 1, with the largest smoothness
     penalty whose chi-square stays within the readings' count (or the one given); returns the shares,
-    the chi-square and the penalty weight."""
+    the chi-square and the penalty weight. With `prior_draw` (one standard normal number per penalty
+    row) the penalty aims at it instead of zero: with data drawn from their noise, that makes the answer
+    a draw of the PSD the readings and the smoothness prior allow (randomise-then-optimise)."""
     from scipy.optimize import lsq_linear
 
     n = len(shares0)
     a = jacobian / sigma[:, None]
     b = (data - base + jacobian @ shares0) / sigma
     total = 1e4 * np.ones((1, n))
-    penalty = _penalty(n)
+    penalty = _penalty(edges)
 
     def solve(weight: float) -> tuple[np.ndarray, float]:
         matrix = np.vstack([a, total, math.sqrt(weight) * penalty * n])
-        target = np.concatenate([b, [1e4], np.zeros(len(penalty))])
+        target = np.concatenate([b, [1e4], np.zeros(len(penalty)) if prior_draw is None else prior_draw])
         x = lsq_linear(matrix, target, bounds=(0.0, np.inf), method="bvls").x
         return x, float(np.sum((a @ x - b) ** 2))
 
@@ -246,6 +316,7 @@ class Inversion:
     percent: np.ndarray          # recovered percent finer at the edges
     low: np.ndarray
     high: np.ndarray
+    measured: np.ndarray         # whether each edge is a reading's cut diameter (else between readings)
     reduction: list[tuple[str, np.ndarray, np.ndarray, np.ndarray]]    # instrument, time, D, P
     fit_rows: list[tuple[str, float, float, float, float]]             # instrument, time, measured, model, sigma
     chi2: float
@@ -269,10 +340,11 @@ class Inversion:
         return PSD(self.edges, self.percent, "recovered")
 
     def table(self) -> Table:
-        """Percent finer with its band at each bin edge."""
-        table = Table(["diameter_um", "percent_finer", "low", "high"], notes=self.notes)
-        for row in zip(self.edges * 1e6, self.percent, self.low, self.high):
-            table.add(*map(float, row))
+        """Percent finer with its band at each bin edge, and whether a reading resolves it (1) or it lies
+        between the readings' diameters (0)."""
+        table = Table(["diameter_um", "percent_finer", "low", "high", "measured"], notes=self.notes)
+        for d, p, low, high, measured in zip(self.edges * 1e6, self.percent, self.low, self.high, self.measured):
+            table.add(float(d), float(p), float(low), float(high), int(measured))
         return table
 
     def save(self, folder: Path) -> list[Path]:
@@ -286,7 +358,8 @@ class Inversion:
         for name, t, measured, model, sigma in self.fit_rows:
             fitted.add(name, t / 60, measured, model, (model - measured) / sigma)
         summary = {"psd": {"diameter_um": (self.edges * 1e6).tolist(), "percent_finer": self.percent.tolist(),
-                           "low": self.low.tolist(), "high": self.high.tolist()},
+                           "low": self.low.tolist(), "high": self.high.tolist(),
+                           "measured": self.measured.astype(int).tolist()},
                    "chi2_per_reading": self.reduced_chi2, "consistent": self.consistent, "rounds": self.rounds,
                    "smoothness": self.smoothness, "resolution": self.resolution, "notes": self.notes}
         return [write_text(folder / "psd.csv", self.table().csv()),
@@ -301,7 +374,10 @@ class Inversion:
         fig, (ax, res) = plt.subplots(1, 2, figsize=(11, 4.5), gridspec_kw={"width_ratios": [3, 2]})
         d = self.edges * 1e6
         ax.fill_between(d, self.low, self.high, color="C0", alpha=0.25, label="band")
-        ax.plot(d, self.percent, "C0-o", ms=4, label="recovered PSD")
+        ax.plot(d, self.percent, "C0-", label="recovered PSD")
+        ax.plot(d[self.measured], self.percent[self.measured], "C0o", ms=4, label="at a reading's diameter")
+        ax.plot(d[~self.measured], self.percent[~self.measured], "o", mec="C0", mfc="white", ms=4,
+                label="between readings")
         for k, (name, _, dd, p) in enumerate(self.reduction):
             ax.plot(dd * 1e6, p, "s", ms=5, color=f"C{k + 1}", label=f"standard reduction ({name})")
         ax.set(xscale="log", xlabel="diameter [um]", ylabel="percent finer [%]", ylim=(0, 100),
@@ -320,7 +396,7 @@ class Inversion:
 
 
 def invert(sheets: list[Sheet], test: LabTest, folder: Path, *, bins: int = 24, particles: int = 20000,
-           courant: float = 4.0, rounds: int = 4, draws: int = 16, seed: int = 1,
+           courant: float = 4.0, rounds: int = 4, draws: int = 64, seed: int = 1,
            budget_band: float = 0.0) -> Inversion:
     """Recovers the PSD the sheets were read from (the method above).
 
@@ -339,7 +415,7 @@ def invert(sheets: list[Sheet], test: LabTest, folder: Path, *, bins: int = 24, 
     rounds : int
         Forward runs at most.
     draws : int
-        Draws of the reading noise and the thermometer for the band.
+        Draws of the PSDs the sheets allow, for the band (their central 95 %).
     budget_band : float
         Points of percent finer the physics' uncertainty adds (an error budget's physical total).
     """
@@ -361,15 +437,14 @@ def invert(sheets: list[Sheet], test: LabTest, folder: Path, *, bins: int = 24, 
                                   test.sphere, test.meniscus)
         reduction.append((sheet.instrument, sheet.time, d, p))
     diameters = np.concatenate([d for _, _, d, _ in reduction])
-    # the bins between the finest and the coarsest reading, and one more above: the earliest readings
-    # see the grains just coarser than their own diameter pass
-    reported = np.geomspace(diameters.min(), diameters.max(), bins)
-    edges = np.append(reported, reported[-1] ** 2 / reported[-2])
+    times = [effective_times(s, water) for s in sheets]
+    edges, at_cut = bin_edges(cut_diameters(sheets, corrected, times, test, water), bins)
+    reported = edges[:-1]
     shares = first_guess(diameters, np.concatenate([p for *_, p in reduction]), edges)
     data = np.concatenate(corrected)
     sigma = np.concatenate([np.full(len(s.time), test.noise[s.instrument]) for s in sheets])
-    times = [effective_times(s, water) for s in sheets]
-    t_end = 1.02 * max(t[-1] for t in times)
+    # the runs reach the latest time the band's thermometer offset (below) maps a reading to
+    t_end = 1.02 * max(effective_times(s, water, 1.0)[-1] for s in sheets)
 
     previous = None
     weight = None
@@ -395,26 +470,29 @@ def invert(sheets: list[Sheet], test: LabTest, folder: Path, *, bins: int = 24, 
             sigma = np.sqrt(reading_sigma ** 2 + model_sigma ** 2)
         for _ in range(2):    # Gauss-Newton on this run's columns
             base, jac = linearise(run, shares, sheets, times)
-            shares, chi2, weight = fit(jac, base, shares, data, sigma)
+            shares, chi2, weight = fit(jac, base, shares, data, sigma, edges)
         percent = 100 * np.cumsum(shares)[:-1]
         if previous is not None and np.max(np.abs(percent - previous)) < CONVERGED:
             break
         previous = percent
     model, jac = linearise(run, shares, sheets, times)
     chi2 = float(np.sum(((model - data) / sigma) ** 2))
-    # the band: the fit again for draws of the reading noise and the thermometer's offset
+    # the band: draws of the PSDs the sheets allow, each fit again with the readings drawn from their noise
+    # (and the forward model's), the thermometer's offset drawn, and the smoothness penalty aiming at a
+    # draw of its prior (randomise-then-optimise)
+    # An offset moves every reading's time alike; its effect on the readings is taken as linear (the
+    # readings with the record 1 C warmer): a drawn offset shifts the data the fit aims at.
+    per_degree = run.readings(shares, sheets, [effective_times(s, water, 1.0) for s in sheets]) - model
     rng = np.random.default_rng(seed)
     draws_percent = []
     for _ in range(draws):
-        offset = rng.normal(0.0, test.thermometer)
-        shifted = [effective_times(s, water, offset) for s in sheets]
-        b, j = linearise(run, shares, sheets, shifted) if offset else (model, jac)
-        noisy = data + rng.normal(0.0, reading_sigma)
-        x, _, _ = fit(j, b, shares, noisy, sigma, weight)
+        noisy = data + rng.normal(0.0, sigma) - rng.normal(0.0, test.thermometer) * per_degree
+        x, _, _ = fit(jac, model, shares, noisy, sigma, edges, weight, rng.normal(0.0, 1.0, len(_penalty(edges))))
         draws_percent.append(100 * np.cumsum(x)[:-1])
-    spread = 2 * np.std(draws_percent, axis=0) if draws > 1 else np.zeros(len(edges))
-    band = np.sqrt(spread ** 2 + budget_band ** 2)
     percent = 100 * np.cumsum(shares)[:-1]
+    low, high = np.percentile(draws_percent, [2.5, 97.5], axis=0) if draws > 1 else (percent, percent)
+    below = np.sqrt(np.maximum(percent - low, 0.0) ** 2 + budget_band ** 2)
+    above = np.sqrt(np.maximum(high - percent, 0.0) ** 2 + budget_band ** 2)
     rows = []
     start = 0
     for sheet in sheets:
@@ -425,8 +503,9 @@ def invert(sheets: list[Sheet], test: LabTest, folder: Path, *, bins: int = 24, 
     resolution = (f"{particles} parcels, Courant {courant:g}, standard drag curve + Richardson & Zaki, water at "
                   f"{mean_temperature:.3g} C")
     inside = slice(0, len(reported))
-    percent, band = percent[inside], band[inside]
-    result = Inversion(reported, percent, np.clip(percent - band, 0, 100), np.clip(percent + band, 0, 100), reduction,
+    percent, below, above = percent[inside], below[inside], above[inside]
+    result = Inversion(reported, percent, np.clip(percent - below, 0, 100), np.clip(percent + above, 0, 100),
+                       at_cut[inside], reduction,
                        rows, chi2, round_number, float(weight), resolution)
     result.notes.append(f"forward model: {resolution}; {round_number} round(s)")
     if not result.consistent:
@@ -484,7 +563,7 @@ def design_test(psd: PSD, folder: Path, masses=(0.030, 0.045, 0.060, 0.080), des
             mean_errors, worst_errors = [], []
             for _ in range(draws):
                 noisy = base + rng.normal(0.0, sigma)
-                x, _, _ = fit(jac, base, truth, noisy, sigma)
+                x, _, _ = fit(jac, base, truth, noisy, sigma, edges)
                 error = np.abs(100 * (np.cumsum(x) - np.cumsum(truth))[:-1])
                 mean_errors.append(error.mean())
                 worst_errors.append(error.max())
