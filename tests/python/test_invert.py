@@ -124,6 +124,33 @@ def test_a_sheet_of_known_answer_is_inverted_closer_than_the_standard_reduction(
         assert (out / name).stat().st_size > 0
 
 
+def test_a_reader_that_leaves_loses_no_file(tmp_path, monkeypatch):
+    """`sediment invert ... | head -1`: the pipe closes after the first line; the command still finishes
+    and writes its report, exit 0."""
+    import io
+    import sys
+
+    class Pipe(io.StringIO):
+        def __init__(self, fd: int) -> None:
+            super().__init__()
+            self.fd = fd
+
+        def write(self, text: str) -> int:
+            if "\n" in self.getvalue():
+                raise BrokenPipeError(32, "Broken pipe")
+            return super().write(text)
+
+        def fileno(self) -> int:
+            return self.fd
+
+    with open(tmp_path / "stdout", "w") as sink:
+        monkeypatch.setattr(sys, "stdout", Pipe(sink.fileno()))
+        code = cli.main(["invert", str(EXAMPLE / "hydrometer.csv"), "--mass", "0.06", "--out", str(tmp_path / "out"),
+                         "--particles", "4000"])
+    assert code == 0
+    assert all((tmp_path / "out" / name).stat().st_size > 0 for name in ("psd.csv", "fit.csv", "invert.json", "invert.png"))
+
+
 def test_the_design_of_a_test_prefers_early_readings_for_a_steep_coarse_end(tmp_path):
     """Sample 2 (45 % of its mass between 50 and 60 um): the 152H read from 1 min (D7928) recovers it far
     better than from 2 min (D422), whose first reading comes after those grains have passed; a mass beyond

@@ -5,6 +5,8 @@ and written with their ``save(folder)``. Every --help works before the C++ core 
 from __future__ import annotations
 
 import argparse
+import io
+import os
 import sys
 
 from .. import __version__
@@ -56,6 +58,8 @@ def main(argv: list[str] | None = None) -> int:
         print(f"sediment {args.command}: the C++ core (sediment._core) is not built: run `make build` in the "
               "repository, or install the package (README, Python route)", file=sys.stderr)
         return 2
+    stdout = sys.stdout
+    sys.stdout = _ReaderMayLeave(stdout)
     try:
         return args.func(args)
     except RunInterrupted as exc:    # says what the run left
@@ -68,3 +72,29 @@ def main(argv: list[str] | None = None) -> int:
     except (ValueError, OSError, RuntimeError) as exc:    # SheetError is a ValueError; OSError: missing, read-only or full files
         print(f"sediment {args.command}: error: {exc}", file=sys.stderr)
         return 2
+    finally:
+        sys.stdout = stdout
+
+
+class _ReaderMayLeave(io.TextIOBase):
+    """Standard output that goes on when its reader leaves (`sediment ... | head`): the rest of the
+    output goes nowhere, and the command still finishes and writes its files."""
+
+    def __init__(self, stream) -> None:
+        self.stream = stream
+
+    def _left(self) -> None:
+        os.dup2(os.open(os.devnull, os.O_WRONLY), self.stream.fileno())
+
+    def write(self, text: str) -> int:
+        try:
+            return self.stream.write(text)
+        except BrokenPipeError:
+            self._left()
+            return len(text)
+
+    def flush(self) -> None:
+        try:
+            self.stream.flush()
+        except BrokenPipeError:
+            self._left()

@@ -89,8 +89,9 @@ def _invert(args: argparse.Namespace, test, sheets) -> int:
         band = max(band_of(args.budget, args.budget_sample)[s.instrument] for s in sheets)
     result = invert(sheets, test, args.out / "runs", bins=args.bins, particles=args.particles, seed=args.seed,
                     budget_band=band)
+    written = result.save(args.out)    # before printing: a reader that leaves (`| head`) loses nothing
     print(result.table().text(), end="")
-    for path in result.save(args.out):
+    for path in written:
         print(f"wrote {path}")
     return 0 if result.consistent else 3
 

@@ -508,6 +508,8 @@ def invert(sheets: list[Sheet], test: LabTest, folder: Path, *, bins: int = 24, 
                        at_cut[inside], reduction,
                        rows, chi2, round_number, float(weight), resolution)
     result.notes.append(f"forward model: {resolution}; {round_number} round(s)")
+    result.notes.append("measured 1: a reading's cut diameter; measured 0: between the readings' diameters, where the "
+                        "value and its band are those of the smoothest PSDs the readings allow (a step there is not seen)")
     if not result.consistent:
         result.notes.append(f"NOT CONSISTENT: chi-square per reading {result.reduced_chi2:.3g} (>= 4): no PSD of this "
                             "sample under this physics gives these readings within their noise: a misread, a "
