@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from sediment import cli
-from sediment.lab.inverse import LabTest, effective_times, whole_sample_reading
+from sediment.lab.inverse import LabTest, effective_times, invert, whole_sample_reading
 from sediment.lab.psd import read_psd
 from sediment.lab.readout import Suspension
 from sediment.lab.sheet import SheetError, check_sheet, read_sheet
@@ -51,6 +51,14 @@ def test_readings_no_suspension_gives_are_refused(tmp_path):
     with pytest.raises(SheetError, match="beyond what the whole sample in suspension reads"):
         check_sheet(above, whole, 0.5)
     check_sheet(read_sheet(EXAMPLE / "hydrometer.csv"), whole, 0.5)    # a real sheet passes
+
+
+def test_an_inversion_needs_two_cuts_and_a_few_bins(tmp_path):
+    one = read_sheet(_sheet(tmp_path, HYDROMETER + "15,28.5,20\n"))
+    with pytest.raises(ValueError, match="cut the sample at one diameter only"):
+        invert([one], LabTest(), tmp_path / "one")
+    with pytest.raises(ValueError, match="give at least 4 size bins"):
+        invert([read_sheet(EXAMPLE / "hydrometer.csv")], LabTest(), tmp_path / "bins", bins=1)
 
 
 def test_a_warmer_day_is_a_longer_test_in_the_reference_water(tmp_path):

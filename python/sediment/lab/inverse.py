@@ -44,6 +44,7 @@ from .sheet import Sheet, check_sheet, standard_reduction
 CONVERGED = 0.2           # points of percent finer between rounds
 MERGE = 1.03              # readings' cut diameters closer than this ratio share a bin edge
 SUBCLASSES = 3            # the forward run's size classes per bin, even in log across it
+MIN_BINS = 4              # a grid coarser than this leaves a PSD of its readings' few diameters
 SMOOTHNESS = np.geomspace(1e-6, 1e2, 17)    # penalty weights tried, largest that still fits the noise
 
 
@@ -251,6 +252,9 @@ def bin_edges(cuts: np.ndarray, bins: int) -> tuple[np.ndarray, np.ndarray]:
         else:
             clusters[-1].append(d)
     kept = [float(np.exp(np.mean(np.log(c)))) for c in clusters]
+    if len(kept) < 2:
+        raise ValueError(f"the readings cut the sample at one diameter only ({kept[0] * 1e6:.3g} um): an inversion "
+                         "needs readings at two times or depths at least")
     edges, cut = [kept[0]], [True]
     for a, b in zip(kept[:-1], kept[1:]):
         parts = max(int(math.ceil(math.log(b / a) / math.log(ratio) - 1e-9)), 1)
@@ -421,6 +425,8 @@ def invert(sheets: list[Sheet], test: LabTest, folder: Path, *, bins: int = 24, 
     """
     if not sheets:
         raise ValueError("no sheet to invert")
+    if bins < MIN_BINS:
+        raise ValueError(f"--bins {bins}: give at least {MIN_BINS} size bins")
     recorded = np.concatenate([s.temperature[np.isfinite(s.temperature)] for s in sheets])
     mean_temperature = float(recorded.mean()) if len(recorded) else 20.0
     water = Suspension.at_temperature(mean_temperature, test.particle_density)
@@ -541,6 +547,8 @@ def design_test(psd: PSD, folder: Path, masses=(0.030, 0.045, 0.060, 0.080), des
     draw's mean and worst absolute error (NaN, with no readings, where the instrument cannot read that
     mass, e.g. a suspension beyond the 152H's scale). The hindrance's own uncertainty, which grows with the mass, is
     not in it (docs/error-budget.md: the exponent row)."""
+    if bins < MIN_BINS:
+        raise ValueError(f"--bins {bins}: give at least {MIN_BINS} size bins")
     water = Suspension.at_temperature(20.0, test.particle_density)
     rng = np.random.default_rng(seed)
     results = []
