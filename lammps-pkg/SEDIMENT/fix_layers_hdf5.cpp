@@ -211,8 +211,8 @@ void copy_file(const std::string &from, const std::string &to)
 }    // namespace
 
 FixLayersHDF5::FixLayersHDF5(LAMMPS *lmp, int narg, char **arg) :
-    Fix(lmp, narg, arg), compute_id(nullptr), fluid_id(nullptr), particle_density(0.0), grid(nullptr),
-    fluid(nullptr), file(-1), frame_sets{-1, -1, -1}, is_open(false), frames(0), last_write(0.0),
+    Fix(lmp, narg, arg), compute_id(nullptr), fluid_id(nullptr), particle_density(0.0), grid(nullptr), file(-1),
+    frame_sets{-1, -1, -1}, is_open(false), frames(0), last_write(0.0),
     overwrite(false), end_time(-1.0), resumed_frames(-1), last_frame_step(-1)
 {
   if (narg < 6)
@@ -241,6 +241,12 @@ FixLayersHDF5::FixLayersHDF5(LAMMPS *lmp, int narg, char **arg) :
       args.unknown("fluid, particle_density, overwrite or end_time");
     }
     args.next(1);
+  }
+  if (fluid_id) {
+    const sediment::Fluid &fluid =
+        FixFluid::find(lmp, fluid_id, "Fix layers/hdf5 (define the fluid before it)")->properties();
+    water = {{"fluid_density", fluid.density}, {"fluid_viscosity", fluid.viscosity},
+             {"fluid_yield_stress", fluid.yield_stress}};
   }
   scalar_flag = 1;
   global_freq = 1;
@@ -306,7 +312,6 @@ void FixLayersHDF5::init()
                compute_id, compute->style);
   if (!grid->is_layers())
     error->all(FLERR, "Fix layers/hdf5: compute '{}' bins into 3d cells; layer files need 'layers AXIS N'", compute_id);
-  fluid = fluid_id ? FixFluid::find(lmp, fluid_id, "Fix layers/hdf5") : nullptr;
 }
 
 void FixLayersHDF5::setup(int /*vflag*/)
@@ -433,11 +438,7 @@ std::vector<std::pair<const char *, double>> FixLayersHDF5::parameters(const sed
                                                         {"cross_section", grid->cross_section()}};
   if (domain->dimension == 2) values.emplace_back("slab_thickness", grid->slab_thickness());
   if (particle_density > 0.0) values.emplace_back("particle_density", particle_density);
-  if (fluid) {
-    values.emplace_back("fluid_density", fluid->properties().density);
-    values.emplace_back("fluid_viscosity", fluid->properties().viscosity);
-    values.emplace_back("fluid_yield_stress", fluid->properties().yield_stress);
-  }
+  values.insert(values.end(), water.begin(), water.end());
   return values;
 }
 

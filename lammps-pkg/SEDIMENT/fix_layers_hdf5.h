@@ -41,7 +41,10 @@ class FixLayersHDF5 : public Fix {
   char *compute_id, *fluid_id;
   double particle_density;
   class ComputeConcentrationGrid *grid;
-  class FixFluid *fluid;
+  // The fluid's properties when this fix was defined, stored with the frames: the deck's first water
+  // (a deck may re-issue the fluid between runs as a temperature record goes), which a resumed run
+  // must have too.
+  std::vector<std::pair<const char *, double>> water;
   long long file;       // hid_t of the open file (rank 0), -1 when closed
   // hid_t of its frame datasets time, step and fraction (rank 0), open while the file is: opening
   // and closing them for each frame was three quarters of the cost of writing it.

@@ -112,10 +112,15 @@ def test_frames_of_another_fluid_are_not_spliced(tmp_path):
     assert digest(tmp_path / "layers.h5") == before
 
 
-def test_a_killed_run_keeps_the_earlier_result_and_resumes_to_the_same_frames(tmp_path):
+@pytest.mark.parametrize("water", ["constant", "record"])
+def test_a_killed_run_keeps_the_earlier_result_and_resumes_to_the_same_frames(tmp_path, water):
     # 8600 steps (24 h at Courant 0.5): restart files at steps 2000 and 4000, and steps after them
-    # for the kill to find the run going
+    # for the kill to find the run going. With a temperature record the deck re-issues the fluid
+    # between its runs: the resumed run starts in the water of its own part of the day.
     options = ("--particles", 5000, "--t-end", 86400, "--courant", 0.5)
+    if water == "record":
+        (tmp_path / "record.csv").write_text("time_min,temperature_C\n0,19\n1440,23\n")
+        options += ("--temperature-record", tmp_path / "record.csv")
     whole = sample(tmp_path / "whole", *options)
     assert sediment("run", whole, "--quiet").returncode == 0
     cut = sample(tmp_path / "cut", *options)

@@ -105,8 +105,10 @@ def test_the_water_follows_its_temperature_record(tmp_path):
     text = (tmp_path / "warmed" / "in.sedimentation").read_text()
     assert "Water at 20-35 C as its record" in text and "viscosity 0.0007188" in text
     before = plain.time <= 1800.0
-    # the same frames (the split runs add up the time in another order: within rounding)
-    assert np.allclose(plain.time, warmed.time, rtol=1e-12) and 0 < before.sum() < len(plain.time)
+    # the same frames at the same times (LAMMPS adds up the time at each run: within a unit of the last
+    # place), and the last exactly at the end of the test, where the last readings are taken
+    assert np.allclose(plain.time, warmed.time, rtol=1e-15) and warmed.time[-1] == plain.time[-1] == 3600.0
+    assert 0 < before.sum() < len(plain.time)
     assert np.array_equal(plain.total[before], warmed.total[before])
     # solids left in the upper half at the end: fewer in the warmed water
     upper = plain.centres > 0.5 * plain.centres.max()
@@ -193,6 +195,14 @@ def test_sample_rejects_what_it_cannot_build(tmp_path, capsys):
     assert "must not decrease" in capsys.readouterr().err
     assert cli.main(["run", str(tmp_path / "missing.lmp")]) == 2
     assert "no such deck" in capsys.readouterr().err
+    for text, message in [("diameter_um,percent_finer\n2,10\n", "needs the columns time_min and temperature_C"),
+                          ("time_min,temperature_C\n10,20\n5,21\n", "must be >= 0 and increase"),
+                          ("time_min,temperature_C\n10,55\n", "within 0-40 C"),
+                          ("time_min,temperature_C\n10,\n", "no temperatures recorded")]:
+        record = tmp_path / "record.csv"
+        record.write_text(text)
+        assert cli.main(["sample", str(psd), "--temperature-record", str(record), "--out", str(tmp_path / "r")]) == 2
+        assert message in capsys.readouterr().err
 
 
 def test_run_reports_the_lammps_error(tmp_path, capsys):

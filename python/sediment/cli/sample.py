@@ -62,6 +62,9 @@ def add_test_options(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--temperature", type=temperature, default=LAB_TEMPERATURE,
                         help="water temperature [C], 0-40: its density and viscosity (default 20; 1 C moves the "
                         "viscosity by about 2.5 %%)")
+    parser.add_argument("--temperature-record", type=Path, metavar="CSV",
+                        help="the water's temperature over the test (columns time_min,temperature_C; a hydrometer "
+                        "sheet serves): the run's water follows it, linear between rows, instead of --temperature")
     parser.add_argument("--classes", type=count, default=40, help="log-spaced size classes (eq. 15)")
     parser.add_argument("--layers", type=count, default=400, help="layers of the concentration grid")
     parser.add_argument("--t-end", type=positive, default=86400.0, help="simulated time [s] (default 24 h)")
@@ -123,11 +126,22 @@ def run(args: argparse.Namespace) -> int:
         print(f"the plan's decision ({args.plan}): --drag {args.drag} --hindrance {args.hindrance} "
               f"--particles {args.particles} --courant {args.courant:g}")
 
+    record = ()
+    suspension = suspension_of(args)
+    if args.temperature_record is not None:
+        from ..lab.readout import Suspension
+        from ..lab.sheet import read_temperature_record
+
+        # the time steps for the warmest water of the record, where the grains fall fastest
+        record = read_temperature_record(args.temperature_record)
+        suspension = Suspension.at_temperature(max(t for _, t in record), args.particle_density)
     scene = plan(psd, geometry=args.geometry, cylinder=cylinder_of(args), mass=args.mass,
-                 suspension=suspension_of(args), width=args.width,
+                 suspension=suspension, width=args.width,
                  classes=args.classes, particles=None if args.real_grains else args.particles,
                  effects=effects_of(args, args.contacts, args.lubrication),
                  layers=args.layers, t_end=args.t_end, courant=args.courant, seed=args.seed)
+    if record:
+        scene.water_record = record
     print(describe(scene))
     for path in write(scene, args.out, force=args.force):
         print(f"wrote {path}")

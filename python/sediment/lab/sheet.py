@@ -56,22 +56,15 @@ class Sheet:
 def read_sheet(path: str | Path, pipette_volume: float = 25e-6) -> Sheet:
     """Reads and checks one sheet (its kind from its header); a pipette's masses become g/L of the sample."""
     path = Path(path)
-    try:
-        with path.open(newline="") as handle:
-            rows = [row for row in csv.reader(handle) if row and not row[0].lstrip().startswith("#")]
-    except UnicodeDecodeError as exc:
-        raise SheetError(f"{path}: not a text CSV ({exc.reason})") from None
-    if not rows:
-        raise SheetError(f"{path}: empty sheet")
-    header = [h.strip() for h in rows[0]]
+    header, rows = _table(path)
     kind = next((k for k, columns in KINDS.items() if set(columns) <= set(header)), None)
     if kind is None:
         expected = "; ".join(",".join(c) for c in KINDS.values())
         raise SheetError(f"{path}: header {','.join(header)} is none of the sheets (expected {expected})")
-    if len(rows) < 2:
+    if not rows:
         raise SheetError(f"{path}: no readings below the header")
     values: dict[str, list[float]] = {name: [] for name in header}
-    for number, row in enumerate(rows[1:], start=2):
+    for number, row in enumerate(rows, start=2):
         if len(row) != len(header):
             raise SheetError(f"{path}, row {number}: {len(row)} fields, the header has {len(header)}")
         for name, text in zip(header, row):
@@ -113,6 +106,48 @@ def read_sheet(path: str | Path, pipette_volume: float = 25e-6) -> Sheet:
         if np.any(reading <= 0):
             raise SheetError(f"{path}: apparent masses must be > 0")
     return Sheet(kind, path, time, reading, temperature, depth)
+
+
+def _table(path: Path) -> tuple[list[str], list[list[str]]]:
+    """A CSV's header and rows (blank lines and # comments left out)."""
+    try:
+        with path.open(newline="") as handle:
+            rows = [row for row in csv.reader(handle) if row and not row[0].lstrip().startswith("#")]
+    except UnicodeDecodeError as exc:
+        raise SheetError(f"{path}: not a text CSV ({exc.reason})") from None
+    if not rows:
+        raise SheetError(f"{path}: empty sheet")
+    return [h.strip() for h in rows[0]], rows[1:]
+
+
+def read_temperature_record(path: str | Path) -> tuple[tuple[float, float], ...]:
+    """The water's temperature over a test, (time [s], temperature [C]) pairs, from any CSV with the
+    columns time_min and temperature_C (a sheet of readings serves; rows without a temperature are
+    left out)."""
+    path = Path(path)
+    header, rows = _table(path)
+    if not {"time_min", "temperature_C"} <= set(header):
+        raise SheetError(f"{path}: a temperature record needs the columns time_min and temperature_C (header: "
+                         f"{','.join(header)})")
+    at, column = header.index("time_min"), header.index("temperature_C")
+    record = []
+    for number, row in enumerate(rows, start=2):
+        if len(row) != len(header):
+            raise SheetError(f"{path}, row {number}: {len(row)} fields, the header has {len(header)}")
+        if row[column].strip() == "":
+            continue
+        try:
+            time, celsius = float(row[at]) * 60.0, float(row[column])
+        except ValueError:
+            raise SheetError(f"{path}, row {number}: time or temperature is not a number") from None
+        if not (math.isfinite(time) and 0.0 <= celsius <= 40.0):
+            raise SheetError(f"{path}, row {number}: a temperature within 0-40 C at a finite time is needed")
+        record.append((time, celsius))
+    if not record:
+        raise SheetError(f"{path}: no temperatures recorded")
+    if record[0][0] < 0 or any(b[0] <= a[0] for a, b in zip(record[:-1], record[1:])):
+        raise SheetError(f"{path}: the times must be >= 0 and increase from row to row")
+    return tuple(record)
 
 
 def check_sheet(sheet: Sheet, whole: float, resolution: float) -> None:

@@ -634,11 +634,13 @@ def _deck(scene: Scene, data: str, layer_file: str) -> str:
         "restart.a.bin restart.b.bin",
         "variable        stage_end equal 0",
     ]
-    for dt, steps, water in _segments(scene, stages, frames_every):
-        fluid = "" if water is None else f'"{_fluid_line(water)}" '
+    for dt, steps, water, first in _segments(scene, stages, frames_every):
+        # the time step set once per stage: LAMMPS adds up the time at each change, and the parts of a
+        # stage then end on the same times as the whole stage would
+        commands = ([f'"{_fluid_line(water)}"'] if water is not None else []) \
+            + ([f'"timestep $({dt:.17g}*v_dt_scale)"'] if first else []) + ['"run ${stage_end} upto post ${timing}"']
         lines += [f"variable        stage_end equal $(v_stage_end+ceil({steps}/v_dt_scale))",
-                  f'if "$(step) < ${{stage_end}}" then {fluid}"timestep $({dt:.17g}*v_dt_scale)" '
-                  '"run ${stage_end} upto post ${timing}"']
+                  f'if "$(step) < ${{stage_end}}" then {" ".join(commands)}']
     return "\n".join(lines) + "\n"
 
 
@@ -655,11 +657,13 @@ def _fluid_line(water: Suspension) -> str:
     return f"fix             water all fluid density {water.fluid_density:.12g} viscosity {water.viscosity:.12g}"
 
 
-def _segments(scene: Scene, stages: list[tuple[float, int]], every: int) -> list[tuple[float, int, Suspension | None]]:
-    """The deck's runs: each stage whole, or, with a water record, split at the frames where the record
-    has moved by more than DRIFT_STEP since the last change, each part with the water at its middle."""
+def _segments(scene: Scene, stages: list[tuple[float, int]],
+              every: int) -> list[tuple[float, int, Suspension | None, bool]]:
+    """The deck's runs (time step, steps, water, whether a stage begins): each stage whole, or, with a
+    water record, split at the frames where the record has moved by more than DRIFT_STEP since the last
+    change, each part with the water at its middle."""
     if not scene.water_record:
-        return [(dt, steps, None) for dt, steps in stages]
+        return [(dt, steps, None, True) for dt, steps in stages]
     times, temperatures = (np.array(v, float) for v in zip(*scene.water_record))
 
     def water_at(t: float) -> Suspension:
@@ -675,7 +679,7 @@ def _segments(scene: Scene, stages: list[tuple[float, int]], every: int) -> list
         for k in range(1, len(frames) + 1):
             if k == len(frames) or abs(level[k] - level[first]) > DRIFT_STEP:
                 end = steps if k == len(frames) else frames[k]
-                out.append((dt, int(end - frames[first]), water_at(start + 0.5 * (frames[first] + end) * dt)))
+                out.append((dt, int(end - frames[first]), water_at(start + 0.5 * (frames[first] + end) * dt), first == 0))
                 first = k
         start += steps * dt
     return out
