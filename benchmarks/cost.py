@@ -2,7 +2,7 @@
 """Cost per particle-step of the SEDIMENT effects, as ratios measured in one run on this machine.
 
     /usr/bin/python3 benchmarks/cost.py [--particles 20000] [--steps 2000] [--repeats 3] [--baseline LMP]
-                                        [--scenes plain,drag,...] [--counts]
+                                        [--scenes plain,drag,...] [--counts] [--sweep] [--jobs]
 
 Each scene runs `repeats` times, the scenes taking turns (so that a drift of the machine's speed
 during the run touches every scene alike); the best loop time is kept. LAMMPS reports the loop
@@ -192,6 +192,8 @@ def main() -> None:
                         help="time step of the scenes [s] (default 1e-4: dt/tau = 0.76 for their 30 um grains)")
     parser.add_argument("--sweep", action="store_true",
                         help="the cost at every dt/tau from 1e-4 to 1e4 against the peer at each (see sweep())")
+    parser.add_argument("--jobs", action="store_true",
+                        help="after the ratios, the main job's commands (make demo's) and the example inversion timed")
     args = parser.parse_args()
     args.steps_given = args.steps is not None
     # The references run where they can (EXPLICIT_LIMIT; --sweep takes the peer's cost at dt/tau = 1 past it).
@@ -202,6 +204,8 @@ def main() -> None:
         return
     if args.sweep:
         sweep([s for s in args.scenes if s in SWEPT] or list(SWEPT), args.particles, args.steps or 1000, args.repeats)
+        if args.jobs:
+            time_jobs()
         return
     args.steps = args.steps or 2000
     rounds: list[dict[str, float]] = []
@@ -235,6 +239,35 @@ def main() -> None:
         print(f"baseline: {args.baseline}; the peer and plain scenes run the same code in both builds, so "
               "their ratios show this machine's noise")
     report_targets(times, rounds)
+    if args.jobs:
+        time_jobs()
+
+
+REPO = HERE.parent
+# What a user runs, in order: make demo's two commands (the planner, then the test of sample 5 with
+# its decision, on 2 ranks), and the README's inversion of the example sheets.
+JOBS = [("the planner: sediment plan sample5 --jobs 2", ["bin/sediment", "plan", "examples/granulometry/psd/sample5.csv",
+                                                         "--out", "{out}/plan", "--jobs", "2"]),
+        ("the test: sample, run (2 ranks) and readout of sample 5 with the plan's decision",
+         ["examples/granulometry/run.sh", "sample5", "{out}/sample5", "--plan", "{out}/plan/report.json"]),
+        ("sediment invert of examples/inverse's three sheets",
+         ["bin/sediment", "invert", "examples/inverse/hydrometer.csv", "examples/inverse/pipette.csv",
+          "examples/inverse/buoyancy.csv", "--mass", "0.06", "--out", "{out}/invert"])]
+
+
+def time_jobs() -> None:
+    """Wall time of each of JOBS, once, in a fresh folder."""
+    import time
+
+    with tempfile.TemporaryDirectory() as out:
+        print("wall time of what users run, in this run (fresh folder, once):")
+        for label, command in JOBS:
+            start = time.perf_counter()
+            done = subprocess.run([word.format(out=out) for word in command], cwd=REPO, capture_output=True, text=True,
+                                  env=dict(os.environ, SEDIMENT_RANKS="2"))
+            if done.returncode != 0:
+                raise SystemExit(f"{label} failed: {done.stderr.strip().splitlines()[-1:]}")
+            print(f"  {label:80s} {time.perf_counter() - start:7.1f} s")
 
 
 # Relaxation time of the scene's grains (30 um quartz in water, Stokes): the step's regime is dt/tau.
