@@ -5,26 +5,31 @@ The readings of a test are nearly linear in the mass of each size class: classes
 but for the hindrance, which the whole suspension sets. So:
 
 1. The sheets' standard reduction gives a first PSD.
-2. One DEM run of the test with that PSD (the forward model's best physics: standard drag curve,
-   Richardson & Zaki's hindrance, the water at the sheet's mean temperature) writes each of K + 2 size
-   bins' layer fractions (the grid's `classes`): the finest bin below the first edge, K bins between
-   the readings' smallest and largest Stokes diameters, the coarsest above. Scaling each bin's layers
-   gives the column of any other mass split among the bins, as that run's hindrance left it.
-3. The instruments read those columns at the sheet's times (each time mapped to the run's water by
+2. Each reading cuts the sample at one diameter (`cut_diameters`: the grains the forward model's
+   hindered drag carries past the instrument's depth by the reading's time); the bins' edges are
+   those cuts, with edges added where cuts are far apart (`bin_edges`), so that a reading takes whole
+   bins whatever the PSD's shape inside them.
+3. One DEM run of the test with that PSD (the forward model's best physics: standard drag curve,
+   Richardson & Zaki's hindrance, the water at the sheet's mean temperature), its size classes
+   `SUBCLASSES` per bin, writes each bin's layer fractions (the grid's `classes`) and the two tails'.
+   Scaling each bin's layers gives the column of any other mass split among the bins, as that run's
+   hindrance left it.
+4. The instruments read those columns at the sheet's times (each time mapped to the run's water by
    the temperature record: a grain falls sum(dt / mu) alike), linearised in the bins' masses: a
    constrained least squares (masses >= 0, so the cumulative PSD never falls; their sum the sample's
-   mass; a smoothness penalty on the interior bins chosen so that the fit reaches the readings' noise)
-   gives new masses, two Gauss-Newton steps on the exact readings.
-4. A new run with the new PSD updates the hindrance; rounds go on until the PSD moves by less than
+   mass; a smoothness penalty on the interior bins' mass densities chosen so that the fit reaches
+   the readings' noise) gives new masses, two Gauss-Newton steps on the exact readings.
+5. A new run with the new PSD updates the hindrance; rounds go on until the PSD moves by less than
    0.2 points (at most `rounds`).
-5. The band: the fit again for draws of the reading noise and of the thermometer's offset (the
-   sheet's own uncertainty), twice their spread, and the physics' band of an error budget if given.
+6. The band: the central 95 % of draws of the PSDs the sheets allow (readings, forward model and
+   thermometer drawn from their noise, the penalty aiming at a draw of its prior), with the physics'
+   band of an error budget if given.
 
 Assumptions: the sample mass and particle density are known; within a bin the PSD keeps the shape of
-the first guess; the hindrance of a round's run holds for the fit of that round; the temperature
-record maps times in the Stokes regime. It fails where readings do not resolve a size range (only the
-diameters between the finest and the coarsest reading are reported), and where the sheet is not a
-sedimenting suspension of the given sample (its chi-square says so).
+the run's PSD; the hindrance of a round's run holds for the fit of that round; the temperature
+record maps times in the Stokes regime. Only the diameters between the finest and the coarsest cut
+are reported; between two cuts the answer is the smoothest the readings allow, so a step there is
+rounded. Where the sheet is not a sedimenting suspension of the given sample, its chi-square says so.
 """
 from __future__ import annotations
 
@@ -483,11 +488,10 @@ def invert(sheets: list[Sheet], test: LabTest, folder: Path, *, bins: int = 24, 
         previous = percent
     model, jac = linearise(run, shares, sheets, times)
     chi2 = float(np.sum(((model - data) / sigma) ** 2))
-    # the band: draws of the PSDs the sheets allow, each fit again with the readings drawn from their noise
-    # (and the forward model's), the thermometer's offset drawn, and the smoothness penalty aiming at a
-    # draw of its prior (randomise-then-optimise)
-    # An offset moves every reading's time alike; its effect on the readings is taken as linear (the
-    # readings with the record 1 C warmer): a drawn offset shifts the data the fit aims at.
+    # The band: draws of the PSDs the sheets allow, each fit again with the readings drawn from their
+    # noise (and the forward model's), the thermometer's offset drawn, and the smoothness penalty aiming
+    # at a draw of its prior (randomise-then-optimise). An offset moves every reading's time alike; its
+    # effect on the readings is taken as linear (the readings with the record 1 C warmer).
     per_degree = run.readings(shares, sheets, [effective_times(s, water, 1.0) for s in sheets]) - model
     rng = np.random.default_rng(seed)
     draws_percent = []

@@ -276,8 +276,8 @@ def terminal_speed(suspension: Suspension, diameter: float, law: str) -> float:
 
 
 def plan(psd: PSD, *, geometry: str = "column", cylinder: Cylinder = Cylinder(), mass: float = 0.060,
-         suspension: Suspension = Suspension(), width: float | None = None, classes: int | np.ndarray = 40, particles: int | None = 20000,
-         effects: Effects = Effects(), layers: int = 400, t_end: float = 86400.0, courant: float = 4.0,
+         suspension: Suspension = Suspension(), width: float | None = None, classes: int | np.ndarray = 40,
+         particles: int | None = 20000, effects: Effects = Effects(), layers: int = 400, t_end: float = 86400.0, courant: float = 4.0,
          seed: int = 1) -> Scene:
     """The scene of a test: sub-volume, classes, particles and their placement.
 
@@ -550,6 +550,7 @@ def _deck(scene: Scene, data: str, layer_file: str) -> str:
     d_max = float(scene.diameter.max())
     stages = scene.stages()
     frames_every = scene.frame_steps()
+    segments = _segments(scene, stages, frames_every)
     total_steps = sum(n for _, n in stages)
     c = scene.classes
     when = datetime.now(timezone.utc).strftime("%Y-%m-%d")
@@ -597,7 +598,7 @@ def _deck(scene: Scene, data: str, layer_file: str) -> str:
     lines += [
         "",
         f"fix             grav all gravity {f.gravity:.12g} vector {gravity}",
-        _fluid_line(f if not scene.water_record else _segments(scene, stages[:1], frames_every)[0][2]),
+        _fluid_line(segments[0][2] or f),    # the record's first water, if any: the layer file keeps it
         f"compute         conc all concentration/grid layers {up} {scene.layers} bounds 0 {scene.height:.12g}"
         f"{f' thickness {scene.thickness:.12g}' if slab else ''} weight d_weight every ${{field_every}}"
         + (" classes " + " ".join(f"{d:.12g}" for d in scene.tag_classes) if scene.tag_classes else ""),
@@ -634,7 +635,7 @@ def _deck(scene: Scene, data: str, layer_file: str) -> str:
         "restart.a.bin restart.b.bin",
         "variable        stage_end equal 0",
     ]
-    for dt, steps, water, first in _segments(scene, stages, frames_every):
+    for dt, steps, water, first in segments:
         # the time step set once per stage: LAMMPS adds up the time at each change, and the parts of a
         # stage then end on the same times as the whole stage would
         commands = ([f'"{_fluid_line(water)}"'] if water is not None else []) \
@@ -675,12 +676,12 @@ def _segments(scene: Scene, stages: list[tuple[float, int]],
         frames = np.arange(0, steps, every)
         middle = start + (frames + 0.5 * every) * dt
         level = np.interp(middle, times, temperatures)
-        first = 0
+        begin = 0    # the frame the current part starts at
         for k in range(1, len(frames) + 1):
-            if k == len(frames) or abs(level[k] - level[first]) > DRIFT_STEP:
+            if k == len(frames) or abs(level[k] - level[begin]) > DRIFT_STEP:
                 end = steps if k == len(frames) else frames[k]
-                out.append((dt, int(end - frames[first]), water_at(start + 0.5 * (frames[first] + end) * dt), first == 0))
-                first = k
+                out.append((dt, int(end - frames[begin]), water_at(start + 0.5 * (frames[begin] + end) * dt), begin == 0))
+                begin = k
         start += steps * dt
     return out
 
