@@ -86,6 +86,12 @@ class _ReaderMayLeave(io.TextIOBase):
     def _left(self) -> None:
         os.dup2(os.open(os.devnull, os.O_WRONLY), self.stream.fileno())
 
+    def writable(self) -> bool:
+        return True
+
+    def fileno(self) -> int:
+        return self.stream.fileno()
+
     def write(self, text: str) -> int:
         try:
             return self.stream.write(text)
