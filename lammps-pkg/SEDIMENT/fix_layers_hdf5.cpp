@@ -211,7 +211,7 @@ void copy_file(const std::string &from, const std::string &to)
 }    // namespace
 
 FixLayersHDF5::FixLayersHDF5(LAMMPS *lmp, int narg, char **arg) :
-    Fix(lmp, narg, arg), compute_id(nullptr), fluid_id(nullptr), particle_density(0.0), grid(nullptr), file(-1),
+    Fix(lmp, narg, arg), compute_id(nullptr), particle_density(0.0), grid(nullptr), file(-1),
     frame_sets{-1, -1, -1}, is_open(false), frames(0), last_write(0.0),
     overwrite(false), end_time(-1.0), resumed_frames(-1), last_frame_step(-1)
 {
@@ -226,11 +226,11 @@ FixLayersHDF5::FixLayersHDF5(LAMMPS *lmp, int narg, char **arg) :
     error->all(FLERR, "Fix layers/hdf5: expected a compute reference c_ID, not '{}'", arg[5]);
   compute_id = utils::strdup(arg[5] + 2);
   StyleArgs args(lmp, FLERR, "Fix layers/hdf5", narg, arg, 6);
+  std::string fluid_id;
   while (args.more()) {
     args.need(1, "a value");
     if (args.is("fluid")) {
-      delete[] fluid_id;
-      fluid_id = utils::strdup(args.text(1));
+      fluid_id = args.text(1);
     } else if (args.is("particle_density")) {
       particle_density = args.positive(1, "particle_density");
     } else if (args.is("overwrite")) {
@@ -242,9 +242,9 @@ FixLayersHDF5::FixLayersHDF5(LAMMPS *lmp, int narg, char **arg) :
     }
     args.next(1);
   }
-  if (fluid_id) {
+  if (!fluid_id.empty()) {
     const sediment::Fluid &fluid =
-        FixFluid::find(lmp, fluid_id, "Fix layers/hdf5 (define the fluid before it)")->properties();
+        FixFluid::find(lmp, fluid_id.c_str(), "Fix layers/hdf5 (define the fluid before it)")->properties();
     water = {{"fluid_density", fluid.density}, {"fluid_viscosity", fluid.viscosity},
              {"fluid_yield_stress", fluid.yield_stress}};
   }
@@ -277,7 +277,6 @@ FixLayersHDF5::~FixLayersHDF5()
     }
   }
   delete[] compute_id;
-  delete[] fluid_id;
 }
 
 int FixLayersHDF5::setmask()

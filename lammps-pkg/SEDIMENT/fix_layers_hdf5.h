@@ -38,7 +38,7 @@ class FixLayersHDF5 : public Fix {
 
  private:
   std::string path;
-  char *compute_id, *fluid_id;
+  char *compute_id;
   double particle_density;
   class ComputeConcentrationGrid *grid;
   // The fluid's properties when this fix was defined, stored with the frames: the deck's first water

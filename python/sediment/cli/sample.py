@@ -140,8 +140,7 @@ def run(args: argparse.Namespace) -> int:
                  classes=args.classes, particles=None if args.real_grains else args.particles,
                  effects=effects_of(args, args.contacts, args.lubrication),
                  layers=args.layers, t_end=args.t_end, courant=args.courant, seed=args.seed)
-    if record:
-        scene.water_record = record
+    scene.water_record = record
     print(describe(scene))
     for path in write(scene, args.out, force=args.force):
         print(f"wrote {path}")

@@ -494,10 +494,11 @@ def invert(sheets: list[Sheet], test: LabTest, folder: Path, *, bins: int = 24, 
     # effect on the readings is taken as linear (the readings with the record 1 C warmer).
     per_degree = run.readings(shares, sheets, [effective_times(s, water, 1.0) for s in sheets]) - model
     rng = np.random.default_rng(seed)
+    penalty_rows = len(_penalty(edges))
     draws_percent = []
     for _ in range(draws):
         noisy = data + rng.normal(0.0, sigma) - rng.normal(0.0, test.thermometer) * per_degree
-        x, _, _ = fit(jac, model, shares, noisy, sigma, edges, weight, rng.normal(0.0, 1.0, len(_penalty(edges))))
+        x, _, _ = fit(jac, model, shares, noisy, sigma, edges, weight, rng.normal(0.0, 1.0, penalty_rows))
         draws_percent.append(100 * np.cumsum(x)[:-1])
     percent = 100 * np.cumsum(shares)[:-1]
     low, high = np.percentile(draws_percent, [2.5, 97.5], axis=0) if draws > 1 else (percent, percent)

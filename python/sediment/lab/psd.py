@@ -145,10 +145,15 @@ class SizeClasses:
         return PSD(self.edges, np.minimum(cumulative, 100.0), name="simulated")
 
 
+def log_bounds(lo: float, hi: float, classes: int) -> np.ndarray:
+    """The bounds of `classes` log-equal classes from lo to hi."""
+    return np.exp(np.linspace(np.log(lo), np.log(hi), classes + 1))
+
+
 def log_classes(psd: PSD, lo: float, hi: float, classes: int) -> tuple[np.ndarray, np.ndarray]:
     """Diameters at the centres of `classes` log-equal bins between lo and hi, and the mass fraction
     of the PSD in each bin."""
-    return classes_between(psd, np.exp(np.linspace(np.log(lo), np.log(hi), classes + 1)))
+    return classes_between(psd, log_bounds(lo, hi, classes))
 
 
 def classes_between(psd: PSD, bounds: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -190,8 +195,7 @@ def discretise(psd: PSD, classes: int | np.ndarray, sample_mass: float, particle
     if np.ndim(classes) == 0:
         if classes < 2:
             raise PSDError("need at least 2 size classes")
-        lo, hi = psd.span()
-        bounds = np.exp(np.linspace(np.log(lo), np.log(hi), int(classes) + 1))
+        bounds = log_bounds(*psd.span(), int(classes))
     else:
         bounds = np.asarray(classes, float)
         if len(bounds) < 3 or not np.all(np.diff(bounds) > 0) or bounds[0] <= 0:

@@ -134,13 +134,10 @@ class Column:
         """Suspension density rho_f + (rho_p - rho_f) phi per layer [kg/m3]."""
         return self.suspension.mixture_density(self.at(t))
 
-    def mass_above(self, depth, t: float) -> np.ndarray:
-        """Integral of the suspension density from the surface to `depth` [kg/m2], exact for
-        layer-wise constant density (linear inside a layer); clear fluid below the column."""
-        return self.mass_profile(t)(depth)
-
     def mass_profile(self, t: float):
-        """`mass_above` at time t as a function of depth alone (the profile summed once)."""
+        """The integral of the suspension density from the surface to a depth [kg/m2] at time t, as a
+        function of the depth (the profile summed once): exact for layer-wise constant density
+        (linear inside a layer); clear fluid below the column."""
         cumulative = np.concatenate([[0.0], np.cumsum(self.density(t) * np.diff(self.depth_edges))])
 
         def above(depth):

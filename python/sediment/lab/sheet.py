@@ -65,8 +65,6 @@ def read_sheet(path: str | Path, pipette_volume: float = 25e-6) -> Sheet:
         raise SheetError(f"{path}: no readings below the header")
     values: dict[str, list[float]] = {name: [] for name in header}
     for number, row in enumerate(rows, start=2):
-        if len(row) != len(header):
-            raise SheetError(f"{path}, row {number}: {len(row)} fields, the header has {len(header)}")
         for name, text in zip(header, row):
             text = text.strip()
             if text == "" and name == "temperature_C":
@@ -109,7 +107,7 @@ def read_sheet(path: str | Path, pipette_volume: float = 25e-6) -> Sheet:
 
 
 def _table(path: Path) -> tuple[list[str], list[list[str]]]:
-    """A CSV's header and rows (blank lines and # comments left out)."""
+    """A CSV's header and rows (blank lines and # comments left out), each row as long as the header."""
     try:
         with path.open(newline="") as handle:
             rows = [row for row in csv.reader(handle) if row and not row[0].lstrip().startswith("#")]
@@ -117,7 +115,11 @@ def _table(path: Path) -> tuple[list[str], list[list[str]]]:
         raise SheetError(f"{path}: not a text CSV ({exc.reason})") from None
     if not rows:
         raise SheetError(f"{path}: empty sheet")
-    return [h.strip() for h in rows[0]], rows[1:]
+    header = [h.strip() for h in rows[0]]
+    for number, row in enumerate(rows[1:], start=2):
+        if len(row) != len(header):
+            raise SheetError(f"{path}, row {number}: {len(row)} fields, the header has {len(header)}")
+    return header, rows[1:]
 
 
 def read_temperature_record(path: str | Path) -> tuple[tuple[float, float], ...]:
@@ -132,8 +134,6 @@ def read_temperature_record(path: str | Path) -> tuple[tuple[float, float], ...]
     at, column = header.index("time_min"), header.index("temperature_C")
     record = []
     for number, row in enumerate(rows, start=2):
-        if len(row) != len(header):
-            raise SheetError(f"{path}, row {number}: {len(row)} fields, the header has {len(header)}")
         if row[column].strip() == "":
             continue
         try:
