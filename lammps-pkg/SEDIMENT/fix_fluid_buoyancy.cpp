@@ -6,6 +6,7 @@
 
 #include "fix_fluid_buoyancy.h"
 #include "sediment_args.h"
+#include "sediment_rows.h"
 
 #include "compute_concentration_grid.h"
 #include "fix_fluid.h"
@@ -140,9 +141,9 @@ void FixFluidBuoyancy::setup(int vflag)
 
 void FixFluidBuoyancy::post_force(int /*vflag*/)
 {
-  double **x = atom->x;
-  double **f = atom->f;
-  double *radius = atom->radius;
+  const auto x = flat_rows<3>(atom->x);
+  const auto f = flat_rows<3>(atom->f);
+  const double *radius = atom->radius;
   int *mask = atom->mask;
   const int nlocal = atom->nlocal;
   const double rho = fluid->properties().density;

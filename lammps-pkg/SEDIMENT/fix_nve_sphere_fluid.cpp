@@ -6,6 +6,7 @@
 
 #include "fix_nve_sphere_fluid.h"
 #include "sediment_args.h"
+#include "sediment_rows.h"
 
 #include "fix_fluid.h"
 #include "fix_fluid_drag.h"
@@ -71,8 +72,11 @@ static inline std::array<double, 3> nve_sphere_kick(double *v, double *omega, co
 }
 
 // The per-atom arrays both halves of the step read, taken anew in each half (exchanges move them).
+// Rows of 3 (sediment_rows.h): found from the atom's index, not a row pointer.
+using Rows3 = double (*)[3];
+
 struct SphereArrays {
-  double **x, **v, **f, **omega, **torque;
+  Rows3 x, v, f, omega, torque;
   const double *radius, *rmass;
   const int *mask;
   int nlocal;
@@ -80,7 +84,9 @@ struct SphereArrays {
 
 static inline SphereArrays sphere_arrays(const Atom *atom)
 {
-  return {atom->x, atom->v, atom->f, atom->omega, atom->torque, atom->radius, atom->rmass, atom->mask, atom->nlocal};
+  return {flat_rows<3>(atom->x),     flat_rows<3>(atom->v),      flat_rows<3>(atom->f),
+          flat_rows<3>(atom->omega), flat_rows<3>(atom->torque), atom->radius,
+          atom->rmass,               atom->mask,                 atom->nlocal};
 }
 
 // The sum of an atom's position and velocity: NaN or inf when any of them is (or when it overflows).
@@ -247,6 +253,10 @@ template <FixNVESphereFluid::HalfStep path, bool is_uniform, class Lookup>
 void FixNVESphereFluid::first_half(Lookup lookup)
 {
   const auto [x, v, f, omega, torque, radius, rmass, mask, nlocal] = sphere_arrays(atom);
+  const auto weight_rows = flat_rows<NWEIGHTS>(weights);
+  const auto general_rows = flat_rows<NGENERAL>(general);
+  const auto drag_memo_rows = flat_rows<sediment::PHI_MEMO_SIZE>(drag_memos);
+  const auto spin_memo_rows = flat_rows<sediment::PHI_MEMO_SIZE>(spin_memos);
   const int floor_dim = floor_axis;    // locals: the stores into the atom arrays cannot change them
   const double floor_at = floor_level;
   const double dt = update->dt;
@@ -279,10 +289,10 @@ void FixNVESphereFluid::first_half(Lookup lookup)
     } else {
       const double per_inertia = ftm2v / sediment::sphere_inertia(rmass[i], radius[i]);
       const double alpha[3] = {torque[i][0] * per_inertia, torque[i][1] * per_inertia, torque[i][2] * per_inertia};
-      spin = sediment::rotation_step_initial(spin_rate, alpha, dt, omega[i], spin_memos[i]) * per_inertia;
+      spin = sediment::rotation_step_initial(spin_rate, alpha, dt, omega[i], spin_memo_rows[i]) * per_inertia;
     }
-    if constexpr (keeps_all) general[i][SPIN] = spin;
-    if constexpr (keeps_weights) sediment::pack_weights(corr, per_mass, weights[i]);
+    if constexpr (keeps_all) general_rows[i][SPIN] = spin;
+    if constexpr (keeps_weights) sediment::pack_weights(corr, per_mass, weight_rows[i]);
     if (floor_dim >= 0) settle_on_floor(x[i], v[i], omega[i], radius[i], floor_dim, floor_at);
     return state;
   };
@@ -332,7 +342,7 @@ void FixNVESphereFluid::first_half(Lookup lookup)
     double spin_rate = 0.0;
     lookup(i, sphere, flow, spin_rate);
 
-    if constexpr (keeps_all) general[i][IN_FLUID] = sphere.model ? 1.0 : 0.0;
+    if constexpr (keeps_all) general_rows[i][IN_FLUID] = sphere.model ? 1.0 : 0.0;
     if (!sphere.model) {
       counts[OUTSIDE] += 1.0;
       state += nve_sphere_kick_drift(x[i], v[i], omega[i], f[i], torque[i], radius[i], rmass[i], kick, dt);
@@ -346,8 +356,8 @@ void FixNVESphereFluid::first_half(Lookup lookup)
         (linear || sediment::step_kind(sphere) != sediment::StepKind::SetValued)) {
       // Held: no weights, and no torque's either (a uniform step's second half gives it fix nve/sphere's,
       // and settle_on_floor takes the rotation away again, as the sphere's velocity stays 0).
-      std::fill(weights[i], weights[i] + NWEIGHTS, 0.0);
-      if constexpr (keeps_all) general[i][SPIN] = 0.0;
+      std::fill(weight_rows[i], weight_rows[i] + NWEIGHTS, 0.0);
+      if constexpr (keeps_all) general_rows[i][SPIN] = 0.0;
       state += state_sum(x[i], v[i]);    // its position along the floor is not among what the test reads
       settle_on_floor(x[i], v[i], omega[i], radius[i], floor_dim, floor_at);    // where it is, its rotation stopped
       continue;
@@ -359,7 +369,7 @@ void FixNVESphereFluid::first_half(Lookup lookup)
     const double a[3] = {f[i][0] * per_mass, f[i][1] * per_mass, f[i][2] * per_mass};
     double dx[3];
     if constexpr (linear) {    // sphere.diameter * c, as the law's linear_coefficient
-      const sediment::Phi &p = linear_decay.phis(sphere.diameter, per_mass, drag_memos[i]);
+      const sediment::Phi &p = linear_decay.phis(sphere.diameter, per_mass, drag_memo_rows[i]);
       state += finish(i, sediment::linear_step_initial(p, a, flow, dt, v[i], dx), dx, spin_rate, per_mass);
       continue;
     }
@@ -377,7 +387,7 @@ void FixNVESphereFluid::first_half(Lookup lookup)
         continue;
       }
     }
-    state += finish(i, sediment::drag_step_initial(sphere, per_mass, a, flow, dt, v[i], dx, drag_memos[i]),
+    state += finish(i, sediment::drag_step_initial(sphere, per_mass, a, flow, dt, v[i], dx, drag_memo_rows[i]),
                     dx, spin_rate, per_mass);
   }
   if (blocks && block.size() > 0) state += step_block();
@@ -468,6 +478,9 @@ void FixNVESphereFluid::initial_integrate(int /*vflag*/)
 void FixNVESphereFluid::final_integrate()
 {
   const auto [x, v, f, omega, torque, radius, rmass, mask, nlocal] = sphere_arrays(atom);
+  const auto weight_rows = flat_rows<NWEIGHTS>(weights);
+  const auto general_rows = flat_rows<NGENERAL>(general);
+  const auto drag_memo_rows = flat_rows<sediment::PHI_MEMO_SIZE>(drag_memos);
   const int floor_dim = floor_axis;
   const double floor_at = floor_level;
   const double ftm2v = force->ftm2v;
@@ -500,7 +513,7 @@ void FixNVESphereFluid::final_integrate()
         continue;
       }
       const double per_mass = ftm2v / rmass[i];
-      const double along = dt * linear_decay.phis(2.0 * radius[i], per_mass, drag_memos[i]).phi2 * per_mass;
+      const double along = dt * linear_decay.phis(2.0 * radius[i], per_mass, drag_memo_rows[i]).phi2 * per_mass;
       sediment::add_weighted_acceleration(along, along, nullptr, f[i], v[i]);
       nve_sphere_spin(omega[i], torque[i], radius[i], rmass[i], kick);
     }
@@ -514,16 +527,16 @@ void FixNVESphereFluid::final_integrate()
     const int drag_bit = uniform ? uniform->groupbit : 0;
     for (int i = 0; i < nlocal; ++i) {
       if (!(mask[i] & groupbit)) continue;
-      if (is_uniform ? !(mask[i] & drag_bit) : general[i][IN_FLUID] == 0.0) {
+      if (is_uniform ? !(mask[i] & drag_bit) : general_rows[i][IN_FLUID] == 0.0) {
         nve_sphere_kick(v[i], omega[i], f[i], torque[i], radius[i], rmass[i], kick);
       } else {
         // The weights are per unit mass: the step is linear in the force, so f takes the place of a = f / m.
         if constexpr (is_uniform) {
-          sediment::add_packed_weighted_acceleration(weights[i], f[i], v[i]);
+          sediment::add_packed_weighted_acceleration(weight_rows[i], f[i], v[i]);
           nve_sphere_spin(omega[i], torque[i], radius[i], rmass[i], kick);
         } else {
-          const double spin = general[i][SPIN];    // read first: the stores into v could alias it
-          sediment::add_packed_weighted_acceleration(weights[i], f[i], v[i]);
+          const double spin = general_rows[i][SPIN];    // read first: the stores into v could alias it
+          sediment::add_packed_weighted_acceleration(weight_rows[i], f[i], v[i]);
           omega[i][0] += spin * torque[i][0];
           omega[i][1] += spin * torque[i][1];
           omega[i][2] += spin * torque[i][2];
