@@ -96,10 +96,11 @@ namespace {
     exp_many(decay, decay, n, kind);
     for (int k = 0; any_large && k < n; ++k) decay[k] = z[k] > normal_decay_limit ? 0.0 : decay[k];
   } else {
-    std::fill(decay, decay + n, 0.0);
+    for (int k = 0; k < n; ++k) decay[k] = 0.0;
   }
   // The direct forms for all (one vector loop); the series and the subnormal band replace theirs below.
-  for (int k = 0; k < n; ++k) {
+  // Not where every rate takes the series (steps limited by contacts): their divisions would be lost.
+  for (int k = 0; (any_direct || any_large) && k < n; ++k) {
     const double inverse = 1.0 / z[k];
     phi1[k] = (1.0 - decay[k]) * inverse;
     phi2[k] = (z[k] - 1.0 + decay[k]) * inverse * inverse;
@@ -122,10 +123,13 @@ namespace {
       any_eighteen |= (size >= ten_terms_limit) & (size < series_limit);
     }
     const int most = any_eighteen ? 18 : any_ten ? 10 : 6;
-    for (int k = 0; k < m; ++k) {    // the first term of the sum from zero: 0 z + c is c
-      const bool used = most - 1 < terms[k];
-      p1[k] = used ? series.phi1[most - 1] : 0.0;
-      p2[k] = used ? series.phi2[most - 1] : 0.0;
+    // The first term of the sum from zero (0 z + c is c); its coefficients read before the loop, whose
+    // loads GCC would not take for every rate (it kept the loop scalar, with a branch per rate).
+    const double top1 = series.phi1[most - 1], top2 = series.phi2[most - 1], top = most - 1;
+    for (int k = 0; k < m; ++k) {
+      const bool used = top < terms[k];
+      p1[k] = used ? top1 : 0.0;
+      p2[k] = used ? top2 : 0.0;
     }
     for (int t = most - 2; t >= 0; --t) {
       const double c1 = series.phi1[t], c2 = series.phi2[t], index = t;
@@ -135,11 +139,15 @@ namespace {
         p2[k] = p2[k] * zc[k] + (used ? c2 : 0.0);
       }
     }
+    // Every rate's values read and written again, the series' or their own: a store only where the
+    // series applies kept this loop scalar.
+    double *decay_c = decay + start, *phi1_c = phi1 + start, *phi2_c = phi2 + start;
     for (int k = 0; k < m; ++k) {
       const bool small = terms[k] > 0.0;
-      decay[start + k] = small ? 1.0 - zc[k] * p1[k] : decay[start + k];
-      phi1[start + k] = small ? p1[k] : phi1[start + k];
-      phi2[start + k] = small ? p2[k] : phi2[start + k];
+      const double own[3] = {decay_c[k], phi1_c[k], phi2_c[k]};
+      decay_c[k] = small ? 1.0 - zc[k] * p1[k] : own[0];
+      phi1_c[k] = small ? p1[k] : own[1];
+      phi2_c[k] = small ? p2[k] : own[2];
     }
   }
   // e^-z subnormal: phis(), whose phi1 and phi2 equal the direct forms' with 0 (1 - e^-z rounds to 1

@@ -23,6 +23,7 @@
 #include <cmath>
 #include <cstring>
 #include <mpi.h>
+#include <type_traits>
 
 using namespace LAMMPS_NS;
 using namespace FixConst;
@@ -155,25 +156,41 @@ void FixFluidBuoyancy::post_force(int /*vflag*/)
   // Local sums: a store into the fix inside the loop would alias the force array.
   double sum[3] = {0.0, 0.0, 0.0};
   int immersed = 0;
-  const bool everywhere = fluid->fills_space();    // tested once, not per atom
-  for (int i = 0; i < nlocal; ++i) {
-    if (!(mask[i] & groupbit)) continue;
-    const sediment::Submergence sub =
-        everywhere ? sediment::Submergence{1.0, 1.0, 1.0} : fluid->immersion(x[i], radius[i]);
-    if (!sub.any()) continue;
-    // The suspension around the sphere, or the clear fluid. The local fraction is capped as the drag
-    // caps it: where parcels stop on a floor without contacts their grid fraction exceeds any packing
-    // (even 1), and an uncapped mixture would float the deposit.
-    const double density =
-        fraction ? sediment::mixture_density(rho, solid_density, std::clamp(fraction[i], 0.0, max_fraction)) : rho;
-    const double displaced = sediment::displaced_mass(density, radius[i], sub);
-    for (int k = 0; k < 3; ++k) {
-      const double fb = -displaced * g[k];
-      f[i][k] += fb;
-      sum[k] += fb;
+  // The loop compiled for a fluid that fills space or not and with a mixture or not: with the tests
+  // inside, the common case (clear fluid everywhere) took 41 instructions per atom.
+  auto add_buoyancy = [&](auto fills_space, auto with_mixture) {
+    for (int i = 0; i < nlocal; ++i) {
+      if (!(mask[i] & groupbit)) continue;
+      sediment::Submergence sub{1.0, 1.0, 1.0};
+      if constexpr (!decltype(fills_space)::value) {
+        sub = fluid->immersion(x[i], radius[i]);
+        if (!sub.any()) continue;
+      }
+      // The suspension around the sphere, or the clear fluid. The local fraction is capped as the drag
+      // caps it: where parcels stop on a floor without contacts their grid fraction exceeds any packing
+      // (even 1), and an uncapped mixture would float the deposit.
+      double density = rho;
+      if constexpr (decltype(with_mixture)::value)
+        density = sediment::mixture_density(rho, solid_density, std::clamp(fraction[i], 0.0, max_fraction));
+      const double displaced = sediment::displaced_mass(density, radius[i], sub);
+      for (int k = 0; k < 3; ++k) {
+        const double fb = -displaced * g[k];
+        f[i][k] += fb;
+        sum[k] += fb;
+      }
+      ++immersed;
     }
-    ++immersed;
-  }
+  };
+  auto with_or_without_mixture = [&](auto fills_space) {
+    if (fraction)
+      add_buoyancy(fills_space, std::true_type{});
+    else
+      add_buoyancy(fills_space, std::false_type{});
+  };
+  if (fluid->fills_space())
+    with_or_without_mixture(std::true_type{});
+  else
+    with_or_without_mixture(std::false_type{});
   totals.clear();
   for (int k = 0; k < 3; ++k) totals[k] = sum[k];
   totals[3] = immersed;

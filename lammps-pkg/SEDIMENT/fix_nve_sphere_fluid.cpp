@@ -284,7 +284,7 @@ void FixNVESphereFluid::first_half(Lookup lookup)
     if (corr.state == sediment::SlipState::HeldAtJump) counts[AT_JUMP] += 1.0;
 
     double spin;
-    if (spin_rate == 0.0) {    // no rotational drag: fix nve/sphere's kick, in fewer operations
+    if (is_uniform || spin_rate == 0.0) {    // no rotational drag: fix nve/sphere's kick, in fewer operations
       spin = nve_sphere_spin(omega[i], torque[i], radius[i], rmass[i], kick);
     } else {
       const double per_inertia = ftm2v / sediment::sphere_inertia(rmass[i], radius[i]);
@@ -374,8 +374,11 @@ void FixNVESphereFluid::first_half(Lookup lookup)
       continue;
     }
     if constexpr (blocks) {
-      if (path == HalfStep::Smooth ? sediment::step_kind(sphere) == sediment::StepKind::Smooth
-                                   : sediment::steps_in_block(sphere, v[i], flow)) {
+      // Under the uniform drag of a smooth law every sphere in the fluid is wholly immersed: each steps
+      // in the block, and none is asked.
+      if ((path == HalfStep::Smooth && is_uniform) ||
+          (path == HalfStep::Smooth ? sediment::step_kind(sphere) == sediment::StepKind::Smooth
+                                    : sediment::steps_in_block(sphere, v[i], flow))) {
         if (sphere.model != block.law()) {    // a block per law, and so per fluid/drag fix and flow
           if (block.size() > 0) state += step_block();
           block.set_law(*sphere.model, flow);

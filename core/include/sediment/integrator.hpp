@@ -22,6 +22,7 @@
 #include <cassert>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 
 namespace sediment {
 
@@ -341,7 +342,11 @@ inline void add_packed_weighted_acceleration(const double packed[PACKED_WEIGHTS_
   const double accel[3] = {a[0], a[1], a[2]};
   const double across = std::abs(packed[0]);
   const double scaled_dir[3] = {packed[1], packed[2], packed[3]};
-  if (scaled_dir[0] == 0.0 && scaled_dir[1] == 0.0 && scaled_dir[2] == 0.0) {
+  // All three == 0.0 (either sign), tested on their bits: three floating-point compares with their
+  // unordered cases took 15 instructions per atom of the second half.
+  std::uint64_t bits[3];
+  std::memcpy(bits, scaled_dir, sizeof bits);
+  if (((bits[0] | bits[1] | bits[2]) << 1) == 0) {
     for (int k = 0; k < 3; ++k) v[k] += across * accel[k];
     return;
   }
