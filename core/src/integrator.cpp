@@ -7,25 +7,25 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <iterator>
 #include <limits>
 
 namespace sediment {
 
 namespace {
 
-// Taylor coefficients (-1)^n / (n + 1)! and (-1)^n / (n + 2)! for n = 0 .. 17: with |z| < 0.5 the
-// truncated series are exact to round-off, where the direct forms lose digits to cancellation.
+// Taylor coefficients (-1)^n / (n + 2)! of phi2 for n = 0 .. 15: with |z| < 0.5 the truncated series
+// is exact to round-off, where the direct form loses digits to cancellation. phi1 = 1 - z phi2 and
+// e^-z = 1 - z phi1 follow without cancellation there (each is near 1), so one series gives all three.
 struct SeriesCoefficients {
-  double phi1[18];
-  double phi2[18];
-  constexpr SeriesCoefficients() : phi1(), phi2()
+  static constexpr int most_terms = 16;
+  double phi2[most_terms];
+  constexpr SeriesCoefficients() : phi2()
   {
-    double factorial = 1.0;    // (n + 1)!
-    for (int n = 0; n < 18; ++n) {
-      factorial *= (n + 1);
-      const double sign = n % 2 ? -1.0 : 1.0;
-      phi1[n] = sign / factorial;
-      phi2[n] = sign / (factorial * (n + 2));
+    double factorial = 1.0;    // (n + 2)!
+    for (int n = 0; n < most_terms; ++n) {
+      factorial *= (n + 2);
+      phi2[n] = (n % 2 ? -1.0 : 1.0) / factorial;
     }
   }
 };
@@ -45,13 +45,28 @@ constexpr double decay_limit = 745.2;
 // (subnormal or zero) the vector exp falls back to the scalar exp, lane by lane, and its slow path.
 constexpr double normal_decay_limit = 708.0;
 
-// As many terms of the series as round-off needs at this |z| < 0.5 (the first one left out is below
-// 1e-19 of the sum): steps limited by contacts are far below the relaxation time, and z is tiny there.
-// Below series_limit the series replaces the direct forms; six terms do below 2^-10, ten below 1/16.
-constexpr double series_limit = 0.5, six_terms_limit = 0x1p-10, ten_terms_limit = 0.0625;
+// As many terms of the series as round-off needs at this |z| < 0.5: the first one left out,
+// |z|^N / (N + 2)!, is below 4e-20, a tenth of the last bit of phi2 (>= 0.42 there). Steps limited by
+// contacts are far below the relaxation time, and z is tiny there: six terms do below 2^-9.
+constexpr double series_limit = 0.5;
+struct SeriesRange {
+  double below;    // |z| below this
+  int terms;
+};
+constexpr SeriesRange series_ranges[] = {{0x1p-9, 6}, {0x1p-6, 8}, {0x1p-4, 10}, {0x1p-3, 12}, {0x1p-2, 14}};
 inline int series_terms(double z)
 {
-  return std::abs(z) < six_terms_limit ? 6 : std::abs(z) < ten_terms_limit ? 10 : 18;
+  const double size = std::abs(z);
+  int terms = SeriesCoefficients::most_terms;
+  for (int r = std::size(series_ranges) - 1; r >= 0; --r) terms = size < series_ranges[r].below ? series_ranges[r].terms : terms;
+  return terms;
+}
+
+// phi1 and e^-z from the series' phi2.
+inline Phi phis_from_series(double z, double p2)
+{
+  const double p1 = 1.0 - z * p2;
+  return {1.0 - z * p1, p1, p2};
 }
 
 }    // namespace
@@ -61,12 +76,9 @@ Phi phis(double z)
   if (z == 0.0) return {1.0, 1.0, 0.5};
   if (std::abs(z) < series_limit) {
     const int terms = series_terms(z);
-    double p1 = series.phi1[terms - 1], p2 = series.phi2[terms - 1];
-    for (int n = terms - 2; n >= 0; --n) {
-      p1 = p1 * z + series.phi1[n];
-      p2 = p2 * z + series.phi2[n];
-    }
-    return {1.0 - z * p1, p1, p2};
+    double p2 = series.phi2[terms - 1];
+    for (int n = terms - 2; n >= 0; --n) p2 = p2 * z + series.phi2[n];
+    return phis_from_series(z, p2);
   }
   return phis_from_decay(z, z > decay_limit ? 0.0 : std::exp(-z));
 }
@@ -111,43 +123,40 @@ namespace {
   // own count at zero, so it stays exactly 0 until its count's last term and then is phis()'s sum,
   // bit for bit.
   constexpr int chunk = 32;    // a block's rates, in registers
+  constexpr int nranges = std::size(series_ranges);
   for (int start = 0; any_small && start < n; start += chunk) {
     const int m = std::min(chunk, n - start);
     const double *zc = z + start;
-    double terms[chunk], p1[chunk], p2[chunk];
-    std::int64_t any_ten = 0, any_eighteen = 0;    // the most terms a rate needs, from two vector tests
+    double terms[chunk], p2[chunk];
+    // The most terms a rate needs, from a vector test per range: whether some rate is past it.
+    std::int64_t past[nranges] = {};
     for (int k = 0; k < m; ++k) {
       const double size = std::abs(zc[k]);
-      terms[k] = size < series_limit ? series_terms(zc[k]) : 0.0;
-      any_ten |= size >= six_terms_limit;
-      any_eighteen |= (size >= ten_terms_limit) & (size < series_limit);
+      const bool small = size < series_limit;
+      terms[k] = small ? series_terms(zc[k]) : 0.0;
+      for (int r = 0; r < nranges; ++r) past[r] |= small & (size >= series_ranges[r].below);
     }
-    const int most = any_eighteen ? 18 : any_ten ? 10 : 6;
-    // The first term of the sum from zero (0 z + c is c); its coefficients read before the loop, whose
-    // loads GCC would not take for every rate (it kept the loop scalar, with a branch per rate).
-    const double top1 = series.phi1[most - 1], top2 = series.phi2[most - 1], top = most - 1;
-    for (int k = 0; k < m; ++k) {
-      const bool used = top < terms[k];
-      p1[k] = used ? top1 : 0.0;
-      p2[k] = used ? top2 : 0.0;
-    }
+    int most = series_ranges[0].terms;
+    for (int r = 0; r < nranges; ++r)
+      if (past[r]) most = r + 1 < nranges ? series_ranges[r + 1].terms : SeriesCoefficients::most_terms;
+    // The first term of the sum from zero (0 z + c is c); its coefficient read before the loop, whose
+    // load GCC would not take for every rate (it kept the loop scalar, with a branch per rate).
+    const double top_coefficient = series.phi2[most - 1], top = most - 1;
+    for (int k = 0; k < m; ++k) p2[k] = top < terms[k] ? top_coefficient : 0.0;
     for (int t = most - 2; t >= 0; --t) {
-      const double c1 = series.phi1[t], c2 = series.phi2[t], index = t;
-      for (int k = 0; k < m; ++k) {
-        const bool used = index < terms[k];
-        p1[k] = p1[k] * zc[k] + (used ? c1 : 0.0);
-        p2[k] = p2[k] * zc[k] + (used ? c2 : 0.0);
-      }
+      const double c = series.phi2[t], index = t;
+      for (int k = 0; k < m; ++k) p2[k] = p2[k] * zc[k] + (index < terms[k] ? c : 0.0);
     }
     // Every rate's values read and written again, the series' or their own: a store only where the
     // series applies kept this loop scalar.
     double *decay_c = decay + start, *phi1_c = phi1 + start, *phi2_c = phi2 + start;
     for (int k = 0; k < m; ++k) {
       const bool small = terms[k] > 0.0;
-      const double own[3] = {decay_c[k], phi1_c[k], phi2_c[k]};
-      decay_c[k] = small ? 1.0 - zc[k] * p1[k] : own[0];
-      phi1_c[k] = small ? p1[k] : own[1];
-      phi2_c[k] = small ? p2[k] : own[2];
+      const Phi own{decay_c[k], phi1_c[k], phi2_c[k]};
+      const Phi from_series = phis_from_series(zc[k], p2[k]);
+      decay_c[k] = small ? from_series.decay : own.decay;
+      phi1_c[k] = small ? from_series.phi1 : own.phi1;
+      phi2_c[k] = small ? from_series.phi2 : own.phi2;
     }
   }
   // e^-z subnormal: phis(), whose phi1 and phi2 equal the direct forms' with 0 (1 - e^-z rounds to 1

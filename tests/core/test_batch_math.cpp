@@ -112,10 +112,11 @@ TEST(BatchMath, PhisManyFollowPhisOnBothSidesOfTheSeriesAndTheUnderflow)
 {
   std::vector<double> z = uniform(-0.6, 4.0, 2000, 4);
   for (double extra : {0.0, -0.0, 0.5, 1e-12, 707.9, 708.0, 708.1, 745.0, 745.3, 5000.0, 1e-300}) z.push_back(extra);
-  // every count of the series' terms, on both sides of its limits (6 below 2^-10, 10 below 1/16, 18)
-  for (double extra : {1e-5, -1e-5, 0x1p-10, std::nextafter(0x1p-10, 0.0), 0.03, 0.0625, std::nextafter(0.0625, 0.0),
-                       0.1, 0.3, std::nextafter(0.5, 0.0), -0.49})
-    z.push_back(extra);
+  // every count of the series' terms, on both sides of its limits (6 below 2^-9, 8, 10, 12 and 14 below
+  // 2^-6, 2^-4, 2^-3 and 2^-2, 16 below 1/2)
+  for (double limit : {0x1p-9, 0x1p-6, 0x1p-4, 0x1p-3, 0x1p-2, 0.5})
+    for (double extra : {limit, std::nextafter(limit, 0.0), -std::nextafter(limit, 0.0), 0.7 * limit}) z.push_back(extra);
+  for (double extra : {1e-5, -1e-5, -0.49}) z.push_back(extra);
   const size_t n = z.size();
   std::vector<double> decay(n), p1(n), p2(n);
   phis_many(z.data(), decay.data(), p1.data(), p2.data(), static_cast<int>(n));
@@ -141,8 +142,8 @@ TEST(BatchMath, PhisManyOfOneRegimeFollowPhis)
 {
   const std::vector<std::vector<double>> groups = {
       {1e-5, -3e-4, 2e-6, 1e-12},                              // six terms
-      {1e-5, 0.03, -0.05, 0x1p-10},                            // six and ten
-      {0.3, -0.2, 1e-7, 0.49},                                 // up to eighteen
+      {1e-5, 0.03, -0.05, 0x1p-9},                             // six to ten
+      {0.3, -0.2, 1e-7, 0.49},                                 // up to sixteen
       {800.0, 708.5, 745.0, 1e6, 5000.0},                      // e^-z subnormal or zero
       {0.01, 900.0, 720.0},                                    // series and underflow, no direct form
   };
