@@ -12,6 +12,7 @@
 
 #include <algorithm>
 #include <array>
+#include <memory>
 #include <random>
 #include <vector>
 
@@ -21,12 +22,13 @@ constexpr int spheres = 20000;
 constexpr double radius = 1.5e-5;
 constexpr double box[3] = {0.004, 0.004, 0.02};
 
-std::vector<std::array<double, 3>> centres()
+// Rows of three coordinates in one block, as LAMMPS keeps positions.
+std::unique_ptr<double[][3]> centres()
 {
   std::mt19937_64 random(11);
-  std::vector<std::array<double, 3>> out(spheres);
-  for (auto &c : out)
-    for (int d = 0; d < 3; ++d) c[d] = std::uniform_real_distribution<double>(0.0, box[d])(random);
+  auto out = std::make_unique<double[][3]>(spheres);
+  for (int i = 0; i < spheres; ++i)
+    for (int d = 0; d < 3; ++d) out[i][d] = std::uniform_real_distribution<double>(0.0, box[d])(random);
   return out;
 }
 
@@ -56,7 +58,7 @@ void deposit(benchmark::State &state, const sediment::Grid &grid)
   const auto at = centres();
   std::vector<double> values(grid.cells());
   for (auto _ : state) {
-    for (const auto &c : at) sediment::add_sphere_to_grid(grid, c.data(), radius, values.data());
+    for (int i = 0; i < spheres; ++i) sediment::add_sphere_to_grid(grid, at[i], radius, values.data());
     benchmark::DoNotOptimize(values.data());
   }
   state.SetItemsProcessed(state.iterations() * spheres);
@@ -67,13 +69,9 @@ void interpolate(benchmark::State &state, const sediment::Grid &grid)
 {
   const auto at = centres();
   std::vector<double> values(grid.cells(), 0.01), out(spheres);
-  std::vector<const double *> rows;
-  for (const auto &c : at) {
-    sediment::add_sphere_to_grid(grid, c.data(), radius, values.data());
-    rows.push_back(c.data());
-  }
+  for (int i = 0; i < spheres; ++i) sediment::add_sphere_to_grid(grid, at[i], radius, values.data());
   for (auto _ : state) {
-    sediment::grid_values_at(grid, values.data(), rows.data(), spheres, out.data());
+    sediment::grid_values_at(grid, values.data(), at.get(), spheres, out.data());
     benchmark::DoNotOptimize(out.data());
   }
   state.SetItemsProcessed(state.iterations() * spheres);

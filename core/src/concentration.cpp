@@ -418,7 +418,7 @@ __attribute__((target("avx2"))) inline __m256d below4(__m256d radius, __m256d u)
 }
 
 // Coordinate d of rows i to i + 3.
-__attribute__((target("avx2"))) inline __m256d coordinates4(const double *const *rows, int i, int d)
+__attribute__((target("avx2"))) inline __m256d coordinates4(const double (*rows)[3], int i, int d)
 {
   return _mm256_set_pd(rows[i + 3][d], rows[i + 2][d], rows[i + 1][d], rows[i][d]);
 }
@@ -449,7 +449,7 @@ __attribute__((target("avx2"))) inline __m256d below_next_face4(const Layers &ax
 // its fast path; the others take add_sphere_to_layers. Deposits go in sphere order, so the sums are
 // the same as one by one.
 __attribute__((target("avx2"))) double layers_deposit_avx2(const Layers &layers, int axis,
-                                                           const double *const *centres, const double *radius,
+                                                           const double (*centres)[3], const double *radius,
                                                            const double *weight, int n, double *values, int stride)
 {
   const __m256d one = _mm256_set1_pd(1.0), reach = _mm256_set1_pd(1 << 30);
@@ -500,7 +500,7 @@ __attribute__((target("avx2"))) double layers_deposit_avx2(const Layers &layers,
 // one face between inner cells (33 %), with their two cells and the split of add_sphere_to_layers' fast
 // path; the others take cells_deposit. Deposits go in sphere order, so the sums are the same as one
 // by one.
-__attribute__((target("avx2"))) double cells_deposit_avx2(const Grid &grid, const double *const *centres,
+__attribute__((target("avx2"))) double cells_deposit_avx2(const Grid &grid, const double (*centres)[3],
                                                           const double *radius, const double *weight, int n,
                                                           double *values, int stride)
 {
@@ -568,7 +568,7 @@ __attribute__((target("avx2"))) double cells_deposit_avx2(const Grid &grid, cons
 
 }    // namespace
 
-double add_spheres_to_grid(const Grid &grid, const double *const *centres, const double *radius,
+double add_spheres_to_grid(const Grid &grid, const double (*centres)[3], const double *radius,
                            const double *weight, int n, double *values, int stride)
 {
   const Grid local = grid;    // a copy: the stores into values could otherwise change the grid
@@ -624,7 +624,7 @@ double grid_value_at(const Grid &grid, const double *values, const double point[
 namespace {
 
 // grid_value_at of points[i], i < n, one by one (what the vector read leaves, and all of it without AVX2).
-void values_at_one_by_one(const Grid &grid, int axis, const double *values, const double *const *points, int first,
+void values_at_one_by_one(const Grid &grid, int axis, const double *values, const double (*points)[3], int first,
                           int n, double *out, int stride)
 {
   if (axis >= 0)
@@ -699,7 +699,7 @@ __attribute__((target("avx2"))) inline __m256d along_y(const double *values, __m
 // grid_values_at four points at a time, bit for bit the scalar read: the corners' values gathered,
 // the same operations lane by lane (no fused multiply-add in this target, so the same roundings).
 __attribute__((target("avx2"))) void values_at_avx2(const Grid &grid, int axis, const double *values,
-                                                    const double *const *points, int n, double *out, int stride)
+                                                    const double (*points)[3], int n, double *out, int stride)
 {
   const __m256d zero = _mm256_setzero_pd();
   const double step[3] = {static_cast<double>(stride), static_cast<double>(grid.axes[0].count) * stride,
@@ -738,7 +738,7 @@ __attribute__((target("avx2"))) void values_at_avx2(const Grid &grid, int axis, 
 
 }    // namespace
 
-void grid_values_at(const Grid &grid, const double *values, const double *const *points, int n, double *out,
+void grid_values_at(const Grid &grid, const double *values, const double (*points)[3], int n, double *out,
                     int stride)
 {
   // A copy: a store into out could otherwise change the grid, for all the compiler knows, and every

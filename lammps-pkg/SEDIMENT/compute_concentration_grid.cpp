@@ -5,6 +5,7 @@
 
 #include "compute_concentration_grid.h"
 #include "sediment_args.h"
+#include "sediment_rows.h"
 
 #include "atom.h"
 #include "comm.h"
@@ -224,8 +225,8 @@ void ComputeConcentrationGrid::profile()
   profiled_step = update->ntimestep;
 
   std::fill(local.begin(), local.end(), 0.0);
-  double **x = atom->x;
-  double *radius = atom->radius;
+  const auto x = flat_rows<3>(atom->x);
+  const double *radius = atom->radius;
   int *mask = atom->mask;
   int *type = atom->type;
   const int class_col = 1;
@@ -296,11 +297,11 @@ void ComputeConcentrationGrid::compute_peratom()
   }
   const double *total = fractions.data();    // column 0
   if (groupbit == 1) {    // group all: every local atom, what depends on the grid alone taken once
-    sediment::grid_values_at(grid, total, atom->x, atom->nlocal, vector_atom, ncols);
+    sediment::grid_values_at(grid, total, flat_rows<3>(atom->x), atom->nlocal, vector_atom, ncols);
     return;
   }
   // Atoms outside the group are not read: their positions are not this compute's to trust.
-  double **x = atom->x;
+  const auto x = flat_rows<3>(atom->x);
   const int *mask = atom->mask;
   for (int i = 0; i < atom->nlocal; ++i)
     vector_atom[i] = (mask[i] & groupbit) ? sediment::grid_value_at(grid, total, x[i], ncols) : 0.0;

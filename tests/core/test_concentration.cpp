@@ -9,6 +9,7 @@
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <memory>
 #include <random>
 #include <vector>
 
@@ -269,17 +270,15 @@ TEST(Grid, ManySpheresAtOnceAreTheSpheresOneByOne)
   std::mt19937_64 random(3);
   std::uniform_real_distribution<double> coordinate(-0.05, 1.05), size(0.005, 0.12), count(0.5, 3.0);
   const int n = 500;
-  std::vector<std::array<double, 3>> centres(n);
+  const auto rows = std::make_unique<double[][3]>(n);    // one block, as LAMMPS keeps positions
   std::vector<double> radius(n), weight(n);
-  std::vector<const double *> rows(n);
   for (int i = 0; i < n; ++i) {
-    for (double &c : centres[i]) c = coordinate(random);
+    for (int d = 0; d < 3; ++d) rows[i][d] = coordinate(random);
     radius[i] = size(random);
     weight[i] = count(random);
-    rows[i] = centres[i].data();
   }
   // Some far outside along one axis: beyond the flat ends, or periods away along a periodic axis.
-  for (int i = 0; i < 12; ++i) centres[7 * i][i % 3] += i % 2 ? 3.3 : -4.7;
+  for (int i = 0; i < 12; ++i) rows[7 * i][i % 3] += i % 2 ? 3.3 : -4.7;
   for (const Grid &grid : grids) {
     for (const double *weights : {static_cast<const double *>(nullptr), static_cast<const double *>(weight.data())}) {
       // Two columns, as the compute interleaves them: the batch fills the second.
@@ -287,12 +286,12 @@ TEST(Grid, ManySpheresAtOnceAreTheSpheresOneByOne)
       double outside_alone = 0.0;
       for (int i = 0; i < n; ++i)
         outside_alone += add_sphere_to_grid(grid, rows[i], radius[i], alone.data() + 1, 2, weights ? weights[i] : 1.0);
-      const double outside = add_spheres_to_grid(grid, rows.data(), radius.data(), weights, n, together.data() + 1, 2);
+      const double outside = add_spheres_to_grid(grid, rows.get(), radius.data(), weights, n, together.data() + 1, 2);
       EXPECT_EQ(outside, outside_alone);
       ASSERT_EQ(together, alone);
 
       std::vector<double> read(n);
-      grid_values_at(grid, alone.data() + 1, rows.data(), n, read.data(), 2);
+      grid_values_at(grid, alone.data() + 1, rows.get(), n, read.data(), 2);
       for (int i = 0; i < n; ++i) EXPECT_EQ(read[i], grid_value_at(grid, alone.data() + 1, rows[i], 2)) << "sphere " << i;
     }
   }

@@ -58,18 +58,18 @@ struct Grid {
 // the sphere beyond three perpendicular planes (cost: the sphere's cell vertices).
 double add_sphere_to_grid(const Grid &grid, const double centre[3], double radius, double *values, int stride = 1,
                           double weight = 1.0);
-// add_sphere_to_grid of n spheres in turn (centres[i] one row of three coordinates, as LAMMPS keeps
-// positions; weight nullptr: one each), with what depends on the grid alone decided once: the same
-// sums in the same order. Returns the sum of their volumes outside the grid.
-double add_spheres_to_grid(const Grid &grid, const double *const *centres, const double *radius,
+// add_sphere_to_grid of n spheres in turn (centres[i] a row of three coordinates, the rows one after
+// another as LAMMPS keeps positions; weight nullptr: one each), with what depends on the grid alone
+// decided once: the same sums in the same order. Returns the sum of their volumes outside the grid.
+double add_spheres_to_grid(const Grid &grid, const double (*centres)[3], const double *radius,
                            const double *weight, int n, double *values, int stride = 1);
 
 // Trilinear interpolation between cell centres (flat beyond the outer centres, wrapped along
 // periodic axes).
 double grid_value_at(const Grid &grid, const double *values, const double point[3], int stride = 1);
-// grid_value_at of n points, out[i] for points[i] (one row of three coordinates each, as LAMMPS keeps
-// positions): the same values, with what depends on the grid alone decided once.
-void grid_values_at(const Grid &grid, const double *values, const double *const *points, int n, double *out,
+// grid_value_at of n points, out[i] for points[i] (rows of three coordinates, one after another as
+// LAMMPS keeps positions): the same values, with what depends on the grid alone decided once.
+void grid_values_at(const Grid &grid, const double *values, const double (*points)[3], int n, double *out,
                     int stride = 1);
 
 // smooth_profile along every resolved axis in turn (a separable Gaussian), in place; scratch needs
