@@ -87,10 +87,11 @@ class FixNVESphereFluid : public Fix {
   HalfStep half_step;
   double linear_per_diameter;    // c of the Linear step
   // The first half of the step for every atom of the group, with the drag found by lookup(i, sphere,
-  // flow, spin_rate) (one loop, compiled for each look-up and way of stepping: step_first_half picks
-  // General, Blocked or Smooth, initial_integrate takes Linear with a look-up of the diameter only);
-  // is_uniform: the look-up is the uniform drag's, and the step keeps only the weights.
-  template <HalfStep path, bool is_uniform, class Lookup> void first_half(Lookup lookup);
+  // flow, spin_rate) (one loop, compiled for each look-up, way of stepping and floor or none:
+  // step_first_half picks General, Blocked or Smooth, initial_integrate takes Linear with a look-up of
+  // the diameter only); is_uniform: the look-up is the uniform drag's, and the step keeps only the
+  // weights.
+  template <HalfStep path, bool is_uniform, bool on_floor, class Lookup> void first_half(Lookup lookup);
   template <bool is_uniform, class Lookup> void step_first_half(Lookup lookup);
 
   int floor_axis;         // -1: no floor
