@@ -635,8 +635,8 @@ void values_at_one_by_one(const Grid &grid, int axis, const double *values, cons
 
 #ifdef SEDIMENT_GRID_AVX2
 // bracket() of four coordinates along an axis: the two centres' indices (whole numbers, as doubles)
-// and the weight of the second, by the same operations, so the same values. False when a lane lies
-// beyond one period of a periodic axis (or is NaN): the caller reads those four points one by one.
+// and the weight of the second, by the same operations, so the same values. False when a lane is NaN
+// or further than 2^30 layers away: the caller reads those four points one by one.
 __attribute__((target("avx2"))) inline bool brackets4(const Layers &axis, __m256d x, __m256d &k0, __m256d &k1,
                                                       __m256d &w)
 {
@@ -645,14 +645,24 @@ __attribute__((target("avx2"))) inline bool brackets4(const Layers &axis, __m256
       _mm256_set1_pd(0.5));
   const __m256d zero = _mm256_setzero_pd(), one = _mm256_set1_pd(1.0), last = _mm256_set1_pd(axis.count - 1);
   if (axis.periodic) {
-    const __m256d k = _mm256_floor_pd(s);
+    const __m256d k = _mm256_floor_pd(s), count = _mm256_set1_pd(axis.count);
+    w = _mm256_sub_pd(s, k);
     const __m256d within = _mm256_and_pd(_mm256_cmp_pd(k, _mm256_set1_pd(-1.0), _CMP_GE_OQ),
                                          _mm256_cmp_pd(k, last, _CMP_LE_OQ));
-    if (_mm256_movemask_pd(within) != 0xF) return false;
-    const __m256d count = _mm256_set1_pd(axis.count), next = _mm256_add_pd(k, one);
-    w = _mm256_sub_pd(s, k);
-    k0 = _mm256_blendv_pd(k, _mm256_add_pd(k, count), _mm256_cmp_pd(k, zero, _CMP_LT_OQ));    // -1 wraps to n - 1
-    k1 = _mm256_blendv_pd(next, zero, _mm256_cmp_pd(next, count, _CMP_EQ_OQ));                // n wraps to 0
+    if (_mm256_movemask_pd(within) == 0xF) {    // most: within the period, or one layer below it
+      k0 = _mm256_blendv_pd(k, _mm256_add_pd(k, count), _mm256_cmp_pd(k, zero, _CMP_LT_OQ));    // -1 wraps to n - 1
+    } else {
+      // Whole periods away, as atoms are between LAMMPS's remaps into the box (the steps of a
+      // sedimentation test's fine grains outrun its neighbor skin). wrap() in doubles: with |k| and
+      // count below 2^31, k / count rounds on the right side of every whole number, so the floor and
+      // the rest are exact.
+      const __m256d reach = _mm256_set1_pd(1 << 30);
+      if (_mm256_movemask_pd(_mm256_cmp_pd(_mm256_andnot_pd(_mm256_set1_pd(-0.0), k), reach, _CMP_LE_OQ)) != 0xF)
+        return false;
+      k0 = _mm256_sub_pd(k, _mm256_mul_pd(_mm256_floor_pd(_mm256_div_pd(k, count)), count));
+    }
+    const __m256d next = _mm256_add_pd(k0, one);
+    k1 = _mm256_blendv_pd(next, zero, _mm256_cmp_pd(next, count, _CMP_EQ_OQ));    // n wraps to 0
     return true;
   }
   if (_mm256_movemask_pd(_mm256_cmp_pd(s, s, _CMP_ORD_Q)) != 0xF) return false;
