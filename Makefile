@@ -87,10 +87,14 @@ docs: build
 
 test: test-cpp test-python docs check-sanitize test-lammps-current
 
-# Cost of each effect per particle-step, as ratios measured in one run, then the core's per-atom
-# kernels (grid deposit and interpolation, Di Felice curve, phi functions; not part of make test).
+# Cost of each effect per particle-step, as ratios measured in one run; the same against the peer at
+# every dt/tau from 1e-4 to 1e4; the settling bed with contacts under each law against fix viscous;
+# then the core's per-atom kernels (grid deposit and interpolation, Di Felice curve, phi functions).
+# Not part of make test.
 bench: build
 	$(PYTHON) benchmarks/cost.py
+	$(PYTHON) benchmarks/cost.py --sweep --particles 20000 --steps 1000 --repeats 3
+	$(PYTHON) benchmarks/bed.py --laws standard,dallavalle,stokes --steps 500 --repeats 3
 	$(BUILD)/bench_core_kernels --benchmark_min_time=0.2
 
 clean:

@@ -58,7 +58,8 @@ inline int series_terms(double z)
 {
   const double size = std::abs(z);
   int terms = SeriesCoefficients::most_terms;
-  for (int r = std::size(series_ranges) - 1; r >= 0; --r) terms = size < series_ranges[r].below ? series_ranges[r].terms : terms;
+  for (int r = std::size(series_ranges) - 1; r >= 0; --r)    // selects, no branch: the block's loops vectorise
+    terms = size < series_ranges[r].below ? series_ranges[r].terms : terms;
   return terms;
 }
 

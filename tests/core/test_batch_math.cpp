@@ -115,7 +115,8 @@ TEST(BatchMath, PhisManyFollowPhisOnBothSidesOfTheSeriesAndTheUnderflow)
   // every count of the series' terms, on both sides of its limits (6 below 2^-9, 8, 10, 12 and 14 below
   // 2^-6, 2^-4, 2^-3 and 2^-2, 16 below 1/2)
   for (double limit : {0x1p-9, 0x1p-6, 0x1p-4, 0x1p-3, 0x1p-2, 0.5})
-    for (double extra : {limit, std::nextafter(limit, 0.0), -std::nextafter(limit, 0.0), 0.7 * limit}) z.push_back(extra);
+    for (double extra : {limit, std::nextafter(limit, 0.0), -std::nextafter(limit, 0.0), 0.7 * limit})
+      z.push_back(extra);
   for (double extra : {1e-5, -1e-5, -0.49}) z.push_back(extra);
   const size_t n = z.size();
   std::vector<double> decay(n), p1(n), p2(n);
