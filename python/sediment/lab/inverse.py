@@ -404,6 +404,11 @@ class Inversion:
         return figures.save(fig, path)
 
 
+def _check_bins(bins: int) -> None:
+    if bins < MIN_BINS:
+        raise ValueError(f"--bins {bins}: give at least {MIN_BINS} size bins")
+
+
 def invert(sheets: list[Sheet], test: LabTest, folder: Path, *, bins: int = 24, particles: int = 20000,
            courant: float = 4.0, rounds: int = 4, draws: int = 64, seed: int = 1,
            budget_band: float = 0.0) -> Inversion:
@@ -430,8 +435,7 @@ def invert(sheets: list[Sheet], test: LabTest, folder: Path, *, bins: int = 24, 
     """
     if not sheets:
         raise ValueError("no sheet to invert")
-    if bins < MIN_BINS:
-        raise ValueError(f"--bins {bins}: give at least {MIN_BINS} size bins")
+    _check_bins(bins)
     recorded = np.concatenate([s.temperature[np.isfinite(s.temperature)] for s in sheets])
     mean_temperature = float(recorded.mean()) if len(recorded) else 20.0
     water = Suspension.at_temperature(mean_temperature, test.particle_density)
@@ -454,8 +458,10 @@ def invert(sheets: list[Sheet], test: LabTest, folder: Path, *, bins: int = 24, 
     shares = first_guess(diameters, np.concatenate([p for *_, p in reduction]), edges)
     data = np.concatenate(corrected)
     sigma = np.concatenate([np.full(len(s.time), test.noise[s.instrument]) for s in sheets])
-    # the runs reach the latest time the band's thermometer offset (below) maps a reading to
-    t_end = 1.02 * max(effective_times(s, water, 1.0)[-1] for s in sheets)
+    # the readings' times in water 1 C warmer: the runs reach the latest, and the band's thermometer
+    # offset (below) is linear in the readings there
+    warmer = [effective_times(s, water, 1.0) for s in sheets]
+    t_end = 1.02 * max(t[-1] for t in warmer)
 
     previous = None
     weight = None
@@ -492,7 +498,7 @@ def invert(sheets: list[Sheet], test: LabTest, folder: Path, *, bins: int = 24, 
     # noise (and the forward model's), the thermometer's offset drawn, and the smoothness penalty aiming
     # at a draw of its prior (randomise-then-optimise). An offset moves every reading's time alike; its
     # effect on the readings is taken as linear (the readings with the record 1 C warmer).
-    per_degree = run.readings(shares, sheets, [effective_times(s, water, 1.0) for s in sheets]) - model
+    per_degree = run.readings(shares, sheets, warmer) - model
     rng = np.random.default_rng(seed)
     penalty_rows = len(_penalty(edges))
     draws_percent = []
@@ -552,8 +558,7 @@ def design_test(psd: PSD, folder: Path, masses=(0.030, 0.045, 0.060, 0.080), des
     draw's mean and worst absolute error (NaN, with no readings, where the instrument cannot read that
     mass, e.g. a suspension beyond the 152H's scale). The hindrance's own uncertainty, which grows with the mass, is
     not in it (docs/error-budget.md: the exponent row)."""
-    if bins < MIN_BINS:
-        raise ValueError(f"--bins {bins}: give at least {MIN_BINS} size bins")
+    _check_bins(bins)
     water = Suspension.at_temperature(20.0, test.particle_density)
     rng = np.random.default_rng(seed)
     results = []

@@ -277,8 +277,8 @@ def terminal_speed(suspension: Suspension, diameter: float, law: str) -> float:
 
 def plan(psd: PSD, *, geometry: str = "column", cylinder: Cylinder = Cylinder(), mass: float = 0.060,
          suspension: Suspension = Suspension(), width: float | None = None, classes: int | np.ndarray = 40,
-         particles: int | None = 20000, effects: Effects = Effects(), layers: int = 400, t_end: float = 86400.0, courant: float = 4.0,
-         seed: int = 1) -> Scene:
+         particles: int | None = 20000, effects: Effects = Effects(), layers: int = 400, t_end: float = 86400.0,
+         courant: float = 4.0, seed: int = 1) -> Scene:
     """The scene of a test: sub-volume, classes, particles and their placement.
 
     Parameters
