@@ -459,6 +459,180 @@ void DragBlock::step(double dt, BatchMath kind)
   if (in_pieces_) step_in_pieces(model, dt);
 }
 
+// step_spheres' loads: add_smooth's, with 1 / m and a_n = f / m taken here in vectors. The rows come as
+// restricted parameters: with them in locals, GCC did not take them as restricted and left the loops
+// scalar (it could not check every pair of arrays for overlap).
+template <class Atom>
+[[gnu::always_inline]] inline void DragBlock::add_spheres(Atom atom, int count, double ftm2v,
+                                                           const double (*__restrict v)[3],
+                                                           const double (*__restrict force)[3],
+                                                           const double *__restrict radius, const double *__restrict mass,
+                                                           const double *__restrict fraction, double max_fraction)
+{
+  const DragModel &model = *model_;
+  for (int n = 0; n < count; ++n) {
+    const int i = atom(n);
+    const double inverse_mass = ftm2v / mass[i];
+    DragScale scale;
+    if (fraction) scale.voidage = voidage_of(fraction[i], max_fraction);
+    const double diameter = 2.0 * radius[i];
+    for (int k = 0; k < 3; ++k) {
+      v_[k][n] = v[i][k];
+      a_[k][n] = force[i][k] * inverse_mass;
+    }
+    reynolds_per_speed_[n] = model.smooth_reynolds_per_speed(diameter);
+    rate_per_g_[n] = model.smooth_drag_per_speed(diameter, scale) * inverse_mass;
+    voidage_[n] = scale.voidage;
+    inverse_mass_[n] = inverse_mass;
+  }
+  size_ = count;
+}
+
+// step_spheres' stores: velocity(), displacement() and pack_weights(correction(), 1 / m) of each
+// sphere, and its rotation's kick.
+template <class Atom>
+[[gnu::always_inline]] inline double DragBlock::finish_spheres(Atom atom, HalfKick kick,
+                                                                double (*__restrict x)[3], double (*__restrict v)[3],
+                                                                double (*__restrict omega)[3],
+                                                                const double (*__restrict torque)[3],
+                                                                const double *__restrict radius,
+                                                                const double *__restrict mass,
+                                                                double (*__restrict weights)[PACKED_WEIGHTS_SIZE]) const
+{
+  double states[capacity];    // summed after the loop: a running sum would keep it from vectors
+  for (int n = 0; n < size_; ++n) {
+    const int i = atom(n);
+    double new_x[3], new_v[3];
+    for (int k = 0; k < 3; ++k) {
+      new_x[k] = x[i][k] + dx_[k][n];
+      new_v[k] = mid_v_[k][n];
+      x[i][k] = new_x[k];
+      v[i][k] = new_v[k];
+    }
+    states[n] = state_sum(new_x, new_v);
+    const double spin = spin_weight(kick, radius[i], mass[i]);
+    for (int k = 0; k < 3; ++k) omega[i][k] += spin * torque[i][k];
+    StepCorrection corr;
+    corr.along = along_[n];
+    corr.across = across_[n];
+    for (int k = 0; k < 3; ++k) corr.dir[k] = dir_[k][n];
+    double packed[PACKED_WEIGHTS_SIZE];    // stored below: through its pointer, a store could be anywhere
+    pack_weights(corr, inverse_mass_[n], packed);
+    for (int k = 0; k < PACKED_WEIGHTS_SIZE; ++k) weights[i][k] = packed[k];
+  }
+  double state = 0.0;
+  for (int n = 0; n < size_; ++n) state += states[n];
+  return state;
+}
+
+// Members, not lambdas, always inlined: a lambda's body would be compiled apart, for the default
+// instruction set, not for the vector width of the step_spheres_* it is called from. The stages are
+// called, not inlined: inlined into both ways of finding the atoms, they outgrew GCC's limits, and
+// the law's curve (drag_curve) was no longer inlined into their vector loops (1.2x slower, Dallavalle).
+template <class Atom>
+[[gnu::always_inline]] inline double DragBlock::step_spheres_of(const SphereRows &rows, Atom atom, int count,
+                                                                 const HalfKick &kick, double dt, BatchMath kind)
+{
+  add_spheres(atom, count, kick.ftm2v, rows.v, rows.force, rows.radius, rows.mass, rows.fraction, rows.max_fraction);
+  step(dt, kind);
+  const double state =
+      finish_spheres(atom, kick, rows.x, rows.v, rows.omega, rows.torque, rows.radius, rows.mass, rows.weights);
+  clear();
+  return state;
+}
+
+[[gnu::always_inline]] inline double DragBlock::step_spheres_in(const SphereRows &rows, const int *atoms, int count,
+                                                                 const HalfKick &kick, double dt, BatchMath kind)
+{
+  const int first = atoms[0];
+  if (atoms[count - 1] - first == count - 1)
+    return step_spheres_of(rows, ConsecutiveAtoms{first}, count, kick, dt, kind);
+  return step_spheres_of(rows, ListedAtoms{atoms}, count, kick, dt, kind);
+}
+
+#if defined(__x86_64__) && defined(__GNUC__)
+__attribute__((target("avx2"))) double DragBlock::step_spheres_avx2(const SphereRows &rows, const int *atoms,
+                                                                    int count, const HalfKick &kick, double dt)
+{
+  return step_spheres_in(rows, atoms, count, kick, dt, BatchMath::AVX2);
+}
+__attribute__((target("avx512f"))) double DragBlock::step_spheres_avx512(const SphereRows &rows, const int *atoms,
+                                                                        int count, const HalfKick &kick, double dt)
+{
+  return step_spheres_in(rows, atoms, count, kick, dt, BatchMath::AVX512);
+}
+#else
+double DragBlock::step_spheres_avx2(const SphereRows &rows, const int *atoms, int count, const HalfKick &kick,
+                                    double dt)
+{
+  return step_spheres_in(rows, atoms, count, kick, dt, BatchMath::Scalar);
+}
+double DragBlock::step_spheres_avx512(const SphereRows &rows, const int *atoms, int count, const HalfKick &kick,
+                                      double dt)
+{
+  return step_spheres_in(rows, atoms, count, kick, dt, BatchMath::Scalar);
+}
+#endif
+
+double DragBlock::step_spheres(const SphereRows &rows, const int *atoms, int count, const HalfKick &kick, double dt,
+                               BatchMath kind)
+{
+  assert(size_ == 0 && count > 0 && count <= capacity && model_->smooth());
+  if (kind == BatchMath::AVX512 && batch_math_available(kind)) return step_spheres_avx512(rows, atoms, count, kick, dt);
+  if (kind == BatchMath::AVX2 && batch_math_available(kind)) return step_spheres_avx2(rows, atoms, count, kick, dt);
+  return step_spheres_in(rows, atoms, count, kick, dt, kind);
+}
+
+namespace {
+// drag_step_final_rows' loop, the rows as restricted parameters (see DragBlock::add_spheres).
+[[gnu::always_inline]] inline void final_rows(int first, int count, HalfKick kick, double (*__restrict v)[3],
+                                              double (*__restrict omega)[3], const double (*__restrict force)[3],
+                                              const double (*__restrict torque)[3], const double *__restrict radius,
+                                              const double *__restrict mass,
+                                              const double (*__restrict weights)[PACKED_WEIGHTS_SIZE])
+{
+  for (int i = first; i < first + count; ++i) {
+    double new_v[3] = {v[i][0], v[i][1], v[i][2]};
+    add_packed_weighted_acceleration(weights[i], force[i], new_v);
+    for (int k = 0; k < 3; ++k) v[i][k] = new_v[k];
+    const double spin = spin_weight(kick, radius[i], mass[i]);
+    for (int k = 0; k < 3; ++k) omega[i][k] += spin * torque[i][k];
+  }
+}
+
+void final_rows_of(const SphereRows &rows, int first, int count, const HalfKick &kick)
+{
+  final_rows(first, count, kick, rows.v, rows.omega, rows.force, rows.torque, rows.radius, rows.mass, rows.weights);
+}
+#if defined(__x86_64__) && defined(__GNUC__)
+__attribute__((target("avx2"))) void final_rows_avx2(const SphereRows &rows, int first, int count, const HalfKick &kick)
+{
+  final_rows(first, count, kick, rows.v, rows.omega, rows.force, rows.torque, rows.radius, rows.mass, rows.weights);
+}
+__attribute__((target("avx512f"))) void final_rows_avx512(const SphereRows &rows, int first, int count,
+                                                           const HalfKick &kick)
+{
+  final_rows(first, count, kick, rows.v, rows.omega, rows.force, rows.torque, rows.radius, rows.mass, rows.weights);
+}
+#else
+void final_rows_avx2(const SphereRows &rows, int first, int count, const HalfKick &kick)
+{
+  final_rows_of(rows, first, count, kick);
+}
+void final_rows_avx512(const SphereRows &rows, int first, int count, const HalfKick &kick)
+{
+  final_rows_of(rows, first, count, kick);
+}
+#endif
+}  // namespace
+
+void drag_step_final_rows(const SphereRows &rows, int first, int count, const HalfKick &kick, BatchMath kind)
+{
+  if (kind == BatchMath::AVX512 && batch_math_available(kind)) return final_rows_avx512(rows, first, count, kick);
+  if (kind == BatchMath::AVX2 && batch_math_available(kind)) return final_rows_avx2(rows, first, count, kick);
+  final_rows_of(rows, first, count, kick);
+}
+
 StepCorrection nonlinear_step_initial(const SphereDrag &drag, double inverse_mass, const double a[3],
                                       const double u[3], double dt, double v[3], double dx[3])
 {

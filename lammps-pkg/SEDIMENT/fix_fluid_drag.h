@@ -67,7 +67,7 @@ class FixFluidDrag : public Fix {
       sediment::SphereDrag drag;
       drag.model = model;
       drag.diameter = 2.0 * radius[i];
-      if (fraction) drag.scale.voidage = 1.0 - std::clamp(fraction[i], 0.0, max_fraction);
+      if (fraction) drag.scale.voidage = sediment::voidage_of(fraction[i], max_fraction);
       return drag;
     }
     bool capped(int i) const { return fraction && fraction[i] > max_fraction; }

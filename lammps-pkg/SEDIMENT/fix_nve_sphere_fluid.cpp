@@ -31,25 +31,14 @@
 using namespace LAMMPS_NS;
 using namespace FixConst;
 
-// fix nve/sphere's factors of a half step: dtf = dt ftm2v / 2 for the forces and dtf / I* for the
-// torques (I* = 2/5, a solid sphere's inertia over m r^2), as it computes them. Taken once per half
-// step: the compiler may not hoist the division out of the loop over the atoms (it could trap, and
-// the group's test guards it), which had made a third division per atom.
-struct HalfKick {
-  double dtf, dtfrotate;
-};
-
-static inline HalfKick half_kick(double dt, double ftm2v)
-{
-  const double dtf = 0.5 * dt * ftm2v;
-  return {dtf, dtf / sediment::solid_sphere_inertia};
-}
+using sediment::HalfKick;
+using sediment::state_sum;
 
 // The rotational half of fix nve/sphere's kick (below), which is also the rotation of a sphere in a
 // fluid without a rotational drag. Returns the torque's weight, dtf / I.
 static inline double nve_sphere_spin(double *omega, const double *torque, double radius, double rmass, HalfKick kick)
 {
-  const double dtirotate = kick.dtfrotate / (radius * radius * rmass);
+  const double dtirotate = sediment::spin_weight(kick, radius, rmass);
   omega[0] += dtirotate * torque[0];
   omega[1] += dtirotate * torque[1];
   omega[2] += dtirotate * torque[2];
@@ -87,12 +76,6 @@ static inline SphereArrays sphere_arrays(const Atom *atom)
   return {flat_rows<3>(atom->x),     flat_rows<3>(atom->v),      flat_rows<3>(atom->f),
           flat_rows<3>(atom->omega), flat_rows<3>(atom->torque), atom->radius,
           atom->rmass,               atom->mask,                 atom->nlocal};
-}
-
-// The sum of an atom's position and velocity: NaN or inf when any of them is (or when it overflows).
-static inline double state_sum(const double x[3], const double v[3])
-{
-  return (x[0] + x[1] + x[2]) + (v[0] + v[1] + v[2]);
 }
 
 // The first half of fix nve/sphere's step: kick, then drift over the whole step. Returns the sum of
@@ -261,7 +244,7 @@ void FixNVESphereFluid::first_half(Lookup lookup)
   const double floor_at = floor_level;
   const double dt = update->dt;
   const double ftm2v = force->ftm2v;
-  const HalfKick kick = half_kick(dt, ftm2v);
+  const HalfKick kick = sediment::half_kick(dt, ftm2v);
   static const double no_flow[3] = {0.0, 0.0, 0.0};
   constexpr bool linear = path == HalfStep::Linear || path == HalfStep::LinearOnFloor;
   constexpr bool keeps_weights = path != HalfStep::Linear;    // else final_integrate takes them anew
@@ -374,11 +357,8 @@ void FixNVESphereFluid::first_half(Lookup lookup)
       continue;
     }
     if constexpr (blocks) {
-      // Under the uniform drag of a smooth law every sphere in the fluid is wholly immersed: each steps
-      // in the block, and none is asked.
-      if ((path == HalfStep::Smooth && is_uniform) ||
-          (path == HalfStep::Smooth ? sediment::step_kind(sphere) == sediment::StepKind::Smooth
-                                    : sediment::steps_in_block(sphere, v[i], flow))) {
+      if (path == HalfStep::Smooth ? sediment::step_kind(sphere) == sediment::StepKind::Smooth
+                                   : sediment::steps_in_block(sphere, v[i], flow)) {
         if (sphere.model != block.law()) {    // a block per law, and so per fluid/drag fix and flow
           if (block.size() > 0) state += step_block();
           block.set_law(*sphere.model, flow);
@@ -397,15 +377,70 @@ void FixNVESphereFluid::first_half(Lookup lookup)
   check_finite(state);
 }
 
+template <bool on_floor> void FixNVESphereFluid::first_half_immersed()
+{
+  const auto [x, v, f, omega, torque, radius, rmass, mask, nlocal] = sphere_arrays(atom);
+  const FixFluidDrag::Immersed immersed = uniform->immersed();
+  const sediment::SphereRows rows{x,      v,     omega,           f, torque, radius, rmass, immersed.fraction,
+                                  immersed.max_fraction, flat_rows<NWEIGHTS>(weights)};
+  const int drag_bit = uniform->groupbit;
+  const double *flow = uniform->fluid_fix()->velocity();
+  const int floor_dim = floor_axis;
+  const double floor_at = floor_level;
+  const double dt = update->dt;
+  const HalfKick kick = sediment::half_kick(dt, force->ftm2v);
+
+  sediment::DragBlock block;
+  block.set_law(*immersed.model, flow);
+  int waiting[sediment::DragBlock::capacity];
+  int size = 0;
+  double state = 0.0;    // as in first_half; local sums: a store into the fix would alias the atom arrays
+  int outside = 0, capped = 0;
+  auto step_block = [&]() {
+    state += block.step_spheres(rows, waiting, size, kick, dt);
+    if constexpr (on_floor)
+      for (int n = 0; n < size; ++n) {
+        const int i = waiting[n];
+        settle_on_floor(x[i], v[i], omega[i], radius[i], floor_dim, floor_at);
+      }
+    size = 0;
+  };
+  for (int i = 0; i < nlocal; ++i) {
+    if (!(mask[i] & groupbit)) continue;
+    if (!(mask[i] & drag_bit)) {
+      ++outside;
+      state += nve_sphere_kick_drift(x[i], v[i], omega[i], f[i], torque[i], radius[i], rmass[i], kick, dt);
+      if constexpr (on_floor) settle_on_floor(x[i], v[i], omega[i], radius[i], floor_dim, floor_at);
+      continue;
+    }
+    if (immersed.capped(i)) ++capped;
+    if (on_floor && rests_on_floor(x[i], v[i], f[i], radius[i], flow, floor_dim, floor_at)) {
+      std::fill(weights[i], weights[i] + NWEIGHTS, 0.0);    // held, as in first_half
+      state += state_sum(x[i], v[i]);
+      settle_on_floor(x[i], v[i], omega[i], radius[i], floor_dim, floor_at);
+      continue;
+    }
+    waiting[size++] = i;
+    if (size == sediment::DragBlock::capacity) step_block();
+  }
+  if (size > 0) step_block();
+  counts[OUTSIDE] += outside;
+  counts[CAPPED] += capped;
+  check_finite(state);
+}
+
 template <bool is_uniform, class Lookup> void FixNVESphereFluid::step_first_half(Lookup lookup)
 {
   // Linear is taken by initial_integrate with its own look-up. Each way compiled with and without the
   // floor, whose tests took 7 instructions per atom where there is none.
   with_floor_or_not(floor_axis, [&](auto with_floor) {
     constexpr bool on_floor = decltype(with_floor)::value;
-    if (half_step == HalfStep::Smooth)
-      first_half<HalfStep::Smooth, is_uniform, on_floor>(lookup);
-    else if (half_step == HalfStep::Blocked)
+    if (half_step == HalfStep::Smooth) {
+      if constexpr (is_uniform)
+        first_half_immersed<on_floor>();
+      else
+        first_half<HalfStep::Smooth, false, on_floor>(lookup);
+    } else if (half_step == HalfStep::Blocked)
       first_half<HalfStep::Blocked, is_uniform, on_floor>(lookup);
     else
       first_half<HalfStep::General, is_uniform, on_floor>(lookup);
@@ -422,7 +457,7 @@ void FixNVESphereFluid::initial_integrate(int /*vflag*/)
     const int floor_dim = floor_axis;
     const double floor_at = floor_level;
     const double dt = update->dt;
-    const HalfKick kick = half_kick(dt, force->ftm2v);
+    const HalfKick kick = sediment::half_kick(dt, force->ftm2v);
     int outside = 0;    // local sums: a store into the fix would alias the atom arrays
     double state = 0.0;
     with_floor_or_not(floor_dim, [&](auto with_floor) {
@@ -492,7 +527,7 @@ void FixNVESphereFluid::final_integrate()
   const double floor_at = floor_level;
   const double ftm2v = force->ftm2v;
 
-  const HalfKick kick = half_kick(update->dt, ftm2v);
+  const HalfKick kick = sediment::half_kick(update->dt, ftm2v);
   if (drags.empty()) {
     with_floor_or_not(floor_dim, [&](auto with_floor) {
       for (int i = 0; i < nlocal; ++i)
@@ -527,37 +562,48 @@ void FixNVESphereFluid::final_integrate()
     return;
   }
 
-  // The loop compiled with and without the floor (its test in the loop cost 4 instructions of 80 per
-  // atom), and for a uniform step (the atoms in a fluid are the drag's group, the torque's weight is
-  // fix nve/sphere's) apart from the general one, which kept both.
-  auto second_half = [&](auto with_floor, auto is_uniform) {
-    const int drag_bit = uniform ? uniform->groupbit : 0;
+  // The uniform step: each run of consecutive atoms in the drag's group (the fluid's) takes its second
+  // half in vectors (sediment::drag_step_final_rows); an atom of the group outside it fix nve/sphere's.
+  if (uniform) {
+    const sediment::SphereRows rows{x,       v,   omega, f, torque, radius, rmass, nullptr, 0.0,
+                                    weight_rows};
+    const int both = groupbit | uniform->groupbit;
+    with_floor_or_not(floor_dim, [&](auto with_floor) {
+      for (int i = 0; i < nlocal;) {
+        int end = i;
+        while (end < nlocal && (mask[end] & both) == both) ++end;
+        if (end > i) {
+          sediment::drag_step_final_rows(rows, i, end - i, kick);
+        } else {
+          if (mask[i] & groupbit) nve_sphere_kick(v[i], omega[i], f[i], torque[i], radius[i], rmass[i], kick);
+          end = i + 1;
+        }
+        if constexpr (decltype(with_floor)::value)
+          for (; i < end; ++i)
+            if (mask[i] & groupbit) settle_on_floor(x[i], v[i], omega[i], radius[i], floor_dim, floor_at);
+        i = end;
+      }
+    });
+    return;
+  }
+
+  // The general step, compiled with and without the floor (its test in the loop cost 4 instructions of
+  // 80 per atom).
+  with_floor_or_not(floor_dim, [&](auto with_floor) {
     for (int i = 0; i < nlocal; ++i) {
       if (!(mask[i] & groupbit)) continue;
-      if (is_uniform ? !(mask[i] & drag_bit) : general_rows[i][IN_FLUID] == 0.0) {
+      if (general_rows[i][IN_FLUID] == 0.0) {
         nve_sphere_kick(v[i], omega[i], f[i], torque[i], radius[i], rmass[i], kick);
       } else {
-        // The weights are per unit mass: the step is linear in the force, so f takes the place of a = f / m.
-        if constexpr (is_uniform) {
-          sediment::add_packed_weighted_acceleration(weight_rows[i], f[i], v[i]);
-          nve_sphere_spin(omega[i], torque[i], radius[i], rmass[i], kick);
-        } else {
-          const double spin = general_rows[i][SPIN];    // read first: the stores into v could alias it
-          sediment::add_packed_weighted_acceleration(weight_rows[i], f[i], v[i]);
-          omega[i][0] += spin * torque[i][0];
-          omega[i][1] += spin * torque[i][1];
-          omega[i][2] += spin * torque[i][2];
-        }
+        const double spin = general_rows[i][SPIN];    // read first: the stores into v could alias it
+        sediment::add_packed_weighted_acceleration(weight_rows[i], f[i], v[i]);
+        omega[i][0] += spin * torque[i][0];
+        omega[i][1] += spin * torque[i][1];
+        omega[i][2] += spin * torque[i][2];
       }
       if constexpr (decltype(with_floor)::value)
         settle_on_floor(x[i], v[i], omega[i], radius[i], floor_dim, floor_at);
     }
-  };
-  with_floor_or_not(floor_dim, [&](auto with_floor) {
-    if (uniform)
-      second_half(with_floor, std::true_type{});
-    else
-      second_half(with_floor, std::false_type{});
   });
 }
 

@@ -93,6 +93,9 @@ class FixNVESphereFluid : public Fix {
   // weights.
   template <HalfStep path, bool is_uniform, bool on_floor, class Lookup> void first_half(Lookup lookup);
   template <bool is_uniform, class Lookup> void step_first_half(Lookup lookup);
+  // first_half of the uniform drag of a smooth law: every sphere of its group is wholly immersed, and
+  // the block takes it through its whole first half (sediment::DragBlock::step_spheres).
+  template <bool on_floor> void first_half_immersed();
 
   int floor_axis;         // -1: no floor
   double floor_level;     // spheres stop with their lowest point here

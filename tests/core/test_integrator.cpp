@@ -483,6 +483,167 @@ TEST(DragBlock, TheArithmeticIsTheSameOnEveryKind)
   if (compared == 0) GTEST_SKIP() << "no vector kind on this processor";
 }
 
+namespace {
+
+// Per-atom arrays laid out as LAMMPS keeps them (rows of 3 one after the other), for the steps that
+// take them whole (DragBlock::step_spheres, drag_step_final_rows).
+struct Atoms {
+  std::vector<std::array<double, 3>> x, v, omega, force, torque;
+  std::vector<double> radius, mass, fraction;
+  std::vector<std::array<double, PACKED_WEIGHTS_SIZE>> weights;
+  SphereRows rows(bool hindered)
+  {
+    return {reinterpret_cast<double(*)[3]>(x.data()),
+            reinterpret_cast<double(*)[3]>(v.data()),
+            reinterpret_cast<double(*)[3]>(omega.data()),
+            reinterpret_cast<const double(*)[3]>(force.data()),
+            reinterpret_cast<const double(*)[3]>(torque.data()),
+            radius.data(),
+            mass.data(),
+            hindered ? fraction.data() : nullptr,
+            0.55,
+            reinterpret_cast<double(*)[PACKED_WEIGHTS_SIZE]>(weights.data())};
+  }
+};
+
+// n grains of three sizes with slips across, along and against their forces, fractions up to past
+// the cap, and some torque.
+Atoms some_atoms(int n)
+{
+  Atoms atoms;
+  for (int i = 0; i < n; ++i) {
+    const double d = std::array<double, 3>{3e-6, 3e-5, 3e-4}[i % 3];
+    const double t = 0.37 * i;
+    atoms.x.push_back({1e-3 * std::cos(t), 2e-3 * std::sin(t), 1e-2 + 1e-4 * i});
+    atoms.v.push_back({1e-4 * std::sin(3 * t), -2e-4 * std::cos(t), -3e-3 * (i % 5) + 1e-3});
+    atoms.omega.push_back({std::cos(t), 0.5, -std::sin(t)});
+    atoms.radius.push_back(d / 2);
+    atoms.mass.push_back(2650.0 * sphere_volume(d));
+    const double weight = -(2650.0 - 998.2) * 9.81 * sphere_volume(d);
+    atoms.force.push_back({0.1 * weight * std::sin(t), (i % 7 == 2) ? 0.0 : 0.05 * weight, weight});
+    atoms.torque.push_back({1e-3 * weight * d, -2e-3 * weight * d * std::cos(t), 0.0});
+    atoms.fraction.push_back(std::array<double, 4>{0.0, 0.1, 0.3, 0.7}[i % 4]);
+    atoms.weights.push_back({0.0, 0.0, 0.0, 0.0});
+  }
+  return atoms;
+}
+
+void expect_same_atoms(const Atoms &a, const Atoms &b)
+{
+  for (size_t i = 0; i < a.x.size(); ++i) {
+    SCOPED_TRACE(testing::Message() << "atom " << i);
+    EXPECT_EQ(a.x[i], b.x[i]);
+    EXPECT_EQ(a.v[i], b.v[i]);
+    EXPECT_EQ(a.omega[i], b.omega[i]);
+    EXPECT_EQ(a.weights[i], b.weights[i]);
+  }
+}
+
+}    // namespace
+
+TEST(DragBlock, StepSpheresIsTheBlockStepThenTheRotationKick)
+{
+  // step_spheres takes LAMMPS's rows itself: bit for bit the step that add_smooth and step give each
+  // sphere (1 / m, a_n and the voidage as fix nve/sphere/fluid takes them), then fix nve/sphere's kick of
+  // its rotation and the weights packed per unit mass. For atoms one after the other (the vector
+  // loads and stores) and atoms with gaps between them, under three laws, on every kind.
+  const Fluid fluid{998.2, 1.002e-3, 0.0};
+  const double dt = 1e-4, ftm2v = 1.0;
+  const HalfKick kick = half_kick(dt, ftm2v);
+  const int n = 2 * DragBlock::capacity + 7;
+  for (const DragLaw law : {DragLaw::Dallavalle, DragLaw::Standard, DragLaw::DiFelice}) {
+    const DragModel model(law, fluid);
+    const bool hindered = law == DragLaw::DiFelice;
+    for (const BatchMath kind : batch_math_kinds) {
+      if (!batch_math_available(kind)) continue;
+      for (const int gap : {1, 3}) {    // every atom, or every third
+        SCOPED_TRACE(testing::Message() << drag_law_name(law) << " " << batch_math_name(kind) << " gap " << gap);
+        Atoms expected = some_atoms(n), stepped = some_atoms(n);
+        std::vector<int> chosen;
+        for (int i = 1; i < n; i += gap) chosen.push_back(i);
+        double expected_state = 0.0, state = 0.0;
+        DragBlock block;
+        block.set_law(model, zero);
+        for (size_t start = 0; start < chosen.size(); start += DragBlock::capacity) {
+          const int count = static_cast<int>(std::min<size_t>(DragBlock::capacity, chosen.size() - start));
+          for (int m = 0; m < count; ++m) {
+            const int i = chosen[start + m];
+            const double per_mass = ftm2v / expected.mass[i];
+            const double a[3] = {expected.force[i][0] * per_mass, expected.force[i][1] * per_mass,
+                                 expected.force[i][2] * per_mass};
+            DragScale scale;
+            if (hindered) scale.voidage = voidage_of(expected.fraction[i], 0.55);
+            block.add_smooth({&model, 2.0 * expected.radius[i], scale}, per_mass, a, expected.v[i].data());
+          }
+          block.step(dt, kind);
+          for (int m = 0; m < count; ++m) {
+            const int i = chosen[start + m];
+            double dx[3];
+            block.velocity(m, expected.v[i].data());
+            block.displacement(m, dx);
+            for (int k = 0; k < 3; ++k) expected.x[i][k] += dx[k];
+            expected_state += state_sum(expected.x[i].data(), expected.v[i].data());
+            const double spin = spin_weight(kick, expected.radius[i], expected.mass[i]);
+            for (int k = 0; k < 3; ++k) expected.omega[i][k] += spin * expected.torque[i][k];
+            pack_weights(block.correction(m), ftm2v / expected.mass[i], expected.weights[i].data());
+          }
+          block.clear();
+          state += block.step_spheres(stepped.rows(hindered), chosen.data() + start, count, kick, dt, kind);
+          EXPECT_EQ(block.size(), 0);
+        }
+        expect_same_atoms(stepped, expected);
+        EXPECT_NEAR(state, expected_state, 1e-12 * std::abs(expected_state));
+      }
+    }
+  }
+}
+
+TEST(DragBlock, StepSpheresSumsANonFiniteState)
+{
+  const DragModel model(DragLaw::Standard, {998.2, 1.002e-3, 0.0});
+  Atoms atoms = some_atoms(DragBlock::capacity);
+  atoms.v[17][1] = std::numeric_limits<double>::quiet_NaN();
+  std::vector<int> all(DragBlock::capacity);
+  for (int i = 0; i < DragBlock::capacity; ++i) all[i] = i;
+  DragBlock block;
+  block.set_law(model, zero);
+  EXPECT_FALSE(std::isfinite(block.step_spheres(atoms.rows(false), all.data(), DragBlock::capacity, half_kick(1e-4, 1.0), 1e-4)));
+}
+
+TEST(Integrator, FinalRowsAddThePackedWeightsAndKickTheRotation)
+{
+  // drag_step_final_rows: per atom add_packed_weighted_acceleration of its force and fix nve/sphere's
+  // kick of its rotation, bit for bit, in vectors on every kind; a run that starts inside the arrays
+  // and ends in a short tail. The weights: isotropic (held, linear), along above and below across.
+  const HalfKick kick = half_kick(1e-4, 1.0);
+  const int n = 45, first = 3, count = 39;
+  for (const BatchMath kind : batch_math_kinds) {
+    if (!batch_math_available(kind)) continue;
+    SCOPED_TRACE(batch_math_name(kind));
+    Atoms expected = some_atoms(n);
+    for (int i = 0; i < n; ++i) {
+      StepCorrection corr;
+      corr.along = std::array<double, 3>{2e-5, 5e-5, 0.0}[i % 3];
+      corr.across = std::array<double, 4>{5e-5, 2e-5, 0.0, 3e-5}[i % 4];
+      const double norm = std::sqrt(1.0 + 0.25 + i * i * 1e-2);
+      corr.dir[0] = 1.0 / norm;
+      corr.dir[1] = -0.5 / norm;
+      corr.dir[2] = 0.1 * i / norm;
+      pack_weights(corr, 1.0 / expected.mass[i], expected.weights[i].data());
+    }
+    // Isotropic (along == across) at i = 2, 9 and 4 among others; at 4 a velocity and force of -0.0.
+    expected.v[4][0] = expected.force[4][0] = -0.0;
+    Atoms stepped = expected;
+    for (int i = first; i < first + count; ++i) {
+      add_packed_weighted_acceleration(expected.weights[i].data(), expected.force[i].data(), expected.v[i].data());
+      const double spin = spin_weight(kick, expected.radius[i], expected.mass[i]);
+      for (int k = 0; k < 3; ++k) expected.omega[i][k] += spin * expected.torque[i][k];
+    }
+    drag_step_final_rows(stepped.rows(false), first, count, kick, kind);
+    expect_same_atoms(stepped, expected);
+  }
+}
+
 TEST(Integrator, RotationDecaysExactly)
 {
   const double alpha[3] = {0, 0, 0};
@@ -610,6 +771,26 @@ TEST(Integrator, PackedWeightsAddTheWeightedAcceleration)
           EXPECT_NEAR(packed_v[k] - v0[k], added, 1e-14 * std::max(along, across) * scale * 10.0)
               << along << " " << across << " " << sign << " " << k;
       }
+    }
+  }
+}
+
+TEST(Integrator, PackedIsotropicWeightsKeepTheSignOfZero)
+{
+  // Isotropic weights (held: both 0; linear: equal) add exactly across a, as add_weighted_acceleration
+  // does, down to the sign of a zero velocity.
+  for (const double weight : {0.0, 3e-5}) {
+    StepCorrection corr;
+    corr.along = corr.across = weight;
+    double packed[PACKED_WEIGHTS_SIZE];
+    pack_weights(corr, 7.5e12, packed);
+    const double a[3] = {-0.0, 0.0, -9.81};
+    double direct[3] = {-0.0, -0.0, 0.0}, packed_v[3] = {-0.0, -0.0, 0.0};
+    add_weighted_acceleration(weight * 7.5e12, weight * 7.5e12, corr.dir, a, direct);
+    add_packed_weighted_acceleration(packed, a, packed_v);
+    for (int k = 0; k < 3; ++k) {
+      EXPECT_EQ(packed_v[k], direct[k]) << weight << " " << k;
+      EXPECT_EQ(std::signbit(packed_v[k]), std::signbit(direct[k])) << weight << " " << k;
     }
   }
 }

@@ -194,6 +194,9 @@ struct DragScale {
   double wetted = 1.0;
   double voidage = 1.0;
 };
+// The voidage around a sphere from the local solid fraction, capped at max_fraction (where grains stop
+// on a floor without contacts their grid fraction exceeds any packing, even 1).
+inline double voidage_of(double fraction, double max_fraction) { return 1.0 - std::clamp(fraction, 0.0, max_fraction); }
 
 // Di Felice (1994) exponent chi(Re) = 3.7 - 0.65 exp(-(1.5 - log10 Re)^2 / 2) and Re d chi / d Re.
 struct Exponent {

@@ -18,6 +18,7 @@
 
 #include "sediment/batch_math.hpp"
 #include "sediment/drag.hpp"
+#include "sediment/geometry.hpp"
 
 #include <cassert>
 #include <cmath>
@@ -75,6 +76,46 @@ struct StepCorrection {
 };
 
 inline double dot(const double a[3], const double b[3]) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+
+// The factors of a half step as LAMMPS's fix nve/sphere takes them: dtf = dt ftm2v / 2 weighs f / m,
+// dtf / I* weighs the torque over m r^2 (I* = 2/5, a solid sphere's inertia over m r^2). Taken once
+// per half step: the compiler may not hoist a division out of a loop over the atoms.
+struct HalfKick {
+  double ftm2v;    // force over mass to acceleration (LAMMPS's force->ftm2v; 1 in coherent units)
+  double dtf;
+  double dtfrotate;
+};
+inline HalfKick half_kick(double dt, double ftm2v)
+{
+  const double dtf = 0.5 * dt * ftm2v;
+  return {ftm2v, dtf, dtf / solid_sphere_inertia};
+}
+// fix nve/sphere's weight of the torque in a half step's kick of a sphere's rotation.
+inline double spin_weight(const HalfKick &kick, double radius, double mass)
+{
+  return kick.dtfrotate / (radius * radius * mass);
+}
+// The sum of a sphere's position and velocity: NaN or inf when any of them is (or when it overflows).
+inline double state_sum(const double x[3], const double v[3]) { return (x[0] + x[1] + x[2]) + (v[0] + v[1] + v[2]); }
+
+// The weights of a_{n+1} in 4 doubles per sphere (pack_weights, below).
+constexpr int PACKED_WEIGHTS_SIZE = 4;
+
+// The per-atom arrays of the spheres a DragBlock takes through a whole first half of the step
+// (DragBlock::step_spheres), as LAMMPS keeps them: indexed by atom, rows of 3 doubles one after
+// the other. No two of them overlap.
+struct SphereRows {
+  double (*x)[3];
+  double (*v)[3];
+  double (*omega)[3];
+  const double (*force)[3];
+  const double (*torque)[3];
+  const double *radius;
+  const double *mass;
+  const double *fraction;    // the local solid fraction of a hindrance, or nullptr (clear fluid)
+  double max_fraction;       // where the fraction is capped (voidage_of)
+  double (*weights)[PACKED_WEIGHTS_SIZE];    // written: each sphere's packed weights per unit mass
+};
 
 // The slip's exact advance over t under ds/dt = c - k s from s0, given p = phis(k t).
 struct Segment {
@@ -156,6 +197,17 @@ class DragBlock {
   // and a caller may take it so (correction(n) tests each sphere).
   bool stepped_in_pieces() const { return in_pieces_; }
 
+  // The first half of the step of the atoms atoms[0..count) of rows (count <= capacity, increasing),
+  // with the block empty and its law smooth: each wholly immersed, of diameter 2 radius, its
+  // acceleration force ftm2v / mass. Its drag step as add_smooth, step and velocity, displacement
+  // and correction give it, then fix nve/sphere's kick of its rotation (spin_weight), bit for bit:
+  // x and v advanced, omega kicked, its weights packed per unit mass into rows.weights. Leaves the
+  // block empty; returns the sum of the spheres' new state_sums (a check of a finite state).
+  // Loops over the block's spheres in vectors of the kind's width, as the stages: consecutive atoms
+  // (the common case) as rows one after the other.
+  double step_spheres(const SphereRows &rows, const int *atoms, int count, const HalfKick &kick, double dt,
+                      BatchMath kind = batch_math_kind());
+
  private:
   // What the one-piece step needs of a sphere.
   int add_for_one_piece(const SphereDrag &drag, double inverse_mass, const double a[3], const double v[3])
@@ -185,6 +237,28 @@ class DragBlock {
     wetted_[n] = drag.scale.wetted;
     inverse_mass_[n] = inverse_mass;
   }
+  // step_spheres in parts: its loads and stores over atoms atom(n), and the whole for an instruction set.
+  template <class Atom>
+  void add_spheres(Atom atom, int count, double ftm2v, const double (*v)[3], const double (*force)[3],
+                   const double *radius, const double *mass, const double *fraction, double max_fraction);
+  template <class Atom>
+  double finish_spheres(Atom atom, HalfKick kick, double (*x)[3], double (*v)[3], double (*omega)[3],
+                        const double (*torque)[3], const double *radius, const double *mass,
+                        double (*weights)[PACKED_WEIGHTS_SIZE]) const;
+  template <class Atom>
+  double step_spheres_of(const SphereRows &rows, Atom atom, int count, const HalfKick &kick, double dt, BatchMath kind);
+  struct ConsecutiveAtoms {
+    int first;
+    int operator()(int n) const { return first + n; }
+  };
+  struct ListedAtoms {
+    const int *atoms;
+    int operator()(int n) const { return atoms[n]; }
+  };
+  double step_spheres_in(const SphereRows &rows, const int *atoms, int count, const HalfKick &kick, double dt,
+                         BatchMath kind);
+  double step_spheres_avx2(const SphereRows &rows, const int *atoms, int count, const HalfKick &kick, double dt);
+  double step_spheres_avx512(const SphereRows &rows, const int *atoms, int count, const HalfKick &kick, double dt);
   // The stages, inlined into the step of each instruction set (integrator.cpp).
   void stages(const DragModel &model, double dt, BatchMath kind);
   void stages_avx2(const DragModel &model, double dt);
@@ -326,7 +400,6 @@ inline void drag_step_final(const StepCorrection &corr, const double a[3], doubl
 // of along - across (a weight is never negative: phi2 > 0 at every rate), and the slip direction
 // times sqrt|along - across|. Half a 64-byte cache line per sphere, where the two weights and the
 // direction took 5 doubles: the memory traffic between the halves is what a cheap step waits on.
-constexpr int PACKED_WEIGHTS_SIZE = 4;
 inline void pack_weights(const StepCorrection &corr, double scale, double packed[PACKED_WEIGHTS_SIZE])
 {
   const double along = corr.along * scale, across = corr.across * scale;
@@ -342,18 +415,32 @@ inline void add_packed_weighted_acceleration(const double packed[PACKED_WEIGHTS_
   const double accel[3] = {a[0], a[1], a[2]};
   const double across = std::abs(packed[0]);
   const double scaled_dir[3] = {packed[1], packed[2], packed[3]};
-  // All three == 0.0 (either sign), tested on their bits: three floating-point compares with their
-  // unordered cases took 15 instructions per atom of the second half.
-  std::uint64_t bits[3];
-  std::memcpy(bits, scaled_dir, sizeof bits);
-  if (((bits[0] | bits[1] | bits[2]) << 1) == 0) {
-    for (int k = 0; k < 3; ++k) v[k] += across * accel[k];
-    return;
+  // Without a branch, so that loops over many spheres take it in vectors: the direction all == 0.0
+  // (either sign) tested with & (&& would branch), and the excess's sign (that of along - across) by a
+  // product with +-1, which is exact (std::signbit has no vector form).
+  const bool isotropic = (scaled_dir[0] == 0.0) & (scaled_dir[1] == 0.0) & (scaled_dir[2] == 0.0);
+  const double excess = dot(accel, scaled_dir) * std::copysign(1.0, packed[0]);    // (along - across) (a . dir)
+  // Isotropic, the excess's term is replaced by -0.0, which leaves any sum as it is: so v takes
+  // across a exactly. Through the bits: GCC turns a choice between -0.0 and the term into a masked
+  // add, which AVX2 lacks, and leaves the loop scalar.
+  const std::uint64_t keep = isotropic ? 0 : ~std::uint64_t{0}, negative_zero = std::uint64_t{1} << 63;
+  for (int k = 0; k < 3; ++k) {
+    std::uint64_t term_bits;
+    const double term = excess * scaled_dir[k];
+    std::memcpy(&term_bits, &term, sizeof term);
+    term_bits = (term_bits & keep) | (negative_zero & ~keep);
+    double kept_term;
+    std::memcpy(&kept_term, &term_bits, sizeof term_bits);
+    v[k] += across * accel[k] + kept_term;
   }
-  const double projection = dot(accel, scaled_dir);
-  const double excess = std::signbit(packed[0]) ? -projection : projection;    // (along - across) (a . dir)
-  for (int k = 0; k < 3; ++k) v[k] += across * accel[k] + excess * scaled_dir[k];
 }
+
+// The second half of the step of the atoms first..first + count - 1 of rows, each with the weights
+// its first half packed per unit mass (DragBlock::step_spheres): add_packed_weighted_acceleration of
+// its force (the step is linear in the force, so f takes the place of a = f / m), then fix
+// nve/sphere's kick of its rotation. In vectors of the kind's width.
+void drag_step_final_rows(const SphereRows &rows, int first, int count, const HalfKick &kick,
+                          BatchMath kind = batch_math_kind());
 
 // Largest time step at which this step is stable for a sphere on a linear spring of angular
 // frequency omega (the spring force taken explicitly, as LAMMPS's contacts are) under a linear drag
