@@ -157,7 +157,8 @@ void FixFluidBuoyancy::post_force(int /*vflag*/)
   double sum[3] = {0.0, 0.0, 0.0};
   int immersed = 0;
   // The loop compiled for a fluid that fills space or not and with a mixture or not: with the tests
-  // inside, the common case (clear fluid everywhere) took 41 instructions per atom.
+  // inside, the common case (clear fluid everywhere) took 41 instructions per atom. That case now runs
+  // in the core's vectors (below), the others here.
   auto add_buoyancy = [&](auto fills_space, auto with_mixture) {
     for (int i = 0; i < nlocal; ++i) {
       if (!(mask[i] & groupbit)) continue;
@@ -181,16 +182,25 @@ void FixFluidBuoyancy::post_force(int /*vflag*/)
       ++immersed;
     }
   };
-  auto with_or_without_mixture = [&](auto fills_space) {
+  if (!fluid->fills_space()) {
     if (fraction)
-      add_buoyancy(fills_space, std::true_type{});
+      add_buoyancy(std::false_type{}, std::true_type{});
     else
-      add_buoyancy(fills_space, std::false_type{});
-  };
-  if (fluid->fills_space())
-    with_or_without_mixture(std::true_type{});
-  else
-    with_or_without_mixture(std::false_type{});
+      add_buoyancy(std::false_type{}, std::false_type{});
+  } else if (fraction) {
+    add_buoyancy(std::true_type{}, std::true_type{});
+  } else {
+    // Clear fluid everywhere (the common case): each run of consecutive atoms of the group in vectors.
+    // The totals from the run's displaced mass: the same forces to round-off.
+    for_each_run(
+        nlocal, [&](int i) { return mask[i] & groupbit; },
+        [&](int first, int count) {
+          const double displaced = sediment::add_immersed_buoyancy(f, radius, first, count, rho, g);
+          for (int k = 0; k < 3; ++k) sum[k] += -displaced * g[k];
+          immersed += count;
+        },
+        [](int) {});
+  }
   totals.clear();
   for (int k = 0; k < 3; ++k) totals[k] = sum[k];
   totals[3] = immersed;

@@ -569,20 +569,20 @@ void FixNVESphereFluid::final_integrate()
                                     weight_rows};
     const int both = groupbit | uniform->groupbit;
     with_floor_or_not(floor_dim, [&](auto with_floor) {
-      for (int i = 0; i < nlocal;) {
-        int end = i;
-        while (end < nlocal && (mask[end] & both) == both) ++end;
-        if (end > i) {
-          sediment::drag_step_final_rows(rows, i, end - i, kick);
-        } else {
-          if (mask[i] & groupbit) nve_sphere_kick(v[i], omega[i], f[i], torque[i], radius[i], rmass[i], kick);
-          end = i + 1;
-        }
-        if constexpr (decltype(with_floor)::value)
-          for (; i < end; ++i)
-            if (mask[i] & groupbit) settle_on_floor(x[i], v[i], omega[i], radius[i], floor_dim, floor_at);
-        i = end;
-      }
+      constexpr bool on_floor = decltype(with_floor)::value;
+      for_each_run(
+          nlocal, [&](int i) { return (mask[i] & both) == both; },
+          [&](int first, int count) {
+            sediment::drag_step_final_rows(rows, first, count, kick);
+            if constexpr (on_floor)
+              for (int i = first; i < first + count; ++i)
+                settle_on_floor(x[i], v[i], omega[i], radius[i], floor_dim, floor_at);
+          },
+          [&](int i) {
+            if (!(mask[i] & groupbit)) return;
+            nve_sphere_kick(v[i], omega[i], f[i], torque[i], radius[i], rmass[i], kick);
+            if constexpr (on_floor) settle_on_floor(x[i], v[i], omega[i], radius[i], floor_dim, floor_at);
+          });
     });
     return;
   }

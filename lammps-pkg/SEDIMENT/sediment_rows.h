@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: GPL-2.0-or-later
 /* ----------------------------------------------------------------------
-   SEDIMENT package: per-atom 2d arrays indexed as rows of a fixed width.
+   SEDIMENT package: per-atom 2d arrays indexed as rows of a fixed width, and runs of atoms.
 ------------------------------------------------------------------------- */
 
 #ifndef LMP_SEDIMENT_ROWS_H
@@ -15,6 +15,23 @@ namespace LAMMPS_NS {
 template <int columns> inline double (*flat_rows(double **array))[columns]
 {
   return array ? reinterpret_cast<double(*)[columns]>(array[0]) : nullptr;
+}
+
+// Calls run(first, count) for each run of consecutive atoms i < n for which in_run(i) holds (the
+// core's loops over rows take a run in vectors), and other(i) for each atom between the runs, in the
+// order of the atoms.
+template <class InRun, class Run, class Other> inline void for_each_run(int n, InRun in_run, Run run, Other other)
+{
+  for (int i = 0; i < n;) {
+    int end = i;
+    while (end < n && in_run(end)) ++end;
+    if (end > i) {
+      run(i, end - i);
+      i = end;
+    } else {
+      other(i++);
+    }
+  }
 }
 
 }    // namespace LAMMPS_NS

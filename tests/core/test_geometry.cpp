@@ -2,7 +2,9 @@
 // Submergence below a free surface and the Rayleigh time (docs/physics.md sections 1 and 6).
 #include "sediment/geometry.hpp"
 
+#include <array>
 #include <cmath>
+#include <vector>
 #include <tuple>
 
 #include <gtest/gtest.h>
@@ -72,6 +74,39 @@ TEST(Buoyancy, MixtureDensityAndDisplacedMass)
   EXPECT_DOUBLE_EQ(displaced_mass(998.2, r, submergence(r, -3 * r)), 998.2 * sphere_volume(2 * r));
   EXPECT_DOUBLE_EQ(displaced_mass(998.2, r, submergence(r, 0.0)), 0.5 * 998.2 * sphere_volume(2 * r));
   EXPECT_EQ(displaced_mass(998.2, r, submergence(r, 3 * r)), 0.0);
+}
+
+TEST(Buoyancy, ImmersedRowsTakeEachAtomsBuoyancyOnEveryKind)
+{
+  // add_immersed_buoyancy adds -displaced_mass g to each force row of its run, bit for bit the atom's
+  // own sum (a zero component of g adds -0.0, which changes no force), in vectors and their tail, and
+  // returns the run's displaced mass to round-off.
+  const int n = 29, first = 2, count = 23;
+  const double g[3] = {0.0, 0.5, -9.81}, rho = 998.2;
+  for (const sediment::BatchMath kind : sediment::batch_math_kinds) {
+    if (!sediment::batch_math_available(kind)) continue;
+    SCOPED_TRACE(sediment::batch_math_name(kind));
+    std::vector<std::array<double, 3>> force(n), expected(n);
+    std::vector<double> radius(n);
+    for (int i = 0; i < n; ++i) {
+      radius[i] = 1e-6 * (5 + 7 * (i % 5));
+      force[i] = expected[i] = {i % 3 == 0 ? -0.0 : 1e-9 * i, -2e-9 * i, 3e-10};
+    }
+    double displaced = 0.0;
+    for (int i = first; i < first + count; ++i) {
+      const double mass = sediment::displaced_mass(rho, radius[i], {1.0, 1.0, 1.0});
+      for (int k = 0; k < 3; ++k) expected[i][k] += -mass * g[k];
+      displaced += mass;
+    }
+    const double sum = sediment::add_immersed_buoyancy(reinterpret_cast<double(*)[3]>(force.data()), radius.data(),
+                                                       first, count, rho, g, kind);
+    EXPECT_NEAR(sum, displaced, 1e-14 * displaced);
+    for (int i = 0; i < n; ++i)
+      for (int k = 0; k < 3; ++k) {
+        EXPECT_EQ(force[i][k], expected[i][k]) << i << " " << k;
+        EXPECT_EQ(std::signbit(force[i][k]), std::signbit(expected[i][k])) << i << " " << k;
+      }
+  }
 }
 
 TEST(HertzImpact, OverlapAndModulusAreInverse)

@@ -2,6 +2,8 @@
 // Sphere geometry: volumes, areas, inertia and partial submergence below a plane free surface.
 #pragma once
 
+#include "sediment/batch_math.hpp"
+
 namespace sediment {
 
 constexpr double pi = 3.14159265358979323846;
@@ -43,6 +45,12 @@ inline double displaced_mass(double density, double radius, const Submergence &s
 {
   return density * sub.volume * sphere_volume(2.0 * radius);
 }
+
+// Archimedes' buoyancy -displaced_mass g added to the forces (rows of 3, indexed by atom, as LAMMPS
+// keeps them) of the atoms first..first + count - 1, each wholly immersed in a fluid of this density:
+// bit for bit the per-atom sum. Returns their displaced mass. In vectors of the kind's width.
+double add_immersed_buoyancy(double (*force)[3], const double *radius, int first, int count, double density,
+                             const double g[3], BatchMath kind = batch_math_kind());
 
 // Rayleigh time pi r sqrt(rho / G) / (0.1631 nu + 0.8766), G = E / (2 (1 + nu)).
 double rayleigh_time(double radius, double density, double youngs_modulus, double poisson_ratio);
