@@ -466,7 +466,8 @@ template <class Atom>
 [[gnu::always_inline]] inline void DragBlock::add_spheres(Atom atom, int count, double ftm2v,
                                                            const double (*__restrict v)[3],
                                                            const double (*__restrict force)[3],
-                                                           const double *__restrict radius, const double *__restrict mass,
+                                                           const double *__restrict radius,
+                                                           const double *__restrict mass,
                                                            const double *__restrict fraction, double max_fraction)
 {
   const DragModel &model = *model_;
@@ -578,7 +579,8 @@ double DragBlock::step_spheres(const SphereRows &rows, const int *atoms, int cou
                                BatchMath kind)
 {
   assert(size_ == 0 && count > 0 && count <= capacity && model_->smooth());
-  if (kind == BatchMath::AVX512 && batch_math_available(kind)) return step_spheres_avx512(rows, atoms, count, kick, dt);
+  if (kind == BatchMath::AVX512 && batch_math_available(kind))
+    return step_spheres_avx512(rows, atoms, count, kick, dt);
   if (kind == BatchMath::AVX2 && batch_math_available(kind)) return step_spheres_avx2(rows, atoms, count, kick, dt);
   return step_spheres_in(rows, atoms, count, kick, dt, kind);
 }
@@ -605,7 +607,8 @@ void final_rows_of(const SphereRows &rows, int first, int count, const HalfKick 
   final_rows(first, count, kick, rows.v, rows.omega, rows.force, rows.torque, rows.radius, rows.mass, rows.weights);
 }
 #if defined(__x86_64__) && defined(__GNUC__)
-__attribute__((target("avx2"))) void final_rows_avx2(const SphereRows &rows, int first, int count, const HalfKick &kick)
+__attribute__((target("avx2"))) void final_rows_avx2(const SphereRows &rows, int first, int count,
+                                                     const HalfKick &kick)
 {
   final_rows(first, count, kick, rows.v, rows.omega, rows.force, rows.torque, rows.radius, rows.mass, rows.weights);
 }

@@ -381,7 +381,7 @@ template <bool on_floor> void FixNVESphereFluid::first_half_immersed()
 {
   const auto [x, v, f, omega, torque, radius, rmass, mask, nlocal] = sphere_arrays(atom);
   const FixFluidDrag::Immersed immersed = uniform->immersed();
-  const sediment::SphereRows rows{x,      v,     omega,           f, torque, radius, rmass, immersed.fraction,
+  const sediment::SphereRows rows{x, v, omega, f, torque, radius, rmass, immersed.fraction,
                                   immersed.max_fraction, flat_rows<NWEIGHTS>(weights)};
   const int drag_bit = uniform->groupbit;
   const double *flow = uniform->fluid_fix()->velocity();
@@ -565,8 +565,7 @@ void FixNVESphereFluid::final_integrate()
   // The uniform step: each run of consecutive atoms in the drag's group (the fluid's) takes its second
   // half in vectors (sediment::drag_step_final_rows); an atom of the group outside it fix nve/sphere's.
   if (uniform) {
-    const sediment::SphereRows rows{x,       v,   omega, f, torque, radius, rmass, nullptr, 0.0,
-                                    weight_rows};
+    const sediment::SphereRows rows{x, v, omega, f, torque, radius, rmass, nullptr, 0.0, weight_rows};
     const int both = groupbit | uniform->groupbit;
     with_floor_or_not(floor_dim, [&](auto with_floor) {
       constexpr bool on_floor = decltype(with_floor)::value;

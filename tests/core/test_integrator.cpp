@@ -607,7 +607,9 @@ TEST(DragBlock, StepSpheresSumsANonFiniteState)
   for (int i = 0; i < DragBlock::capacity; ++i) all[i] = i;
   DragBlock block;
   block.set_law(model, zero);
-  EXPECT_FALSE(std::isfinite(block.step_spheres(atoms.rows(false), all.data(), DragBlock::capacity, half_kick(1e-4, 1.0), 1e-4)));
+  const double dt = 1e-4;
+  const double state = block.step_spheres(atoms.rows(false), all.data(), DragBlock::capacity, half_kick(dt, 1.0), dt);
+  EXPECT_FALSE(std::isfinite(state));
 }
 
 TEST(Integrator, FinalRowsAddThePackedWeightsAndKickTheRotation)
