@@ -459,7 +459,7 @@ void DragBlock::step(double dt, BatchMath kind)
   if (in_pieces_) step_in_pieces(model, dt);
 }
 
-// step_spheres' loads: add_smooth's, with 1 / m and a_n = f / m taken here in vectors. The rows come as
+// step_spheres' loads: add_smooth's (set_for_one_piece), with 1 / m and a_n = f / m taken here in vectors. The rows come as
 // restricted parameters: with them in locals, GCC did not take them as restricted and left the loops
 // scalar (it could not check every pair of arrays for overlap).
 template <class Atom>
@@ -470,20 +470,13 @@ template <class Atom>
                                                            const double *__restrict mass,
                                                            const double *__restrict fraction, double max_fraction)
 {
-  const DragModel &model = *model_;
   for (int n = 0; n < count; ++n) {
     const int i = atom(n);
     const double inverse_mass = ftm2v / mass[i];
+    const double a[3] = {force[i][0] * inverse_mass, force[i][1] * inverse_mass, force[i][2] * inverse_mass};
     DragScale scale;
     if (fraction) scale.voidage = voidage_of(fraction[i], max_fraction);
-    const double diameter = 2.0 * radius[i];
-    for (int k = 0; k < 3; ++k) {
-      v_[k][n] = v[i][k];
-      a_[k][n] = force[i][k] * inverse_mass;
-    }
-    reynolds_per_speed_[n] = model.smooth_reynolds_per_speed(diameter);
-    rate_per_g_[n] = model.smooth_drag_per_speed(diameter, scale) * inverse_mass;
-    voidage_[n] = scale.voidage;
+    set_for_one_piece(n, {model_, 2.0 * radius[i], scale}, inverse_mass, a, v[i]);
     inverse_mass_[n] = inverse_mass;
   }
   size_ = count;
@@ -504,21 +497,18 @@ template <class Atom>
   for (int n = 0; n < size_; ++n) {
     const int i = atom(n);
     double new_x[3], new_v[3];
+    displacement(n, new_x);
+    velocity(n, new_v);
     for (int k = 0; k < 3; ++k) {
-      new_x[k] = x[i][k] + dx_[k][n];
-      new_v[k] = mid_v_[k][n];
+      new_x[k] += x[i][k];
       x[i][k] = new_x[k];
       v[i][k] = new_v[k];
     }
     states[n] = state_sum(new_x, new_v);
     const double spin = spin_weight(kick, radius[i], mass[i]);
     for (int k = 0; k < 3; ++k) omega[i][k] += spin * torque[i][k];
-    StepCorrection corr;
-    corr.along = along_[n];
-    corr.across = across_[n];
-    for (int k = 0; k < 3; ++k) corr.dir[k] = dir_[k][n];
     double packed[PACKED_WEIGHTS_SIZE];    // stored below: through its pointer, a store could be anywhere
-    pack_weights(corr, inverse_mass_[n], packed);
+    pack_weights(correction(n), inverse_mass_[n], packed);
     for (int k = 0; k < PACKED_WEIGHTS_SIZE; ++k) weights[i][k] = packed[k];
   }
   double state = 0.0;

@@ -232,6 +232,19 @@ static inline bool rests_on_floor(const double *x, const double *v, const double
   return true;
 }
 
+// A sphere that rests_on_floor held there: no weights for the second half (nor the torque's: a
+// uniform step's second half gives it fix nve/sphere's, and settle_on_floor takes the rotation away
+// again, as the sphere's velocity stays 0), left where it is with its rotation stopped. Returns its
+// state_sum (its position along the floor is not among what the test reads).
+static inline double hold_on_floor(double *weights, double *x, double *v, double *omega, double radius, int axis,
+                                   double level)
+{
+  std::fill(weights, weights + sediment::PACKED_WEIGHTS_SIZE, 0.0);
+  const double state = state_sum(x, v);
+  settle_on_floor(x, v, omega, radius, axis, level);
+  return state;
+}
+
 template <FixNVESphereFluid::HalfStep path, bool is_uniform, bool on_floor, class Lookup>
 void FixNVESphereFluid::first_half(Lookup lookup)
 {
@@ -337,12 +350,8 @@ void FixNVESphereFluid::first_half(Lookup lookup)
     // a set-valued law would count it as stuck, so it takes its step.
     if (on_floor && rests_on_floor(x[i], v[i], f[i], radius[i], flow, floor_dim, floor_at) &&
         (linear || sediment::step_kind(sphere) != sediment::StepKind::SetValued)) {
-      // Held: no weights, and no torque's either (a uniform step's second half gives it fix nve/sphere's,
-      // and settle_on_floor takes the rotation away again, as the sphere's velocity stays 0).
-      std::fill(weight_rows[i], weight_rows[i] + NWEIGHTS, 0.0);
       if constexpr (keeps_all) general_rows[i][SPIN] = 0.0;
-      state += state_sum(x[i], v[i]);    // its position along the floor is not among what the test reads
-      settle_on_floor(x[i], v[i], omega[i], radius[i], floor_dim, floor_at);    // where it is, its rotation stopped
+      state += hold_on_floor(weight_rows[i], x[i], v[i], omega[i], radius[i], floor_dim, floor_at);
       continue;
     }
 
@@ -415,9 +424,7 @@ template <bool on_floor> void FixNVESphereFluid::first_half_immersed()
     }
     if (immersed.capped(i)) ++capped;
     if (on_floor && rests_on_floor(x[i], v[i], f[i], radius[i], flow, floor_dim, floor_at)) {
-      std::fill(weights[i], weights[i] + NWEIGHTS, 0.0);    // held, as in first_half
-      state += state_sum(x[i], v[i]);
-      settle_on_floor(x[i], v[i], omega[i], radius[i], floor_dim, floor_at);
+      state += hold_on_floor(weights[i], x[i], v[i], omega[i], radius[i], floor_dim, floor_at);
       continue;
     }
     waiting[size++] = i;

@@ -209,10 +209,15 @@ class DragBlock {
                       BatchMath kind = batch_math_kind());
 
  private:
-  // What the one-piece step needs of a sphere.
+  // What the one-piece step needs of a sphere, as the next of the block or in place n.
   int add_for_one_piece(const SphereDrag &drag, double inverse_mass, const double a[3], const double v[3])
   {
     const int n = size_++;
+    set_for_one_piece(n, drag, inverse_mass, a, v);
+    return n;
+  }
+  void set_for_one_piece(int n, const SphereDrag &drag, double inverse_mass, const double a[3], const double v[3])
+  {
     for (int k = 0; k < 3; ++k) {
       v_[k][n] = v[k];
       a_[k][n] = a[k];
@@ -220,7 +225,6 @@ class DragBlock {
     reynolds_per_speed_[n] = drag.model->smooth_reynolds_per_speed(drag.diameter);
     rate_per_g_[n] = drag.model->smooth_drag_per_speed(drag.diameter, drag.scale) * inverse_mass;
     voidage_[n] = drag.scale.voidage;
-    return n;
   }
   static void copy3(const double (&from)[3][capacity], int n, double to[3])
   {
