@@ -97,12 +97,28 @@ namespace {
   // lose digits to cancellation there), the direct forms with an exponential, or past the normal
   // range of e^-z the direct forms with e^-z = 0, except in the narrow band where e^-z is subnormal.
   std::int64_t any_small = 0, any_direct = 0, any_large = 0, any_subnormal = 0;    // 64 bits, as a lane of doubles
+  std::int64_t all_fewest = 1;
   for (int k = 0; k < n; ++k) {
     const bool small = std::abs(z[k]) < series_limit, large = z[k] > normal_decay_limit;
     any_small |= small;
     any_direct |= !small & !large;
     any_large |= large;
     any_subnormal |= large & (z[k] <= decay_limit);
+    all_fewest &= std::abs(z[k]) < series_ranges[0].below;
+  }
+  // Every rate in the first range (steps far below the relaxation time: a bed's contacts, dt/tau up
+  // to about 1e-3): each takes the series' fewest terms, so the sums below need no count per rate.
+  if (all_fewest) {
+    constexpr int fewest = series_ranges[0].terms;
+    for (int k = 0; k < n; ++k) {
+      double p2 = series.phi2[fewest - 1];
+      for (int t = fewest - 2; t >= 0; --t) p2 = p2 * z[k] + series.phi2[t];
+      const Phi from_series = phis_from_series(z[k], p2);
+      decay[k] = from_series.decay;
+      phi1[k] = from_series.phi1;
+      phi2[k] = from_series.phi2;
+    }
+    return;
   }
   if (any_direct) {
     for (int k = 0; k < n; ++k) decay[k] = -std::min(z[k], normal_decay_limit);

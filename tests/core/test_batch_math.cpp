@@ -143,6 +143,7 @@ TEST(BatchMath, PhisManyOfOneRegimeFollowPhis)
 {
   const std::vector<std::vector<double>> groups = {
       {1e-5, -3e-4, 2e-6, 1e-12},                              // six terms
+      {0.0, -0.0, 1e-300, -0x1p-10, 0x1.fffffffffffffp-10},    // six terms, up to the first range's end
       {1e-5, 0.03, -0.05, 0x1p-9},                             // six to ten
       {0.3, -0.2, 1e-7, 0.49},                                 // up to sixteen
       {800.0, 708.5, 745.0, 1e6, 5000.0},                      // e^-z subnormal or zero
