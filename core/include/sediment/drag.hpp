@@ -333,33 +333,40 @@ class DragModel {
       }
       case DragLaw::Standard: {
         constexpr int chunk = 64;
-        double log_re[chunk], power[chunk];
+        double log_re[chunk];
         for (int start = 0; start < n; start += chunk) {
           const int m = std::min(n - start, chunk);
           log_many(re + start, log_re, m, kind);
-          // A chunk wholly on the lowest piece (most, in a settling test) takes it without the selects
-          // and table look-ups of the others (a quarter of the block's step under this law).
-          std::int64_t all_low = 1;
-          for (int j = 0; j < m; ++j) all_low &= re[start + j] < standard_curve::low_to_mid;
-          if (all_low) {
-            for (int j = 0; j < m; ++j) {
-              log_re[j] = standard_curve::clamp_log(log_re[j]);
-              power[j] = standard_curve::low_argument(log_re[j]);
-            }
-            exp_many(power, power, m, kind);
-            for (int j = 0; j < m; ++j) out[start + j] = standard_curve::low_curve(log_re[j], power[j]);
-            continue;
-          }
-          for (int j = 0; j < m; ++j) {
-            log_re[j] = standard_curve::clamp_log(log_re[j]);
-            power[j] = standard_curve::argument(re[start + j], log_re[j]);
-          }
-          exp_many(power, power, m, kind);
-          for (int j = 0; j < m; ++j) out[start + j] = standard_curve::curve(re[start + j], log_re[j], power[j]);
+          standard_curves(re + start, log_re, out + start, m, kind);
         }
         return;
       }
     }
+  }
+  // The standard curve of m <= 64 spheres from their Re and ln Re (log_re is overwritten).
+  [[gnu::always_inline]] static void standard_curves(const double *re, double *log_re, DragCurve *out, int m,
+                                                     BatchMath kind)
+  {
+    double power[64];
+    // A chunk wholly on the lowest piece (most, in a settling test) takes it without the selects
+    // and table look-ups of the others (a quarter of the block's step under this law).
+    std::int64_t all_low = 1;
+    for (int j = 0; j < m; ++j) all_low &= re[j] < standard_curve::low_to_mid;
+    if (all_low) {
+      for (int j = 0; j < m; ++j) {
+        log_re[j] = standard_curve::clamp_log(log_re[j]);
+        power[j] = standard_curve::low_argument(log_re[j]);
+      }
+      exp_many(power, power, m, kind);
+      for (int j = 0; j < m; ++j) out[j] = standard_curve::low_curve(log_re[j], power[j]);
+      return;
+    }
+    for (int j = 0; j < m; ++j) {
+      log_re[j] = standard_curve::clamp_log(log_re[j]);
+      power[j] = standard_curve::argument(re[j], log_re[j]);
+    }
+    exp_many(power, power, m, kind);
+    for (int j = 0; j < m; ++j) out[j] = standard_curve::curve(re[j], log_re[j], power[j]);
   }
   // Di Felice's hindrance applied to single-sphere curves (nothing under another law), each stage one
   // loop over a chunk of spheres with no gather of the hindered ones: an unhindered sphere (eps >= 1)
@@ -373,7 +380,7 @@ class DragModel {
     double log_re[chunk], log_eps[chunk], t[chunk], gauss[chunk], value[chunk], slope[chunk], factor[chunk];
     for (int start = 0; start < n; start += chunk) {
       const int m = std::min(n - start, chunk);
-      bool any = false;    // a chunk in clear fluid costs nothing
+      std::int64_t any = 0;    // a chunk in clear fluid costs nothing (64 bits, as a lane: one vector loop)
       for (int j = 0; j < m; ++j) any |= hindered(voidage[start + j]);
       if (!any) continue;
       for (int j = 0; j < m; ++j) {
@@ -405,22 +412,21 @@ class DragModel {
                                                BatchMath kind) const
   {
     constexpr int chunk = 64;
-    double log_eps[chunk], k[chunk], stretch[chunk], stretched_re[chunk], value[chunk], slope[chunk];
+    double log_re[chunk], log_eps[chunk], k[chunk], stretch[chunk], stretched_re[chunk], value[chunk],
+        slope[chunk];
     for (int start = 0; start < n; start += chunk) {
       const int m = std::min(n - start, chunk);
-      bool any = false;    // a chunk in clear fluid costs its curves alone
+      std::int64_t any = 0;    // a chunk in clear fluid costs its curves alone (one vector loop)
       for (int j = 0; j < m; ++j) any |= hindered(voidage[start + j]);
       if (!any) {
         single_curves(re + start, out + start, m, kind);
         continue;
       }
-      for (int j = 0; j < m; ++j) {
-        k[j] = re[start + j];                                   // ln 0 = -inf and e^-inf = 0: K = 0 at rest
-        log_eps[j] = std::min(voidage[start + j], 1.0);         // eps >= 1: no hindrance; NaN stays NaN
-      }
-      log_many(k, k, m, kind);
+      // eps >= 1: no hindrance; NaN stays NaN
+      for (int j = 0; j < m; ++j) log_eps[j] = std::min(voidage[start + j], 1.0);
+      log_many(re + start, log_re, m, kind);    // ln 0 = -inf and e^-inf = 0: K = 0 at rest
       log_many(log_eps, log_eps, m, kind);
-      for (int j = 0; j < m; ++j) k[j] = exponent_fit_.power * k[j] + log_scale_;
+      for (int j = 0; j < m; ++j) k[j] = exponent_fit_.power * log_re[j] + log_scale_;
       exp_many(k, k, m, kind);
       for (int j = 0; j < m; ++j) {
         const Exponent e = richardson_zaki_exponent(exponent_fit_, k[j]);
@@ -428,9 +434,16 @@ class DragModel {
         slope[j] = e.re_slope;
         stretch[j] = -e.value * log_eps[j];
       }
+      // The standard curve takes ln(S Re) as ln Re + ln S, ln S being the exponent just taken: one
+      // logarithm less (within round-off of curve(), which takes the logarithm of S Re).
+      if (single_law_ == DragLaw::Standard)
+        for (int j = 0; j < m; ++j) log_re[j] += stretch[j];
       exp_many(stretch, stretch, m, kind);
       for (int j = 0; j < m; ++j) stretched_re[j] = stretch[j] * re[start + j];
-      single_curves(stretched_re, out + start, m, kind);
+      if (single_law_ == DragLaw::Standard)
+        standard_curves(stretched_re, log_re, out + start, m, kind);
+      else
+        single_curves(stretched_re, out + start, m, kind);
       for (int j = 0; j < m; ++j)
         out[start + j] = stretched_curve(out[start + j], {value[j], slope[j]}, log_eps[j], stretch[j],
                                          std::min(voidage[start + j], 1.0));
