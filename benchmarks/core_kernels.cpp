@@ -77,7 +77,28 @@ void interpolate(benchmark::State &state, const sediment::Grid &grid)
   state.SetItemsProcessed(state.iterations() * spheres);
 }
 
+// Every sphere in one call, as compute concentration/grid deposits group all, the rows in LAMMPS's
+// order after its spatial sort (atom_modify sort, by default every 1000 steps): neighbours in turn,
+// so that consecutive spheres mostly add to the same layer.
+void deposit_sorted(benchmark::State &state, const sediment::Grid &grid)
+{
+  const auto random_order = centres();
+  std::vector<int> order(spheres);
+  for (int i = 0; i < spheres; ++i) order[i] = i;
+  std::sort(order.begin(), order.end(), [&](int a, int b) { return random_order[a][2] < random_order[b][2]; });
+  auto at = std::make_unique<double[][3]>(spheres);
+  for (int i = 0; i < spheres; ++i) std::copy_n(random_order[order[i]], 3, at[i]);
+  const std::vector<double> radii(spheres, radius);
+  std::vector<double> values(grid.cells());
+  for (auto _ : state) {
+    sediment::add_spheres_to_grid(grid, at.get(), radii.data(), nullptr, spheres, values.data());
+    benchmark::DoNotOptimize(values.data());
+  }
+  state.SetItemsProcessed(state.iterations() * spheres);
+}
+
 void LayerDeposit(benchmark::State &state) { deposit(state, layer_grid()); }
+void LayerDepositSorted(benchmark::State &state) { deposit_sorted(state, layer_grid()); }
 void LayerInterpolation(benchmark::State &state) { interpolate(state, layer_grid()); }
 void CellDeposit(benchmark::State &state) { deposit(state, cell_grid()); }
 void CellInterpolation(benchmark::State &state) { interpolate(state, cell_grid()); }
@@ -222,6 +243,7 @@ void ZhangLiBinghamInPieces(benchmark::State &state)
 void ZhangLiBinghamBlocks(benchmark::State &state) { nonlinear_step(state, sediment::DragLaw::ZhangLi, bingham, Stepping::Blocks); }
 
 BENCHMARK(LayerDeposit);
+BENCHMARK(LayerDepositSorted);
 BENCHMARK(LayerInterpolation);
 BENCHMARK(CellDeposit);
 BENCHMARK(CellInterpolation);
