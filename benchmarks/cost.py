@@ -89,7 +89,8 @@ def cachegrind_totals(text: str) -> dict[str, int]:
     return dict(zip(names, map(int, values)))
 
 
-def counts_per_step(scene: str, particles: int, steps: int, lmp: Path | None = None) -> dict[str, float]:
+def counts_per_step(scene: str, particles: int, steps: int, lmp: Path | None = None,
+                    dt: float = 1e-4) -> dict[str, float]:
     """Instructions, L1 and L2 data misses per particle-step, and the estimate of cycles."""
     if shutil.which("valgrind") is None:
         sys.exit("cost.py --counts needs valgrind (Debian package valgrind)")
@@ -99,7 +100,8 @@ def counts_per_step(scene: str, particles: int, steps: int, lmp: Path | None = N
             out = Path(tmp) / f"{scene}.{run_steps}"
             cmd = ["valgrind", "--tool=cachegrind", *CACHE_MODEL, f"--cachegrind-out-file={out}",
                    str(lmp or lmp_executable()), "-in", str(HERE / "in.cost"), "-log", "none", "-screen", "none",
-                   "-var", "scene", scene, "-var", "n", str(particles), "-var", "steps", str(run_steps)]
+                   "-var", "scene", scene, "-var", "n", str(particles), "-var", "steps", str(run_steps),
+                   "-var", "dt", repr(dt)]
             done = subprocess.run(cmd, capture_output=True, text=True, env=dict(os.environ, OMP_NUM_THREADS="1"))
             if done.returncode != 0:
                 sys.exit(f"cost.py --counts: scene {scene} failed under cachegrind:\n{done.stderr[-2000:]}")
@@ -143,16 +145,17 @@ def report_counts(scenes: dict[str, str], args: argparse.Namespace) -> None:
     """The --counts table: this build, and the baseline when given (the counts need no turns)."""
     steps = args.steps if args.steps_given else 50
     columns = ("instructions", "L1 misses", "L2 misses", "cycles (est.)")
-    print(f"{args.particles} particles x ({steps}, {3 * steps}) steps under cachegrind, per particle-step")
+    print(f"{args.particles} particles x ({steps}, {3 * steps}) steps at dt {args.dt:g} s (dt/tau {args.dt / TAU:.3g}) "
+          "under cachegrind, per particle-step")
     print(f"{'scene':10s} " + " ".join(f"{c:>13s}" for c in columns) + (f" {'this/baseline':>14s}" if args.baseline
                                                                          else "") + "  what")
     cycles = {}
     for s, what in scenes.items():
-        mine = counts_per_step(s, args.particles, steps)
+        mine = counts_per_step(s, args.particles, steps, dt=args.dt)
         cycles[s] = mine["cycles (est.)"]
         against = ""
         if args.baseline:
-            theirs = counts_per_step(s, args.particles, steps, args.baseline)
+            theirs = counts_per_step(s, args.particles, steps, args.baseline, dt=args.dt)
             against = f" {mine['cycles (est.)'] / theirs['cycles (est.)']:14.3f}"
         print(f"{s:10s} " + " ".join(f"{mine[c]:13.2f}" for c in columns) + against + f"  {what}", flush=True)
     print()
@@ -280,26 +283,32 @@ RATIOS = (1e-4, 1e-3, 1e-2, 1e-1, 1.0, 10.0, 100.0, 1e3, 1e4)
 
 
 def sweep(scenes: list[str], particles: int, steps: int, repeats: int) -> None:
-    """The step's cost at each dt/tau against the peer's at the same dt (best of `repeats`, the scenes
-    of a ratio taking turns). Above dt/tau = 2 the explicit peer is unstable: there its cost at
-    dt/tau = 1 stands in, as its cost per particle-step does not depend on the step."""
+    """The step's cost at each dt/tau against the peer's at the same dt: in each of `repeats` rounds
+    the scenes of a ratio run one after the other, so that a drift of the machine's speed touches
+    them alike; printed as the ratio of the best times and as the median of the rounds' ratios. Above
+    dt/tau = 2 the explicit peer is unstable: there its cost at dt/tau = 1 stands in (the best of its
+    rounds there), as its cost per particle-step does not depend on the step."""
     peer_at_one = None
     rows = []
     for ratio in RATIOS:
         dt = ratio * TAU
         runs = (["peer"] if ratio <= EXPLICIT_LIMIT else []) + scenes
-        best = {s: min(loop_time(s, particles, steps, dt=dt) for _ in range(repeats)) for s in runs}
-        per = {s: t / (particles * steps) * 1e9 for s, t in best.items()}
+        rounds = [{s: loop_time(s, particles, steps, dt=dt) / (particles * steps) * 1e9 for s in runs}
+                  for _ in range(repeats)]
+        best = {s: min(r[s] for r in rounds) for s in runs}
         if ratio == 1.0:
-            peer_at_one = per["peer"]
-        rows.append((ratio, per))
-    print(f"{particles} particles x {steps} steps, best of {repeats}, 1 rank; tau = {TAU:.3g} s; ratios to the peer "
-          "at the same dt (its cost at dt/tau = 1 above 2, where it is unstable)")
-    print(f"{'dt/tau':>8s} {'peer ns':>9s} " + " ".join(f"{s:>11s}" for s in scenes))
-    for ratio, per in rows:
-        peer = per.get("peer", peer_at_one)
-        mark = "" if "peer" in per else "*"
-        print(f"{ratio:8.0e} {peer:8.2f}{mark or ' '} " + " ".join(f"{per[s] / peer:10.2f}x" for s in scenes))
+            peer_at_one = best["peer"]
+        rows.append((ratio, best, rounds))
+    print(f"{particles} particles x {steps} steps, {repeats} rounds, 1 rank; tau = {TAU:.3g} s; ratios to the peer "
+          "at the same dt (its cost at dt/tau = 1 above 2, where it is unstable): of the best times, and in "
+          "brackets the median of the rounds' ratios")
+    print(f"{'dt/tau':>8s} {'peer ns':>9s} " + " ".join(f"{s:>17s}" for s in scenes))
+    for ratio, best, rounds in rows:
+        peer = best.get("peer", peer_at_one)
+        mark = "" if "peer" in best else "*"
+        medians = {s: statistics.median(r[s] / r.get("peer", peer_at_one) for r in rounds) for s in scenes}
+        print(f"{ratio:8.0e} {peer:8.2f}{mark or ' '} "
+              + " ".join(f"{best[s] / peer:9.2f}x ({medians[s]:.2f})" for s in scenes))
     print("* the peer's cost at dt/tau = 1")
 
 

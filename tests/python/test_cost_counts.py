@@ -59,3 +59,21 @@ def test_the_targets_come_from_the_best_times_and_each_round(cost, capsys):
     off = next(line for line in lines if line.startswith("every effect off"))
     assert off.split()[-7:] == ["1.200", "0.950", "0.600", "-", "1.300", "<=", "1.02"]
     assert not any(line.startswith("explicit") for line in lines)
+
+
+def test_the_counts_run_the_scene_at_the_step_asked_for(cost, monkeypatch):
+    # --counts --dt: the deck takes the step (it ran every scene at the default 1e-4 s before).
+    commands = []
+
+    def run(cmd, **kwargs):
+        commands.append(cmd)
+        out = Path(next(a for a in cmd if a.startswith("--cachegrind-out-file=")).split("=", 1)[1])
+        steps = int(cmd[cmd.index("steps") + 1])
+        out.write_text(f"events: Ir D1mr D1mw DLmr DLmw\nsummary: {1000 + 10 * steps} 0 0 0 0\n")
+        return type("Done", (), {"returncode": 0, "stderr": ""})()
+
+    monkeypatch.setattr(cost.shutil, "which", lambda name: "/usr/bin/" + name)
+    monkeypatch.setattr(cost.subprocess, "run", run)
+    per = cost.counts_per_step("nonlinear", 100, 5, dt=1.32e-8)
+    assert [cmd[cmd.index("dt") + 1] for cmd in commands] == ["1.32e-08", "1.32e-08"]
+    assert per["instructions"] == pytest.approx(10 * 10 / (100 * 10))
