@@ -475,9 +475,9 @@ void DragBlock::step(double dt, BatchMath kind)
   if (in_pieces_) step_in_pieces(model, dt);
 }
 
-// step_spheres' loads: add_smooth's (set_for_one_piece), with 1 / m and a_n = f / m taken here in vectors. The rows come as
-// restricted parameters: with them in locals, GCC did not take them as restricted and left the loops
-// scalar (it could not check every pair of arrays for overlap).
+// step_spheres' loads: add_smooth's (set_for_one_piece), with 1 / m and a_n = f / m taken here in
+// vectors. The rows come as restricted parameters: with them in locals, GCC did not take them as
+// restricted and left the loops scalar (it could not check every pair of arrays for overlap).
 template <class Atom>
 [[gnu::always_inline]] inline void DragBlock::add_spheres(Atom atom, int count, double ftm2v,
                                                            const double (*__restrict v)[3],
