@@ -7,6 +7,7 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <iterator>
 #include <limits>
 
@@ -86,6 +87,36 @@ Phi phis(double z)
 
 namespace {
 
+// A size (a double >= 0, or NaN) as its bits, and back: sizes compare as their bits do.
+inline std::int64_t size_bits(double size)
+{
+  std::int64_t bits;
+  std::memcpy(&bits, &size, sizeof bits);
+  return bits;
+}
+inline double size_of(std::int64_t bits)
+{
+  double size;
+  std::memcpy(&size, &bits, sizeof size);
+  return size;
+}
+
+// phis() of rates that all take the series with this many terms: each rate's Horner sum from the
+// top coefficient, as phis() sums it, in one vector loop.
+template <int terms>
+[[gnu::always_inline]] inline void series_phis(const double *z, double *decay, double *phi1, double *phi2, int n)
+{
+  static_assert(terms == SeriesCoefficients::most_terms || terms % 2 == 0, "a count series_terms() gives");
+  for (int k = 0; k < n; ++k) {
+    double p2 = series.phi2[terms - 1];
+    for (int t = terms - 2; t >= 0; --t) p2 = p2 * z[k] + series.phi2[t];
+    const Phi from_series = phis_from_series(z[k], p2);
+    decay[k] = from_series.decay;
+    phi1[k] = from_series.phi1;
+    phi2[k] = from_series.phi2;
+  }
+}
+
 // The body of phis_many, inlined into the block's step of each instruction set. Where the rates fall
 // sets the work: at dt/tau below about 0.1 every rate takes the series (no exponential is taken), and
 // beyond the normal range of e^-z (dt/tau above about 1e3) every rate's e^-z is 0.
@@ -97,28 +128,30 @@ namespace {
   // lose digits to cancellation there), the direct forms with an exponential, or past the normal
   // range of e^-z the direct forms with e^-z = 0, except in the narrow band where e^-z is subnormal.
   std::int64_t any_small = 0, any_direct = 0, any_large = 0, any_subnormal = 0;    // 64 bits, as a lane of doubles
-  std::int64_t all_fewest = 1;
+  // The smallest and biggest |z|, by their bits (ordered as the values, for sizes): a vector loop, which
+  // a minimum of doubles (NaN and -0.0 have to stay in place) is not.
+  std::int64_t smallest = size_bits(series_limit), biggest = 0;
   for (int k = 0; k < n; ++k) {
-    const bool small = std::abs(z[k]) < series_limit, large = z[k] > normal_decay_limit;
+    const double size = std::abs(z[k]);
+    const bool small = size < series_limit, large = z[k] > normal_decay_limit;
     any_small |= small;
     any_direct |= !small & !large;
     any_large |= large;
     any_subnormal |= large & (z[k] <= decay_limit);
-    all_fewest &= std::abs(z[k]) < series_ranges[0].below;
+    smallest = std::min(smallest, size_bits(size));
+    biggest = std::max(biggest, size_bits(size));
   }
-  // Every rate in the first range (steps far below the relaxation time: a bed's contacts, dt/tau up
-  // to about 1e-3): each takes the series' fewest terms, so the sums below need no count per rate.
-  if (all_fewest) {
-    constexpr int fewest = series_ranges[0].terms;
-    for (int k = 0; k < n; ++k) {
-      double p2 = series.phi2[fewest - 1];
-      for (int t = fewest - 2; t >= 0; --t) p2 = p2 * z[k] + series.phi2[t];
-      const Phi from_series = phis_from_series(z[k], p2);
-      decay[k] = from_series.decay;
-      phi1[k] = from_series.phi1;
-      phi2[k] = from_series.phi2;
+  // Every rate takes the series with the same number of terms (most blocks: their rates lie within a
+  // factor of 2 to 4 of each other at one dt/tau), so the sums need no count per rate.
+  if (!any_direct && !any_large && series_terms(size_of(smallest)) == series_terms(size_of(biggest))) {
+    switch (series_terms(size_of(biggest))) {
+      case 6: return series_phis<6>(z, decay, phi1, phi2, n);
+      case 8: return series_phis<8>(z, decay, phi1, phi2, n);
+      case 10: return series_phis<10>(z, decay, phi1, phi2, n);
+      case 12: return series_phis<12>(z, decay, phi1, phi2, n);
+      case 14: return series_phis<14>(z, decay, phi1, phi2, n);
+      default: return series_phis<SeriesCoefficients::most_terms>(z, decay, phi1, phi2, n);
     }
-    return;
   }
   if (any_direct) {
     for (int k = 0; k < n; ++k) decay[k] = -std::min(z[k], normal_decay_limit);

@@ -144,6 +144,11 @@ TEST(BatchMath, PhisManyOfOneRegimeFollowPhis)
   const std::vector<std::vector<double>> groups = {
       {1e-5, -3e-4, 2e-6, 1e-12},                              // six terms
       {0.0, -0.0, 1e-300, -0x1p-10, 0x1.fffffffffffffp-10},    // six terms, up to the first range's end
+      {0x1p-9, 0.01, -0.003},                                  // eight terms each
+      {0.02, -0.05, 0x1.fffffffffffffp-5},                     // ten
+      {0.07, 0.1, -0.12},                                      // twelve
+      {0.13, -0.2, 0.24},                                      // fourteen
+      {0.25, 0.3, -0.45, 0x1.fffffffffffffp-2},                // sixteen
       {1e-5, 0.03, -0.05, 0x1p-9},                             // six to ten
       {0.3, -0.2, 1e-7, 0.49},                                 // up to sixteen
       {800.0, 708.5, 745.0, 1e6, 5000.0},                      // e^-z subnormal or zero
