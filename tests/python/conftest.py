@@ -7,10 +7,21 @@ REPO = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(REPO / "python"))
 os.environ.setdefault("SEDIMENT_LMP", str(REPO / "build" / "lmp_sediment"))
 
+import importlib.util
 import shutil
 import subprocess
+from types import ModuleType
 
 import pytest
+
+
+def benchmark_script(name: str) -> ModuleType:
+    """benchmarks/NAME.py loaded as a module (the scripts are not a package), for their tests."""
+    spec = importlib.util.spec_from_file_location(name, REPO / "benchmarks" / f"{name}.py")
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[name] = module
+    spec.loader.exec_module(module)
+    return module
 
 
 @pytest.fixture(scope="session")

@@ -3,23 +3,16 @@
 the difference of two runs (start-up cancels), and the targets' ratios from the rounds' times."""
 from __future__ import annotations
 
-import importlib.util
 import shutil
-import sys
 from pathlib import Path
 
 import pytest
-
-COST = Path(__file__).resolve().parents[2] / "benchmarks" / "cost.py"
+from conftest import benchmark_script
 
 
 @pytest.fixture(scope="module")
 def cost():
-    spec = importlib.util.spec_from_file_location("cost", COST)
-    module = importlib.util.module_from_spec(spec)
-    sys.modules["cost"] = module
-    spec.loader.exec_module(module)
-    return module
+    return benchmark_script("cost")
 
 
 def test_the_totals_are_the_summary_line_named_by_the_events_line(cost):

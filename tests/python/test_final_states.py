@@ -4,25 +4,18 @@ apart (byte for byte, or by their largest differences) without mistaking differe
 difference of the step."""
 from __future__ import annotations
 
-import importlib.util
-import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
+from conftest import benchmark_script
 
 from sediment.sim.paths import lmp_executable
-
-FINAL_STATES = Path(__file__).resolve().parents[2] / "benchmarks" / "final_states.py"
 
 
 @pytest.fixture(scope="module")
 def final_states():
-    spec = importlib.util.spec_from_file_location("final_states", FINAL_STATES)
-    module = importlib.util.module_from_spec(spec)
-    sys.modules["final_states"] = module
-    spec.loader.exec_module(module)
-    return module
+    return benchmark_script("final_states")
 
 
 HEADER = ("ITEM: TIMESTEP\n3\nITEM: NUMBER OF ATOMS\n2\nITEM: BOX BOUNDS pp pp pp\n0 1\n0 1\n0 1\n"
