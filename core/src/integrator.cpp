@@ -106,7 +106,7 @@ inline double size_of(std::int64_t bits)
 template <int terms>
 [[gnu::always_inline]] inline void series_phis(const double *z, double *decay, double *phi1, double *phi2, int n)
 {
-  static_assert(terms == SeriesCoefficients::most_terms || terms % 2 == 0, "a count series_terms() gives");
+  static_assert(terms >= 1 && terms <= SeriesCoefficients::most_terms, "more terms than coefficients");
   for (int k = 0; k < n; ++k) {
     double p2 = series.phi2[terms - 1];
     for (int t = terms - 2; t >= 0; --t) p2 = p2 * z[k] + series.phi2[t];
@@ -135,8 +135,9 @@ template <int terms>
     any_large |= large;
     any_subnormal |= large & (z[k] <= decay_limit);
   }
-  // Every rate takes the series with the same number of terms (most blocks: their rates lie within a
-  // factor of 2 to 4 of each other at one dt/tau), so the sums need no count per rate. The smallest
+  // Every rate takes the series with the same number of terms (most blocks: at one dt/tau a block's
+  // rates lie within a factor of a few, and a count's range of z spans 2 to 8), so the sums need no
+  // count per rate. The smallest
   // and biggest |z| tell, compared by their bits (ordered as the values, for sizes): a vector loop,
   // which a minimum of doubles (NaN and -0.0 have to stay in place) is not. Only where every rate
   // takes the series (dt/tau below about 0.1): above, this loop cost 1.5 % of the step's instructions.
@@ -147,6 +148,9 @@ template <int terms>
       biggest = std::max(biggest, size_bits(std::abs(z[k])));
     }
     const int terms = series_terms(size_of(biggest));
+    static_assert(std::size(series_ranges) == 5 && series_ranges[0].terms == 6 && series_ranges[1].terms == 8 &&
+                      series_ranges[2].terms == 10 && series_ranges[3].terms == 12 && series_ranges[4].terms == 14,
+                  "the cases below are the counts series_terms() gives");
     if (series_terms(size_of(smallest)) == terms) {
       switch (terms) {
         case 6: return series_phis<6>(z, decay, phi1, phi2, n);
@@ -353,7 +357,8 @@ AlongSlip advance_along(const SphereDrag &drag, double mass, double s, double a_
 // F / s = k G and c = a_par + k s Re G', with no division. Under one, F = F_y + k (s + s_y) G(Re'),
 // Re' = K s^2 / (s + s_y): F' = k (G + Re' G' (2 s_y + s) / s) and c = a_par - F / m + F' s / m; a
 // sphere at rest (s = 0) takes the step in pieces, which replaces what its division by s gives here.
-template <bool yield> [[gnu::always_inline]] inline void DragBlock::rates(const DragModel &model, double dt, BatchMath kind)
+template <bool yield>
+[[gnu::always_inline]] inline void DragBlock::rates(const DragModel &model, double dt, BatchMath kind)
 {
   if constexpr (yield)
     for (int n = 0; n < size_; ++n) {
