@@ -64,6 +64,15 @@ inline int series_terms(double z)
   return terms;
 }
 
+// phi2 from its series' first `terms` terms, summed from the top (Horner): the one sum phis() and
+// the block's series take, with `terms` known to the compiler in the block's loops.
+[[gnu::always_inline]] inline double series_phi2(double z, int terms)
+{
+  double p2 = series.phi2[terms - 1];
+  for (int n = terms - 2; n >= 0; --n) p2 = p2 * z + series.phi2[n];
+  return p2;
+}
+
 // phi1 and e^-z from the series' phi2.
 inline Phi phis_from_series(double z, double p2)
 {
@@ -76,12 +85,7 @@ inline Phi phis_from_series(double z, double p2)
 Phi phis(double z)
 {
   if (z == 0.0) return {1.0, 1.0, 0.5};
-  if (std::abs(z) < series_limit) {
-    const int terms = series_terms(z);
-    double p2 = series.phi2[terms - 1];
-    for (int n = terms - 2; n >= 0; --n) p2 = p2 * z + series.phi2[n];
-    return phis_from_series(z, p2);
-  }
+  if (std::abs(z) < series_limit) return phis_from_series(z, series_phi2(z, series_terms(z)));
   return phis_from_decay(z, z > decay_limit ? 0.0 : std::exp(-z));
 }
 
@@ -101,16 +105,13 @@ inline double size_of(std::int64_t bits)
   return size;
 }
 
-// phis() of rates that all take the series with this many terms: each rate's Horner sum from the
-// top coefficient, as phis() sums it, in one vector loop.
+// phis() of rates that all take the series with this many terms, in one vector loop.
 template <int terms>
 [[gnu::always_inline]] inline void series_phis(const double *z, double *decay, double *phi1, double *phi2, int n)
 {
   static_assert(terms >= 1 && terms <= SeriesCoefficients::most_terms, "more terms than coefficients");
   for (int k = 0; k < n; ++k) {
-    double p2 = series.phi2[terms - 1];
-    for (int t = terms - 2; t >= 0; --t) p2 = p2 * z[k] + series.phi2[t];
-    const Phi from_series = phis_from_series(z[k], p2);
+    const Phi from_series = phis_from_series(z[k], series_phi2(z[k], terms));
     decay[k] = from_series.decay;
     phi1[k] = from_series.phi1;
     phi2[k] = from_series.phi2;
@@ -137,10 +138,10 @@ template <int terms>
   }
   // Every rate takes the series with the same number of terms (most blocks: at one dt/tau a block's
   // rates lie within a factor of a few, and a count's range of z spans 2 to 8), so the sums need no
-  // count per rate. The smallest
-  // and biggest |z| tell, compared by their bits (ordered as the values, for sizes): a vector loop,
-  // which a minimum of doubles (NaN and -0.0 have to stay in place) is not. Only where every rate
-  // takes the series (dt/tau below about 0.1): above, this loop cost 1.5 % of the step's instructions.
+  // count per rate. The smallest and biggest |z| tell, compared by their bits (ordered as the values,
+  // for sizes): a vector loop, which a minimum of doubles (NaN and -0.0 have to stay in place) is
+  // not. Only where every rate takes the series (dt/tau below about 0.1): above, this loop cost 1.5 %
+  // of the step's instructions.
   if (!any_direct && !any_large) {
     std::int64_t smallest = size_bits(series_limit), biggest = 0;
     for (int k = 0; k < n; ++k) {
