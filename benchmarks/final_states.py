@@ -74,6 +74,8 @@ def main() -> None:
     args = parser.parse_args()
     if shutil.which(args.baseline) is None:
         sys.exit(f"final_states.py: --baseline {args.baseline}: no such executable")
+    if args.ranks > 1 and shutil.which("mpirun") is None:
+        sys.exit("final_states.py: --ranks needs mpirun (Debian package openmpi-bin)")
     ours_lmp = str(lmp_executable())
     runs = [(f"{law} dt/tau {ratio:g}{' floor' if floor else ''}", HERE / "in.cost",
              {"scene": law, "n": str(args.particles), "steps": str(args.steps), "dt": repr(ratio * TAU),

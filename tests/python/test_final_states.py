@@ -4,6 +4,7 @@ apart (byte for byte, or by their largest differences) without mistaking differe
 difference of the step."""
 from __future__ import annotations
 
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -61,3 +62,13 @@ def test_a_scene_dumps_its_final_state_with_the_options_asked_for(final_states, 
     assert floor[:, 3].min() == pytest.approx(rest, rel=1e-12)
     on_floor = np.abs(floor[:, 3] - rest) < 1e-12
     assert on_floor.sum() > 10 and np.all(floor[on_floor, 4:10] == 0.0)
+
+
+def test_a_missing_baseline_or_mpirun_is_refused_before_any_run(final_states, monkeypatch):
+    for argv, message in ((["--baseline", "/no/such/lmp"], "no such executable"),
+                          (["--baseline", "/bin/true", "--ranks", "2"], "needs mpirun")):
+        monkeypatch.setattr(sys, "argv", ["final_states.py", *argv])
+        monkeypatch.setattr(final_states.shutil, "which",
+                            lambda name: None if name in ("mpirun", "/no/such/lmp") else "/bin/" + name)
+        with pytest.raises(SystemExit, match=message):
+            final_states.main()
