@@ -407,6 +407,34 @@ double add_sphere_to_grid(const Grid &grid, const double centre[3], double radiu
 namespace {
 
 #ifdef SEDIMENT_GRID_AVX2
+// Lanes whose whole number k (as a double) lies within 2^30 layers: those cast to int as they are.
+__attribute__((target("avx2"))) inline __m256d within_reach4(__m256d k)
+{
+  return _mm256_cmp_pd(_mm256_andnot_pd(_mm256_set1_pd(-0.0), k), _mm256_set1_pd(1 << 30), _CMP_LE_OQ);
+}
+
+// cell_of(axis, k) and cell_of(axis, k + 1) of a periodic axis for four whole numbers k within reach,
+// without a branch: wrap() in doubles. With |k| and count below 2^31, k / count rounds on the right
+// side of every whole number, so the floor and the rest are exact. (A branch on whether all four lie
+// within the period, which most do at small steps, was mispredicted for a quarter of the groups at
+// dt/tau = 1e4, where atoms outrun the neighbor skin and lie whole periods away between LAMMPS's
+// remaps into the box.)
+__attribute__((target("avx2"))) inline void periodic_cells4(const Layers &axis, __m256d k, __m256d &k0, __m256d &k1)
+{
+  const __m256d count = _mm256_set1_pd(axis.count);
+  k0 = _mm256_sub_pd(k, _mm256_mul_pd(_mm256_floor_pd(_mm256_div_pd(k, count)), count));
+  const __m256d next = _mm256_add_pd(k0, _mm256_set1_pd(1.0));
+  k1 = _mm256_blendv_pd(next, _mm256_setzero_pd(), _mm256_cmp_pd(next, count, _CMP_EQ_OQ));    // n wraps to 0
+}
+
+// cell_of(axis, k) of a bounded axis for four whole numbers k: k, or -1 outside the axis.
+__attribute__((target("avx2"))) inline __m256d bounded_cells4(const Layers &axis, __m256d k)
+{
+  const __m256d outside = _mm256_or_pd(_mm256_cmp_pd(k, _mm256_setzero_pd(), _CMP_LT_OQ),
+                                       _mm256_cmp_pd(k, _mm256_set1_pd(axis.count), _CMP_GE_OQ));
+  return _mm256_blendv_pd(k, _mm256_set1_pd(-1.0), outside);
+}
+
 // below() of four heights, by the same operations (min and max with their operands in this order
 // pick as std::min and std::max do, NaN included).
 __attribute__((target("avx2"))) inline __m256d below4(__m256d radius, __m256d u)
@@ -452,7 +480,7 @@ __attribute__((target("avx2"))) double layers_deposit_avx2(const Layers &layers,
                                                            const double (*centres)[3], const double *radius,
                                                            const double *weight, int n, double *values, int stride)
 {
-  const __m256d one = _mm256_set1_pd(1.0), reach = _mm256_set1_pd(1 << 30);
+  const __m256d one = _mm256_set1_pd(1.0);
   double outside = 0.0;
   int i = 0;
   for (; i + 4 <= n; i += 4) {
@@ -460,14 +488,24 @@ __attribute__((target("avx2"))) double layers_deposit_avx2(const Layers &layers,
     __m256d first, last;
     touched4(layers, c, r, first, last);
     // At most one face crossed, and indices an int holds as they are (NaN: neither)
-    const __m256d near = _mm256_and_pd(_mm256_cmp_pd(_mm256_sub_pd(last, first), one, _CMP_LE_OQ),
-                                       _mm256_cmp_pd(_mm256_andnot_pd(_mm256_set1_pd(-0.0), first), reach, _CMP_LE_OQ));
+    const __m256d near =
+        _mm256_and_pd(_mm256_cmp_pd(_mm256_sub_pd(last, first), one, _CMP_LE_OQ), within_reach4(first));
+    const int split = _mm256_movemask_pd(near);
+    // The two layers' cells as cell_of gives them, in vectors (a branch per sphere on whether it lies
+    // in the box was mispredicted for one atom in four at dt/tau = 1e4, half the atoms lying outside)
+    __m256d cell[2];
+    if (layers.periodic) {
+      periodic_cells4(layers, first, cell[0], cell[1]);
+    } else {
+      cell[0] = bounded_cells4(layers, first);
+      cell[1] = bounded_cells4(layers, _mm256_add_pd(first, one));
+    }
     alignas(32) double lower[4], total[4];
-    alignas(16) int index[4];
+    alignas(16) int index[2][4];
     _mm256_store_pd(lower, below_next_face4(layers, c, r, first, half));
     _mm256_store_pd(total, _mm256_mul_pd(_mm256_set1_pd(2.0), half));
-    _mm_store_si128(reinterpret_cast<__m128i *>(index), _mm256_cvttpd_epi32(first));
-    const int split = _mm256_movemask_pd(near);
+    for (int side = 0; side < 2; ++side)    // (lanes not near: 0, unused)
+      _mm_store_si128(reinterpret_cast<__m128i *>(index[side]), _mm256_cvttpd_epi32(_mm256_and_pd(cell[side], near)));
     // Upper halves cleared before the SSE code below: GCC left them dirty, and this processor ran that
     // code 1.5-2x slower after them.
     _mm256_zeroupper();
@@ -480,7 +518,7 @@ __attribute__((target("avx2"))) double layers_deposit_avx2(const Layers &layers,
       double inside = 0.0;
       const double part[2] = {lower[k], total[k] - lower[k]};
       for (int side = 0; side < 2; ++side) {
-        const int cell = cell_of(layers, index[k] + side);
+        const int cell = index[side][k];
         if (cell < 0) continue;
         values[cell * stride] += count * part[side];
         inside += part[side];
@@ -645,24 +683,10 @@ __attribute__((target("avx2"))) inline bool brackets4(const Layers &axis, __m256
       _mm256_set1_pd(0.5));
   const __m256d zero = _mm256_setzero_pd(), one = _mm256_set1_pd(1.0), last = _mm256_set1_pd(axis.count - 1);
   if (axis.periodic) {
-    const __m256d k = _mm256_floor_pd(s), count = _mm256_set1_pd(axis.count);
+    const __m256d k = _mm256_floor_pd(s);
     w = _mm256_sub_pd(s, k);
-    const __m256d within = _mm256_and_pd(_mm256_cmp_pd(k, _mm256_set1_pd(-1.0), _CMP_GE_OQ),
-                                         _mm256_cmp_pd(k, last, _CMP_LE_OQ));
-    if (_mm256_movemask_pd(within) == 0xF) {    // most: within the period, or one layer below it
-      k0 = _mm256_blendv_pd(k, _mm256_add_pd(k, count), _mm256_cmp_pd(k, zero, _CMP_LT_OQ));    // -1 wraps to n - 1
-    } else {
-      // Whole periods away, as atoms are between LAMMPS's remaps into the box (the steps of a
-      // sedimentation test's fine grains outrun its neighbor skin). wrap() in doubles: with |k| and
-      // count below 2^31, k / count rounds on the right side of every whole number, so the floor and
-      // the rest are exact.
-      const __m256d reach = _mm256_set1_pd(1 << 30);
-      if (_mm256_movemask_pd(_mm256_cmp_pd(_mm256_andnot_pd(_mm256_set1_pd(-0.0), k), reach, _CMP_LE_OQ)) != 0xF)
-        return false;
-      k0 = _mm256_sub_pd(k, _mm256_mul_pd(_mm256_floor_pd(_mm256_div_pd(k, count)), count));
-    }
-    const __m256d next = _mm256_add_pd(k0, one);
-    k1 = _mm256_blendv_pd(next, zero, _mm256_cmp_pd(next, count, _CMP_EQ_OQ));    // n wraps to 0
+    if (_mm256_movemask_pd(within_reach4(k)) != 0xF) return false;
+    periodic_cells4(axis, k, k0, k1);
     return true;
   }
   if (_mm256_movemask_pd(_mm256_cmp_pd(s, s, _CMP_ORD_Q)) != 0xF) return false;

@@ -264,8 +264,9 @@ TEST(Grid, ManySpheresAtOnceAreTheSpheresOneByOne)
   // give bit for bit what add_sphere_to_grid and grid_value_at give one sphere at a time: on layers
   // and on cells, bounded and periodic, spheres inside, across faces and edges, partly and far
   // outside (the read goes four points at a time where the processor has AVX2).
-  const Layers one{0.0, 1.0, 1}, column{0.0, 0.1, 10, true};
-  const std::vector<Grid> grids = {Grid{{one, one, column}, {false, false, true}}, cube_grid(0.0, 0.1, 10),
+  const Layers one{0.0, 1.0, 1}, column{0.0, 0.1, 10, true}, bounded_column{0.0, 0.1, 10};
+  const std::vector<Grid> grids = {Grid{{one, one, column}, {false, false, true}},
+                                   Grid{{one, one, bounded_column}, {false, false, true}}, cube_grid(0.0, 0.1, 10),
                                    cube_grid(0.0, 0.1, 10, true)};
   std::mt19937_64 random(3);
   std::uniform_real_distribution<double> coordinate(-0.05, 1.05), size(0.005, 0.12), count(0.5, 3.0);
