@@ -17,6 +17,17 @@ Submergence submergence(double radius, double centre_height)
 }
 
 namespace {
+// Atom i's buoyancy, -m_f g with m_f the mass of fluid it displaces whole, added to its force; returns m_f.
+[[gnu::always_inline]] inline double push_up(double (*__restrict force)[3], const double *__restrict radius, int i,
+                                             double density, double g0, double g1, double g2)
+{
+  const double displaced = displaced_mass(density, radius[i], Submergence{1.0, 1.0, 1.0});
+  force[i][0] += -displaced * g0;
+  force[i][1] += -displaced * g1;
+  force[i][2] += -displaced * g2;
+  return displaced;
+}
+
 // add_immersed_buoyancy's loop, the rows as restricted parameters (else GCC leaves it scalar). The
 // displaced mass summed per lane of 8 (a single running sum would keep the loop scalar).
 [[gnu::always_inline]] inline double add_buoyancy(double (*__restrict force)[3], const double *__restrict radius,
@@ -25,56 +36,26 @@ namespace {
 {
   constexpr int lanes = 8;
   double sums[lanes] = {};
-  const Submergence whole{1.0, 1.0, 1.0};
   const int end = first + count;
   int i = first;
   for (; i + lanes <= end; i += lanes)
-    for (int l = 0; l < lanes; ++l) {
-      const double displaced = displaced_mass(density, radius[i + l], whole);
-      force[i + l][0] += -displaced * g0;
-      force[i + l][1] += -displaced * g1;
-      force[i + l][2] += -displaced * g2;
-      sums[l] += displaced;
-    }
-  for (; i < end; ++i) {
-    const double displaced = displaced_mass(density, radius[i], whole);
-    force[i][0] += -displaced * g0;
-    force[i][1] += -displaced * g1;
-    force[i][2] += -displaced * g2;
-    sums[0] += displaced;
-  }
+    for (int l = 0; l < lanes; ++l) sums[l] += push_up(force, radius, i + l, density, g0, g1, g2);
+  for (; i < end; ++i) sums[0] += push_up(force, radius, i, density, g0, g1, g2);
   double sum = 0.0;
   for (double lane : sums) sum += lane;
   return sum;
 }
 
-double add_buoyancy_avx2(double (*force)[3], const double *radius, int first, int count, double density,
-                         const double g[3]);
-double add_buoyancy_avx512(double (*force)[3], const double *radius, int first, int count, double density,
-                           const double g[3]);
-#if defined(__x86_64__) && defined(__GNUC__)
-__attribute__((target("avx2"))) double add_buoyancy_avx2(double (*force)[3], const double *radius, int first,
-                                                         int count, double density, const double g[3])
+SEDIMENT_TARGET_AVX2 double add_buoyancy_avx2(double (*force)[3], const double *radius, int first, int count,
+                                              double density, const double g[3])
 {
   return add_buoyancy(force, radius, first, count, density, g[0], g[1], g[2]);
 }
-__attribute__((target("avx512f"))) double add_buoyancy_avx512(double (*force)[3], const double *radius, int first,
-                                                             int count, double density, const double g[3])
+SEDIMENT_TARGET_AVX512 double add_buoyancy_avx512(double (*force)[3], const double *radius, int first, int count,
+                                                  double density, const double g[3])
 {
   return add_buoyancy(force, radius, first, count, density, g[0], g[1], g[2]);
 }
-#else
-double add_buoyancy_avx2(double (*force)[3], const double *radius, int first, int count, double density,
-                         const double g[3])
-{
-  return add_buoyancy(force, radius, first, count, density, g[0], g[1], g[2]);
-}
-double add_buoyancy_avx512(double (*force)[3], const double *radius, int first, int count, double density,
-                           const double g[3])
-{
-  return add_buoyancy(force, radius, first, count, density, g[0], g[1], g[2]);
-}
-#endif
 }    // namespace
 
 double add_immersed_buoyancy(double (*force)[3], const double *radius, int first, int count, double density,

@@ -488,23 +488,16 @@ void DragBlock::step_in_pieces(const DragModel &model, double dt)
   }
 }
 
-#if defined(__x86_64__) && defined(__GNUC__)
 // The same stages in 4-wide vectors (the 2-wide SSE2 of the default build takes 1.3-1.4x as long:
-// bench_core_kernels SmoothStepBlocks against SmoothStepBlocksSSE2), and in 8-wide ones. No fused
-// multiply-adds (AVX-512 F has them; -ffp-contract=off keeps the compiler from using them), so the
-// same roundings.
-__attribute__((target("avx2"))) void DragBlock::stages_avx2(const DragModel &model, double dt)
+// bench_core_kernels SmoothStepBlocks against SmoothStepBlocksSSE2), and in 8-wide ones.
+SEDIMENT_TARGET_AVX2 void DragBlock::stages_avx2(const DragModel &model, double dt)
 {
   stages(model, dt, BatchMath::AVX2);
 }
-__attribute__((target("avx512f"))) void DragBlock::stages_avx512(const DragModel &model, double dt)
+SEDIMENT_TARGET_AVX512 void DragBlock::stages_avx512(const DragModel &model, double dt)
 {
   stages(model, dt, BatchMath::AVX512);
 }
-#else
-void DragBlock::stages_avx2(const DragModel &model, double dt) { stages(model, dt, BatchMath::Scalar); }
-void DragBlock::stages_avx512(const DragModel &model, double dt) { stages(model, dt, BatchMath::Scalar); }
-#endif
 
 void DragBlock::step(double dt, BatchMath kind)
 {
@@ -601,29 +594,16 @@ template <class Atom>
   return step_spheres_of(rows, ListedAtoms{atoms}, count, kick, dt, kind);
 }
 
-#if defined(__x86_64__) && defined(__GNUC__)
-__attribute__((target("avx2"))) double DragBlock::step_spheres_avx2(const SphereRows &rows, const int *atoms,
-                                                                    int count, const HalfKick &kick, double dt)
+SEDIMENT_TARGET_AVX2 double DragBlock::step_spheres_avx2(const SphereRows &rows, const int *atoms, int count,
+                                                          const HalfKick &kick, double dt)
 {
   return step_spheres_in(rows, atoms, count, kick, dt, BatchMath::AVX2);
 }
-__attribute__((target("avx512f"))) double DragBlock::step_spheres_avx512(const SphereRows &rows, const int *atoms,
-                                                                        int count, const HalfKick &kick, double dt)
+SEDIMENT_TARGET_AVX512 double DragBlock::step_spheres_avx512(const SphereRows &rows, const int *atoms, int count,
+                                                              const HalfKick &kick, double dt)
 {
   return step_spheres_in(rows, atoms, count, kick, dt, BatchMath::AVX512);
 }
-#else
-double DragBlock::step_spheres_avx2(const SphereRows &rows, const int *atoms, int count, const HalfKick &kick,
-                                    double dt)
-{
-  return step_spheres_in(rows, atoms, count, kick, dt, BatchMath::Scalar);
-}
-double DragBlock::step_spheres_avx512(const SphereRows &rows, const int *atoms, int count, const HalfKick &kick,
-                                      double dt)
-{
-  return step_spheres_in(rows, atoms, count, kick, dt, BatchMath::Scalar);
-}
-#endif
 
 double DragBlock::step_spheres(const SphereRows &rows, const int *atoms, int count, const HalfKick &kick, double dt,
                                BatchMath kind)
@@ -656,27 +636,14 @@ void final_rows_of(const SphereRows &rows, int first, int count, const HalfKick 
 {
   final_rows(first, count, kick, rows.v, rows.omega, rows.force, rows.torque, rows.radius, rows.mass, rows.weights);
 }
-#if defined(__x86_64__) && defined(__GNUC__)
-__attribute__((target("avx2"))) void final_rows_avx2(const SphereRows &rows, int first, int count,
-                                                     const HalfKick &kick)
+SEDIMENT_TARGET_AVX2 void final_rows_avx2(const SphereRows &rows, int first, int count, const HalfKick &kick)
 {
   final_rows(first, count, kick, rows.v, rows.omega, rows.force, rows.torque, rows.radius, rows.mass, rows.weights);
 }
-__attribute__((target("avx512f"))) void final_rows_avx512(const SphereRows &rows, int first, int count,
-                                                           const HalfKick &kick)
+SEDIMENT_TARGET_AVX512 void final_rows_avx512(const SphereRows &rows, int first, int count, const HalfKick &kick)
 {
   final_rows(first, count, kick, rows.v, rows.omega, rows.force, rows.torque, rows.radius, rows.mass, rows.weights);
 }
-#else
-void final_rows_avx2(const SphereRows &rows, int first, int count, const HalfKick &kick)
-{
-  final_rows_of(rows, first, count, kick);
-}
-void final_rows_avx512(const SphereRows &rows, int first, int count, const HalfKick &kick)
-{
-  final_rows_of(rows, first, count, kick);
-}
-#endif
 }  // namespace
 
 void drag_step_final_rows(const SphereRows &rows, int first, int count, const HalfKick &kick, BatchMath kind)

@@ -8,6 +8,18 @@
 // does not depend on which others share its batch (nor on how atoms are spread over MPI ranks).
 #pragma once
 
+// The attributes that compile a function for AVX2 or for AVX-512 F beside the default build, so that
+// the per-atom loops inlined into it run in vectors of that width (no fused multiply-adds: the build
+// keeps -ffp-contract=off, so every width rounds alike). Empty off x86-64 GCC/Clang, where
+// batch_math_available() never picks those kinds.
+#if defined(__x86_64__) && defined(__GNUC__)
+#define SEDIMENT_TARGET_AVX2 __attribute__((target("avx2")))
+#define SEDIMENT_TARGET_AVX512 __attribute__((target("avx512f")))
+#else
+#define SEDIMENT_TARGET_AVX2
+#define SEDIMENT_TARGET_AVX512
+#endif
+
 namespace sediment {
 
 enum class BatchMath { Scalar, SSE2, AVX2, AVX512 };
