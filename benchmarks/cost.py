@@ -284,32 +284,30 @@ RATIOS = (1e-4, 1e-3, 1e-2, 1e-1, 1.0, 10.0, 100.0, 1e3, 1e4)
 
 def sweep(scenes: list[str], particles: int, steps: int, repeats: int) -> None:
     """The step's cost at each dt/tau against the peer's at the same dt: in each of `repeats` rounds
-    the scenes of a ratio run one after the other, so that a drift of the machine's speed touches
-    them alike; printed as the ratio of the best times and as the median of the rounds' ratios. Above
-    dt/tau = 2 the explicit peer is unstable: there its cost at dt/tau = 1 stands in (the best of its
-    rounds there), as its cost per particle-step does not depend on the step."""
-    peer_at_one = None
+    the peer and the scenes of a ratio run one after the other, so that a drift of the machine's
+    speed touches them alike; printed as the ratio of the best times and as the median of the rounds'
+    ratios. Above dt/tau = 2 the explicit peer is unstable: there it runs at dt/tau = 1 in the same
+    rounds and stands in, as its cost per particle-step does not depend on the step."""
     rows = []
     for ratio in RATIOS:
         dt = ratio * TAU
-        runs = (["peer"] if ratio <= EXPLICIT_LIMIT else []) + scenes
-        rounds = [{s: loop_time(s, particles, steps, dt=dt) / (particles * steps) * 1e9 for s in runs}
-                  for _ in range(repeats)]
-        best = {s: min(r[s] for r in rounds) for s in runs}
-        if ratio == 1.0:
-            peer_at_one = best["peer"]
-        rows.append((ratio, best, rounds))
+        peer_dt = dt if ratio <= EXPLICIT_LIMIT else TAU
+        rounds = []
+        for _ in range(repeats):
+            times = {"peer": loop_time("peer", particles, steps, dt=peer_dt)}
+            times.update({s: loop_time(s, particles, steps, dt=dt) for s in scenes})
+            rounds.append({s: t / (particles * steps) * 1e9 for s, t in times.items()})
+        rows.append((ratio, {s: min(r[s] for r in rounds) for s in rounds[0]}, rounds))
     print(f"{particles} particles x {steps} steps, {repeats} rounds, 1 rank; tau = {TAU:.3g} s; ratios to the peer "
-          "at the same dt (its cost at dt/tau = 1 above 2, where it is unstable): of the best times, and in "
-          "brackets the median of the rounds' ratios")
+          "at the same dt (at dt/tau = 1 above 2, where it is unstable): of the best times, and in brackets the "
+          "median of the rounds' ratios")
     print(f"{'dt/tau':>8s} {'peer ns':>9s} " + " ".join(f"{s:>17s}" for s in scenes))
     for ratio, best, rounds in rows:
-        peer = best.get("peer", peer_at_one)
-        mark = "" if "peer" in best else "*"
-        medians = {s: statistics.median(r[s] / r.get("peer", peer_at_one) for r in rounds) for s in scenes}
-        print(f"{ratio:8.0e} {peer:8.2f}{mark or ' '} "
-              + " ".join(f"{best[s] / peer:9.2f}x ({medians[s]:.2f})" for s in scenes))
-    print("* the peer's cost at dt/tau = 1")
+        mark = "*" if ratio > EXPLICIT_LIMIT else " "
+        medians = {s: statistics.median(r[s] / r["peer"] for r in rounds) for s in scenes}
+        print(f"{ratio:8.0e} {best['peer']:8.2f}{mark} "
+              + " ".join(f"{best[s] / best['peer']:9.2f}x ({medians[s]:.2f})" for s in scenes))
+    print("* the peer at dt/tau = 1, run in the same rounds")
 
 
 def report_targets(times: dict[str, float], rounds: list[dict[str, float]]) -> None:
