@@ -70,3 +70,32 @@ def test_the_counts_run_the_scene_at_the_step_asked_for(cost, monkeypatch):
     per = cost.counts_per_step("nonlinear", 100, 5, dt=1.32e-8)
     assert [cmd[cmd.index("dt") + 1] for cmd in commands] == ["1.32e-08", "1.32e-08"]
     assert per["instructions"] == pytest.approx(10 * 10 / (100 * 10))
+
+
+def test_the_sweep_runs_the_peer_beside_the_scenes_at_every_point(cost, monkeypatch, capsys):
+    # Above dt/tau = 2 the explicit peer runs at dt/tau = 1, in the same round as the scenes there,
+    # and each round's ratio divides by that round's peer (a drift of the machine between the points
+    # must not enter a point's ratio). Times here: the peer doubles from round to round, the scene
+    # costs twice the peer of its round, so every ratio is 2 exactly.
+    calls = []
+    state = {"round": 0}
+
+    def loop_time(scene, particles, steps, lmp=None, dt=1e-4):
+        calls.append((scene, dt))
+        if scene == "peer":
+            state["round"] += 1
+        return 2.0 ** state["round"] * (2.0 if scene == "drag" else 1.0)
+
+    monkeypatch.setattr(cost, "loop_time", loop_time)
+    cost.sweep(["drag"], 10, 10, 3)
+    for ratio in cost.RATIOS:
+        dt = ratio * cost.TAU
+        peer_dt = dt if ratio <= cost.EXPLICIT_LIMIT else cost.TAU
+        assert calls.count(("peer", peer_dt)) >= 3 and calls.count(("drag", dt)) == 3
+    assert len(calls) == 2 * 3 * len(cost.RATIOS)
+    points = {f"{ratio:.0e}" for ratio in cost.RATIOS}
+    rows = [line.split() for line in capsys.readouterr().out.splitlines() if line.split()[:1] and
+            line.split()[0] in points]
+    assert len(rows) == len(cost.RATIOS)
+    assert all(row[-2:] == ["2.00x", "(2.00)"] for row in rows)
+    assert [row[1].endswith("*") for row in rows] == [r > cost.EXPLICIT_LIMIT for r in cost.RATIOS]
