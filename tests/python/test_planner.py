@@ -199,9 +199,11 @@ def test_bad_input_is_refused_with_the_reason(tmp_path, capsys):
     assert not (tmp_path / "o").exists()
 
 
-def test_an_interrupted_plan_stops_every_run_and_says_so(tmp_path):
-    """Ctrl-C while trials run in parallel: exit 130 with one line, no LAMMPS left running, and no
-    decision written."""
+@pytest.mark.parametrize("stop", ["SIGINT", "SIGTERM"])
+def test_an_interrupted_plan_stops_every_run_and_says_so(tmp_path, stop):
+    """Ctrl-C (or SIGTERM) while trials run in parallel: exit 130 with one line, no LAMMPS left
+    running, and no decision written. The plan starts with SIGINT ignored, as a background job of a
+    script does (and as make test's own processes may): it is stopped all the same."""
     import signal
     import subprocess
 
@@ -209,14 +211,15 @@ def test_an_interrupted_plan_stops_every_run_and_says_so(tmp_path):
 
     out = tmp_path / "plan"
     plan = subprocess.Popen([str(REPO / "bin" / "sediment"), "plan", str(SAMPLE5), "--out", str(out), "--particles",
-                             "40000,20000", "--courant", "1,2", "--t-end", "7200"], stderr=subprocess.PIPE, text=True)
+                             "40000,20000", "--courant", "1,2", "--t-end", "7200"], stderr=subprocess.PIPE, text=True,
+                            preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_IGN))
     def busy() -> list[Path]:    # the plan works in a new folder beside --out until it is done
         return [f for f in tmp_path.glob(".plan.new-*/runs/*") if f.is_dir() and processes_in(f)]
 
     wait_for(lambda: len(busy()) == 2)      # two trials at once (--jobs 2)
-    plan.send_signal(signal.SIGINT)
+    plan.send_signal(getattr(signal, stop))
     _, err = plan.communicate(timeout=20)     # not after the runs end (about 40 s each)
-    assert plan.returncode == 130 and "Traceback" not in err and "interrupted" in err
+    assert plan.returncode == 130 and "Traceback" not in err and f"interrupted by {stop}" in err
     wait_for(lambda: not busy(), seconds=10)
     assert not (out / "report.json").exists() and not list(tmp_path.glob(".plan.new-*"))
 

@@ -7,7 +7,9 @@ from __future__ import annotations
 import argparse
 import io
 import os
+import signal
 import sys
+import threading
 
 from .. import __version__
 from ..sim.run import RunInterrupted
@@ -60,20 +62,30 @@ def main(argv: list[str] | None = None) -> int:
         return 2
     stdout = sys.stdout
     sys.stdout = _ReaderMayLeave(stdout)
+    # SIGINT and SIGTERM stop every command alike, through its clean-up, also where SIGINT came in
+    # ignored (a background job of a script): `sediment run` takes them so while its run lasts.
+    in_main_thread = threading.current_thread() is threading.main_thread()    # (signal's condition)
+    previous = {sig: signal.signal(sig, _interrupt) for sig in (signal.SIGINT, signal.SIGTERM)} if in_main_thread else {}
     try:
         return args.func(args)
     except RunInterrupted as exc:    # says what the run left
         print(f"sediment {args.command}: {exc}", file=sys.stderr)
         return 130
-    except KeyboardInterrupt:
-        print(f"sediment {args.command}: interrupted; files being written were left as *.partial or not written",
-              file=sys.stderr)
+    except KeyboardInterrupt as exc:
+        print(f"sediment {args.command}: interrupted by {exc or 'SIGINT'}; files being written were left as "
+              "*.partial or not written", file=sys.stderr)
         return 130
     except (ValueError, OSError, RuntimeError) as exc:    # SheetError is a ValueError; OSError: missing, read-only or full files
         print(f"sediment {args.command}: error: {exc}", file=sys.stderr)
         return 2
     finally:
         sys.stdout = stdout
+        for sig, handler in previous.items():
+            signal.signal(sig, handler)
+
+
+def _interrupt(signum: int, _frame: object) -> None:
+    raise KeyboardInterrupt(signal.Signals(signum).name)
 
 
 class _ReaderMayLeave(io.TextIOBase):
