@@ -64,8 +64,9 @@ def main(argv: list[str] | None = None) -> int:
     sys.stdout = _ReaderMayLeave(stdout)
     # SIGINT and SIGTERM stop every command alike, through its clean-up, also where SIGINT came in
     # ignored (a background job of a script): `sediment run` takes them so while its run lasts.
-    in_main_thread = threading.current_thread() is threading.main_thread()    # (signal's condition)
-    previous = {sig: signal.signal(sig, _interrupt) for sig in (signal.SIGINT, signal.SIGTERM)} if in_main_thread else {}
+    previous = {}
+    if threading.current_thread() is threading.main_thread():    # where Python lets a handler be set
+        previous = {sig: signal.signal(sig, _interrupt) for sig in (signal.SIGINT, signal.SIGTERM)}
     try:
         return args.func(args)
     except RunInterrupted as exc:    # says what the run left
