@@ -26,7 +26,7 @@ namespace {
 #ifdef SEDIMENT_LIBMVEC
 // A short last group is padded with ones (finite for both functions) to a full vector, or masked:
 // each value takes the same function wherever it sits.
-__attribute__((target("avx512f"))) void with_avx512(const double *x, double *out, int n, __m512d (*f)(__m512d))
+SEDIMENT_TARGET_AVX512 void with_avx512(const double *x, double *out, int n, __m512d (*f)(__m512d))
 {
   int k = 0;
   for (; k + 8 <= n; k += 8) _mm512_storeu_pd(out + k, f(_mm512_loadu_pd(x + k)));
@@ -36,7 +36,7 @@ __attribute__((target("avx512f"))) void with_avx512(const double *x, double *out
   _mm512_mask_storeu_pd(out + k, tail, f(_mm512_mask_loadu_pd(_mm512_set1_pd(1.0), tail, x + k)));
 }
 
-__attribute__((target("avx2"))) void with_avx2(const double *x, double *out, int n, __m256d (*f)(__m256d))
+SEDIMENT_TARGET_AVX2 void with_avx2(const double *x, double *out, int n, __m256d (*f)(__m256d))
 {
   int k = 0;
   for (; k + 4 <= n; k += 4) _mm256_storeu_pd(out + k, f(_mm256_loadu_pd(x + k)));

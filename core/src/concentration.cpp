@@ -408,7 +408,7 @@ namespace {
 
 #ifdef SEDIMENT_GRID_AVX2
 // Lanes whose whole number k (as a double) lies within 2^30 layers: those cast to int as they are.
-__attribute__((target("avx2"))) inline __m256d within_reach4(__m256d k)
+SEDIMENT_TARGET_AVX2 inline __m256d within_reach4(__m256d k)
 {
   return _mm256_cmp_pd(_mm256_andnot_pd(_mm256_set1_pd(-0.0), k), _mm256_set1_pd(1 << 30), _CMP_LE_OQ);
 }
@@ -419,7 +419,7 @@ __attribute__((target("avx2"))) inline __m256d within_reach4(__m256d k)
 // within the period, which most do at small steps, was mispredicted for a quarter of the groups at
 // dt/tau = 1e4, where atoms outrun the neighbor skin and lie whole periods away between LAMMPS's
 // remaps into the box.)
-__attribute__((target("avx2"))) inline void periodic_cells4(const Layers &axis, __m256d k, __m256d &k0, __m256d &k1)
+SEDIMENT_TARGET_AVX2 inline void periodic_cells4(const Layers &axis, __m256d k, __m256d &k0, __m256d &k1)
 {
   const __m256d count = _mm256_set1_pd(axis.count);
   k0 = _mm256_sub_pd(k, _mm256_mul_pd(_mm256_floor_pd(_mm256_div_pd(k, count)), count));
@@ -428,7 +428,7 @@ __attribute__((target("avx2"))) inline void periodic_cells4(const Layers &axis, 
 }
 
 // cell_of(axis, k) of a bounded axis for four whole numbers k: k, or -1 outside the axis.
-__attribute__((target("avx2"))) inline __m256d bounded_cells4(const Layers &axis, __m256d k)
+SEDIMENT_TARGET_AVX2 inline __m256d bounded_cells4(const Layers &axis, __m256d k)
 {
   const __m256d outside = _mm256_or_pd(_mm256_cmp_pd(k, _mm256_setzero_pd(), _CMP_LT_OQ),
                                        _mm256_cmp_pd(k, _mm256_set1_pd(axis.count), _CMP_GE_OQ));
@@ -437,7 +437,7 @@ __attribute__((target("avx2"))) inline __m256d bounded_cells4(const Layers &axis
 
 // below() of four heights, by the same operations (min and max with their operands in this order
 // pick as std::min and std::max do, NaN included).
-__attribute__((target("avx2"))) inline __m256d below4(__m256d radius, __m256d u)
+SEDIMENT_TARGET_AVX2 inline __m256d below4(__m256d radius, __m256d u)
 {
   const __m256d v = _mm256_min_pd(radius, _mm256_max_pd(_mm256_xor_pd(radius, _mm256_set1_pd(-0.0)), u));
   return _mm256_mul_pd(_mm256_mul_pd(_mm256_set1_pd(pi), v),
@@ -446,14 +446,14 @@ __attribute__((target("avx2"))) inline __m256d below4(__m256d radius, __m256d u)
 }
 
 // Coordinate d of rows i to i + 3.
-__attribute__((target("avx2"))) inline __m256d coordinates4(const double (*rows)[3], int i, int d)
+SEDIMENT_TARGET_AVX2 inline __m256d coordinates4(const double (*rows)[3], int i, int d)
 {
   return _mm256_set_pd(rows[i + 3][d], rows[i + 2][d], rows[i + 1][d], rows[i][d]);
 }
 
 // touched() of four spheres: the first and last layer (whole numbers, as doubles).
-__attribute__((target("avx2"))) inline void touched4(const Layers &axis, __m256d c, __m256d r, __m256d &first,
-                                                     __m256d &last)
+SEDIMENT_TARGET_AVX2 inline void touched4(const Layers &axis, __m256d c, __m256d r, __m256d &first,
+                                          __m256d &last)
 {
   const __m256d lo = _mm256_set1_pd(axis.lo), per = _mm256_set1_pd(axis.per_thickness);
   first = _mm256_floor_pd(_mm256_mul_pd(_mm256_sub_pd(_mm256_sub_pd(c, r), lo), per));
@@ -462,8 +462,8 @@ __attribute__((target("avx2"))) inline void touched4(const Layers &axis, __m256d
 
 // The part of four spheres below the face above their first layer, as add_sphere_to_layers' fast path
 // computes it (half: below4(r, r)).
-__attribute__((target("avx2"))) inline __m256d below_next_face4(const Layers &axis, __m256d c, __m256d r,
-                                                               __m256d first, __m256d half)
+SEDIMENT_TARGET_AVX2 inline __m256d below_next_face4(const Layers &axis, __m256d c, __m256d r,
+                                                     __m256d first, __m256d half)
 {
   const __m256d face = _mm256_sub_pd(
       _mm256_add_pd(_mm256_set1_pd(axis.lo),
@@ -476,9 +476,9 @@ __attribute__((target("avx2"))) inline __m256d below_next_face4(const Layers &ax
 // time splitting those in one layer or across one face (most) in vectors, by the same operations as
 // its fast path; the others take add_sphere_to_layers. Deposits go in sphere order, so the sums are
 // the same as one by one.
-__attribute__((target("avx2"))) double layers_deposit_avx2(const Layers &layers, int axis,
-                                                           const double (*centres)[3], const double *radius,
-                                                           const double *weight, int n, double *values, int stride)
+SEDIMENT_TARGET_AVX2 double layers_deposit_avx2(const Layers &layers, int axis,
+                                                const double (*centres)[3], const double *radius,
+                                                const double *weight, int n, double *values, int stride)
 {
   const __m256d one = _mm256_set1_pd(1.0);
   double outside = 0.0;
@@ -538,9 +538,9 @@ __attribute__((target("avx2"))) double layers_deposit_avx2(const Layers &layers,
 // one face between inner cells (33 %), with their two cells and the split of add_sphere_to_layers' fast
 // path; the others take cells_deposit. Deposits go in sphere order, so the sums are the same as one
 // by one.
-__attribute__((target("avx2"))) double cells_deposit_avx2(const Grid &grid, const double (*centres)[3],
-                                                          const double *radius, const double *weight, int n,
-                                                          double *values, int stride)
+SEDIMENT_TARGET_AVX2 double cells_deposit_avx2(const Grid &grid, const double (*centres)[3],
+                                               const double *radius, const double *weight, int n,
+                                               double *values, int stride)
 {
   const double step[3] = {1.0, static_cast<double>(grid.axes[0].count),
                           static_cast<double>(grid.axes[0].count) * grid.axes[1].count};
@@ -675,8 +675,8 @@ void values_at_one_by_one(const Grid &grid, int axis, const double *values, cons
 // bracket() of four coordinates along an axis: the two centres' indices (whole numbers, as doubles)
 // and the weight of the second, by the same operations, so the same values. False when a lane is NaN
 // or further than 2^30 layers away: the caller reads those four points one by one.
-__attribute__((target("avx2"))) inline bool brackets4(const Layers &axis, __m256d x, __m256d &k0, __m256d &k1,
-                                                      __m256d &w)
+SEDIMENT_TARGET_AVX2 inline bool brackets4(const Layers &axis, __m256d x, __m256d &k0, __m256d &k1,
+                                           __m256d &w)
 {
   const __m256d s = _mm256_sub_pd(
       _mm256_mul_pd(_mm256_sub_pd(x, _mm256_set1_pd(axis.lo)), _mm256_set1_pd(axis.per_thickness)),
@@ -701,14 +701,14 @@ __attribute__((target("avx2"))) inline bool brackets4(const Layers &axis, __m256
 }
 
 // (1 - w) a + w b, lane by lane, as the scalar read computes it.
-__attribute__((target("avx2"))) inline __m256d between(__m256d a, __m256d b, __m256d w)
+SEDIMENT_TARGET_AVX2 inline __m256d between(__m256d a, __m256d b, __m256d w)
 {
   return _mm256_add_pd(_mm256_mul_pd(_mm256_sub_pd(_mm256_set1_pd(1.0), w), a), _mm256_mul_pd(w, b));
 }
 
 // values at four element offsets (whole numbers below 2^31, as doubles); the masked form with every
 // lane on gathers the same, from a defined source (GCC 12 warns of the plain form's undefined one)
-__attribute__((target("avx2"))) inline __m256d gather(const double *values, __m256d offset)
+SEDIMENT_TARGET_AVX2 inline __m256d gather(const double *values, __m256d offset)
 {
   const __m256d every_lane = _mm256_castsi256_pd(_mm256_set1_epi64x(-1));
   return _mm256_mask_i32gather_pd(_mm256_setzero_pd(), values, _mm256_cvttpd_epi32(offset), every_lane, 8);
@@ -716,15 +716,15 @@ __attribute__((target("avx2"))) inline __m256d gather(const double *values, __m2
 
 // Linear along x between the centres' values on the edge at `offset`, then along y between two such
 // edges, as cells_value_at (lambdas would not take the target).
-__attribute__((target("avx2"))) inline __m256d along_x(const double *values, __m256d offset, const __m256d lower[3],
-                                                       const __m256d upper[3], const __m256d w[3])
+SEDIMENT_TARGET_AVX2 inline __m256d along_x(const double *values, __m256d offset, const __m256d lower[3],
+                                            const __m256d upper[3], const __m256d w[3])
 {
   return between(gather(values, _mm256_add_pd(offset, lower[0])), gather(values, _mm256_add_pd(offset, upper[0])),
                  w[0]);
 }
 
-__attribute__((target("avx2"))) inline __m256d along_y(const double *values, __m256d offset, const __m256d lower[3],
-                                                       const __m256d upper[3], const __m256d w[3])
+SEDIMENT_TARGET_AVX2 inline __m256d along_y(const double *values, __m256d offset, const __m256d lower[3],
+                                            const __m256d upper[3], const __m256d w[3])
 {
   return between(along_x(values, _mm256_add_pd(offset, lower[1]), lower, upper, w),
                  along_x(values, _mm256_add_pd(offset, upper[1]), lower, upper, w), w[1]);
@@ -732,8 +732,8 @@ __attribute__((target("avx2"))) inline __m256d along_y(const double *values, __m
 
 // grid_values_at four points at a time, bit for bit the scalar read: the corners' values gathered,
 // the same operations lane by lane (no fused multiply-add in this target, so the same roundings).
-__attribute__((target("avx2"))) void values_at_avx2(const Grid &grid, int axis, const double *values,
-                                                    const double (*points)[3], int n, double *out, int stride)
+SEDIMENT_TARGET_AVX2 void values_at_avx2(const Grid &grid, int axis, const double *values,
+                                         const double (*points)[3], int n, double *out, int stride)
 {
   const __m256d zero = _mm256_setzero_pd();
   const double step[3] = {static_cast<double>(stride), static_cast<double>(grid.axes[0].count) * stride,
