@@ -23,8 +23,9 @@ import numpy as np
 
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE.parent / "python"))
+sys.path.insert(0, str(HERE))
 
-from sediment import _core  # noqa: E402
+from cost import TAU  # noqa: E402  (of in.cost's grains)
 from sediment.cli.types import count  # noqa: E402
 from sediment.sim.paths import lmp_executable  # noqa: E402
 
@@ -32,7 +33,6 @@ LAWS = ("drag", "nonlinear", "standard", "hindered", "richardson", "bingham", "c
 RATIOS = (1e-4, 1e-2, 1.0, 1e2, 1e4)
 FLOOR = "floor z 0.006"    # a floor a third of the way up the box: spheres come to rest on it
 BED_LAWS = ("standard", "dallavalle", "stokes")
-TAU = _core.relaxation_time("stokes", 998.2, 1.002e-3, 3e-5, 2650)    # of in.cost's grains
 
 
 def final_state(lmp: str, deck: Path, variables: dict[str, str], out: Path, ranks: int) -> np.ndarray:
