@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <vector>
 
 #if defined(__x86_64__) && defined(__GNUC__)
@@ -472,16 +473,32 @@ SEDIMENT_TARGET_AVX2 inline __m256d below_next_face4(const Layers &axis, __m256d
   return _mm256_add_pd(below4(r, face), half);
 }
 
+// Where four spheres' shares of one side go: the addresses of their cells (whole numbers as doubles) in
+// values, and sink's for lanes that add nothing there (a cell outside a bounded axis, or a sphere that
+// takes add_sphere_to_layers), so that the adds need no branch.
+SEDIMENT_TARGET_AVX2 inline __m256i cell_addresses4(__m256d cell, __m256d near, double *values, int stride,
+                                                     double *sink, __m256d &kept)
+{
+  kept = _mm256_and_pd(near, _mm256_cmp_pd(cell, _mm256_setzero_pd(), _CMP_GE_OQ));
+  // byte offsets below 2^31: cells lie within the axis where kept, and the grid is smaller than that
+  const __m256d offset = _mm256_and_pd(kept, _mm256_mul_pd(cell, _mm256_set1_pd(stride * sizeof(double))));
+  const __m256i address = _mm256_add_epi64(_mm256_set1_epi64x(reinterpret_cast<std::intptr_t>(values)),
+                                           _mm256_cvtepi32_epi64(_mm256_cvttpd_epi32(offset)));
+  return _mm256_castpd_si256(_mm256_blendv_pd(
+      _mm256_castsi256_pd(_mm256_set1_epi64x(reinterpret_cast<std::intptr_t>(sink))), _mm256_castsi256_pd(address),
+      kept));
+}
+
 // add_sphere_to_layers of n spheres in turn (their coordinate along the layers' axis), four at a
 // time splitting those in one layer or across one face (most) in vectors, by the same operations as
-// its fast path; the others take add_sphere_to_layers. Deposits go in sphere order, so the sums are
-// the same as one by one.
+// its fast path, down to the two adds per sphere; the others take add_sphere_to_layers. Deposits go
+// in sphere order, so the sums are the same as one by one.
 SEDIMENT_TARGET_AVX2 double layers_deposit_avx2(const Layers &layers, int axis,
                                                 const double (*centres)[3], const double *radius,
                                                 const double *weight, int n, double *values, int stride)
 {
-  const __m256d one = _mm256_set1_pd(1.0);
-  double outside = 0.0;
+  const __m256d one = _mm256_set1_pd(1.0), zero = _mm256_setzero_pd();
+  double outside = 0.0, sink = 0.0;
   int i = 0;
   for (; i + 4 <= n; i += 4) {
     const __m256d r = _mm256_loadu_pd(radius + i), c = coordinates4(centres, i, axis), half = below4(r, r);
@@ -500,30 +517,37 @@ SEDIMENT_TARGET_AVX2 double layers_deposit_avx2(const Layers &layers, int axis,
       cell[0] = bounded_cells4(layers, first);
       cell[1] = bounded_cells4(layers, _mm256_add_pd(first, one));
     }
-    alignas(32) double lower[4], total[4];
-    alignas(16) int index[2][4];
-    _mm256_store_pd(lower, below_next_face4(layers, c, r, first, half));
-    _mm256_store_pd(total, _mm256_mul_pd(_mm256_set1_pd(2.0), half));
-    for (int side = 0; side < 2; ++side)    // (lanes not near: 0, unused)
-      _mm_store_si128(reinterpret_cast<__m128i *>(index[side]), _mm256_cvttpd_epi32(_mm256_and_pd(cell[side], near)));
-    // Upper halves cleared before the SSE code below: GCC left them dirty, and this processor ran that
-    // code 1.5-2x slower after them.
-    _mm256_zeroupper();
+    const __m256d total = _mm256_mul_pd(_mm256_set1_pd(2.0), half),
+                  lower = below_next_face4(layers, c, r, first, half), count = weight ? _mm256_loadu_pd(weight + i) : one;
+    const __m256d part[2] = {lower, _mm256_sub_pd(total, lower)};
+    alignas(32) double *to[2][4];
+    alignas(32) double add[2][4], rest[4];
+    __m256d inside = zero;    // as add_sphere_to_layers sums it: 0, plus each part that lands in the axis
+    for (int side = 0; side < 2; ++side) {
+      __m256d kept;
+      _mm256_store_si256(reinterpret_cast<__m256i *>(to[side]),
+                         cell_addresses4(cell[side], near, values, stride, &sink, kept));
+      _mm256_store_pd(add[side], _mm256_mul_pd(count, part[side]));
+      inside = _mm256_add_pd(inside, _mm256_and_pd(kept, part[side]));
+    }
+    _mm256_store_pd(rest, _mm256_sub_pd(total, inside));
+    auto add_lane = [&](int k) {
+      *to[0][k] += add[0][k];
+      *to[1][k] += add[1][k];
+      outside += rest[k];
+    };
+    if (split == 0xF) {    // the common case apart, without the call: the sums stay in registers
+      for (int k = 0; k < 4; ++k) add_lane(k);
+      continue;
+    }
     for (int k = 0; k < 4; ++k) {
-      const double count = weight ? weight[i + k] : 1.0;
-      if (!(split >> k & 1)) {
-        outside += add_sphere_to_layers(layers, centres[i + k][axis], radius[i + k], values, stride, count);
-        continue;
+      if (split >> k & 1) {
+        add_lane(k);
+      } else {
+        _mm256_zeroupper();    // before the SSE code: this processor ran it 1.5-2x slower after dirty upper halves
+        outside += add_sphere_to_layers(layers, centres[i + k][axis], radius[i + k], values, stride,
+                                        weight ? weight[i + k] : 1.0);
       }
-      double inside = 0.0;
-      const double part[2] = {lower[k], total[k] - lower[k]};
-      for (int side = 0; side < 2; ++side) {
-        const int cell = index[side][k];
-        if (cell < 0) continue;
-        values[cell * stride] += count * part[side];
-        inside += part[side];
-      }
-      outside += total[k] - inside;
     }
   }
   _mm256_zeroupper();
@@ -732,38 +756,49 @@ SEDIMENT_TARGET_AVX2 inline __m256d along_y(const double *values, __m256d offset
 
 // grid_values_at four points at a time, bit for bit the scalar read: the corners' values gathered,
 // the same operations lane by lane (no fused multiply-add in this target, so the same roundings).
+// Layers take a loop of their own, without the bookkeeping of the axes they do not resolve.
 SEDIMENT_TARGET_AVX2 void values_at_avx2(const Grid &grid, int axis, const double *values,
                                          const double (*points)[3], int n, double *out, int stride)
 {
-  const __m256d zero = _mm256_setzero_pd();
-  const double step[3] = {static_cast<double>(stride), static_cast<double>(grid.axes[0].count) * stride,
-                          static_cast<double>(grid.axes[0].count) * grid.axes[1].count * stride};
   int i = 0;
-  for (; i + 4 <= n; i += 4) {
-    __m256d lower[3], upper[3], w[3];    // per axis: the two centres' offsets into values, the weight
-    bool in_common_range = true;
-    for (int d = 0; d < 3; ++d) {
-      if (axis >= 0 ? d != axis : !grid.resolved[d]) {
-        lower[d] = upper[d] = w[d] = zero;
+  if (axis >= 0) {
+    const Layers &layers = grid.axes[axis];
+    const __m256d step = _mm256_set1_pd(stride);
+    for (; i + 4 <= n; i += 4) {
+      __m256d lower, upper, w;
+      if (!brackets4(layers, coordinates4(points, i, axis), lower, upper, w)) {
+        values_at_one_by_one(grid, axis, values, points, i, i + 4, out, stride);
         continue;
       }
-      if (!brackets4(grid.axes[d], coordinates4(points, i, d), lower[d], upper[d], w[d])) {
-        in_common_range = false;
-        break;
+      _mm256_storeu_pd(out + i, between(gather(values, _mm256_mul_pd(lower, step)),
+                                        gather(values, _mm256_mul_pd(upper, step)), w));
+    }
+  } else {
+    const __m256d zero = _mm256_setzero_pd();
+    const double step[3] = {static_cast<double>(stride), static_cast<double>(grid.axes[0].count) * stride,
+                            static_cast<double>(grid.axes[0].count) * grid.axes[1].count * stride};
+    for (; i + 4 <= n; i += 4) {
+      __m256d lower[3], upper[3], w[3];    // per axis: the two centres' offsets into values, the weight
+      bool in_common_range = true;
+      for (int d = 0; d < 3; ++d) {
+        if (!grid.resolved[d]) {
+          lower[d] = upper[d] = w[d] = zero;
+          continue;
+        }
+        if (!brackets4(grid.axes[d], coordinates4(points, i, d), lower[d], upper[d], w[d])) {
+          in_common_range = false;
+          break;
+        }
+        lower[d] = _mm256_mul_pd(lower[d], _mm256_set1_pd(step[d]));
+        upper[d] = _mm256_mul_pd(upper[d], _mm256_set1_pd(step[d]));
       }
-      lower[d] = _mm256_mul_pd(lower[d], _mm256_set1_pd(axis >= 0 ? stride : step[d]));
-      upper[d] = _mm256_mul_pd(upper[d], _mm256_set1_pd(axis >= 0 ? stride : step[d]));
+      if (!in_common_range) {
+        values_at_one_by_one(grid, axis, values, points, i, i + 4, out, stride);
+        continue;
+      }
+      _mm256_storeu_pd(out + i, between(along_y(values, lower[2], lower, upper, w),
+                                        along_y(values, upper[2], lower, upper, w), w[2]));
     }
-    if (!in_common_range) {
-      values_at_one_by_one(grid, axis, values, points, i, i + 4, out, stride);
-      continue;
-    }
-    if (axis >= 0) {
-      _mm256_storeu_pd(out + i, between(gather(values, lower[axis]), gather(values, upper[axis]), w[axis]));
-      continue;
-    }
-    _mm256_storeu_pd(out + i, between(along_y(values, lower[2], lower, upper, w), along_y(values, upper[2], lower, upper, w),
-                                      w[2]));
   }
   _mm256_zeroupper();    // GCC left the upper halves dirty at the return: the SSE code after it ran 2x slower
   values_at_one_by_one(grid, axis, values, points, i, n, out, stride);
