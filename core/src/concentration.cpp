@@ -637,7 +637,9 @@ double add_spheres_to_grid(const Grid &grid, const double (*centres)[3], const d
   double outside = 0.0;
   const int axis = layer_axis(local);
 #ifdef SEDIMENT_GRID_AVX2
-  if (processor_has_avx2())    // four spheres at a time
+  // Four spheres at a time, on grids whose byte offsets an int holds (the compute's limit on its values
+  // keeps them there)
+  if (processor_has_avx2() && static_cast<double>(local.cells()) * stride * sizeof(double) < 0x1p31)
     return axis >= 0 ? layers_deposit_avx2(local.axes[axis], axis, centres, radius, weight, n, values, stride)
                      : cells_deposit_avx2(local, centres, radius, weight, n, values, stride);
 #endif
