@@ -517,8 +517,8 @@ SEDIMENT_TARGET_AVX2 double layers_deposit_avx2(const Layers &layers, int axis,
       cell[0] = bounded_cells4(layers, first);
       cell[1] = bounded_cells4(layers, _mm256_add_pd(first, one));
     }
-    const __m256d total = _mm256_mul_pd(_mm256_set1_pd(2.0), half),
-                  lower = below_next_face4(layers, c, r, first, half), count = weight ? _mm256_loadu_pd(weight + i) : one;
+    const __m256d total = _mm256_mul_pd(_mm256_set1_pd(2.0), half), lower = below_next_face4(layers, c, r, first, half);
+    const __m256d count = weight ? _mm256_loadu_pd(weight + i) : one;
     const __m256d part[2] = {lower, _mm256_sub_pd(total, lower)};
     alignas(32) double *to[2][4];
     alignas(32) double add[2][4], rest[4];
