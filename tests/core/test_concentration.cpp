@@ -298,6 +298,36 @@ TEST(Grid, ManySpheresAtOnceAreTheSpheresOneByOne)
   }
 }
 
+TEST(Grid, ManySpheresWholePeriodsAwayLandInTheirLayers)
+{
+  // On 49 periodic layers of thickness 1, k / 49 is a whole number m for a sphere whose lowest point
+  // lies in layer 49 m; a wrap through k times the rounded 1 / 49 would come out just under m for most
+  // m, one period off (tried). The vector deposit must give layer 0 as the scalar wrap does, and the
+  // read, layers 48 and 0 around centres in the first half of layer 0.
+  const Layers periodic{0.0, 1.0, 49, true};
+  const Grid grid{{Layers{0.0, 1.0, 1}, Layers{0.0, 1.0, 1}, periodic}, {false, false, true}};
+  const int n = 2 * 40 * 4;
+  const auto rows = std::make_unique<double[][3]>(n);
+  std::vector<double> radius(n);
+  for (int i = 0; i < n; ++i) {
+    const int m = i / 4 % 40 - 20;    // -20 to 19 periods away
+    rows[i][0] = rows[i][1] = 0.5;
+    rows[i][2] = 49.0 * m + (i < n / 2 ? 0.55 : 0.95);    // inside layer 49 m, or across into 49 m + 1
+    radius[i] = i < n / 2 ? 0.3 : 0.25 + 0.01 * (i % 4);
+  }
+  std::vector<double> alone(grid.cells(), 0.0), together(grid.cells(), 0.0);
+  double outside_alone = 0.0;
+  for (int i = 0; i < n; ++i) outside_alone += add_sphere_to_grid(grid, rows[i], radius[i], alone.data());
+  EXPECT_EQ(add_spheres_to_grid(grid, rows.get(), radius.data(), nullptr, n, together.data()), outside_alone);
+  ASSERT_EQ(together, alone);
+  EXPECT_GT(alone[0], 0.0);
+  EXPECT_GT(alone[1], 0.0);
+
+  std::vector<double> read(n);
+  grid_values_at(grid, alone.data(), rows.get(), n, read.data());
+  for (int i = 0; i < n; ++i) EXPECT_EQ(read[i], grid_value_at(grid, alone.data(), rows[i])) << "sphere " << i;
+}
+
 TEST(Grid, ASphereAcrossOneFaceInEachOfTwoOrThreeAxesAgreesWithRefinedCells)
 {
   // On cells of 0.25 each sphere crosses one face along two axes and none along the third (its four
