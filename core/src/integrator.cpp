@@ -632,17 +632,18 @@ namespace {
   }
 }
 
-void final_rows_of(const SphereRows &rows, int first, int count, const HalfKick &kick)
+// Inline, so that each caller's instruction set vectorises the loop.
+[[gnu::always_inline]] inline void final_rows_of(const SphereRows &rows, int first, int count, const HalfKick &kick)
 {
   final_rows(first, count, kick, rows.v, rows.omega, rows.force, rows.torque, rows.radius, rows.mass, rows.weights);
 }
 SEDIMENT_TARGET_AVX2 void final_rows_avx2(const SphereRows &rows, int first, int count, const HalfKick &kick)
 {
-  final_rows(first, count, kick, rows.v, rows.omega, rows.force, rows.torque, rows.radius, rows.mass, rows.weights);
+  final_rows_of(rows, first, count, kick);
 }
 SEDIMENT_TARGET_AVX512 void final_rows_avx512(const SphereRows &rows, int first, int count, const HalfKick &kick)
 {
-  final_rows(first, count, kick, rows.v, rows.omega, rows.force, rows.torque, rows.radius, rows.mass, rows.weights);
+  final_rows_of(rows, first, count, kick);
 }
 }  // namespace
 
