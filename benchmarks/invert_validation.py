@@ -9,7 +9,12 @@ al.'s times, in the water of the moment), inverted, and the recovered PSD compar
 reported diameters: those the readings resolve and those between them, with how often the band holds
 the truth; the standard reduction of the same sheets beside it.
 
-    /usr/bin/python3 benchmarks/invert_validation.py [--out out/invert-validation] [--reuse-truth] [PSD.csv ...]
+With --soils, real soils instead (examples/inverse/soils: sand to 0.6-1 mm, clay to 50 %): 50 g, the 152H at
+the D7928 times and the sieve sheet of the same sample (ASTM openings from 2 mm to 75 um, percent passing to
+0.1), each inverted with and without the sieves; the table adds the sieves, the tails and the USDA
+fractions against the truth's.
+
+    /usr/bin/python3 benchmarks/invert_validation.py [--out out/invert-validation] [--reuse-truth] [--soils] [PSD.csv ...]
 """
 from __future__ import annotations
 
@@ -22,7 +27,8 @@ import numpy as np
 
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE.parent / "python"))
-from sediment.lab.inverse import LabTest, invert  # noqa: E402
+from sediment.inverse import LabTest, invert  # noqa: E402
+from sediment.lab import texture  # noqa: E402
 from sediment.lab.psd import read_psd  # noqa: E402
 from sediment.lab.readout import SCHEDULES, BuoyancySphere, Column, Hydrometer, Pipette, Suspension  # noqa: E402
 from sediment.lab.sheet import read_sheet  # noqa: E402
@@ -32,6 +38,10 @@ from sediment.sim.scene import plan, write  # noqa: E402
 
 PSDS = [HERE.parent / "examples" / "granulometry" / "psd" / f"sample{k}.csv" for k in range(1, 6)] + \
        [HERE.parent / "examples" / "inverse" / "psd" / f"{name}.csv" for name in ("gap_graded", "bimodal", "narrow")]
+SOILS = [HERE.parent / "examples" / "inverse" / "soils" / f"{name}.csv"
+         for name in ("sandy_clay", "clay", "clay_loam", "silt_loam")]
+SIEVES_MM = (2.0, 0.85, 0.425, 0.25, 0.15, 0.106, 0.075)
+SOIL_MASS = 0.050
 REFERENCE_TEMPERATURE = 20.0
 TRUTH_CLASSES = 200    # size ratio 1.03 per class for the samples' spans: finer than the inverse's bins
 
@@ -41,11 +51,11 @@ def drift(time_s: np.ndarray) -> np.ndarray:
     return 19.0 + 4.0 * np.asarray(time_s) / 86400.0
 
 
-def synthesise(psd_path: Path, folder: Path) -> list[Path]:
-    """The truth run and its three sheets."""
+def synthesise(psd_path: Path, folder: Path, soil: bool = False) -> list[Path]:
+    """The truth run and its sheets: the three instruments', or for a soil the 152H's and the sieves'."""
     water = Suspension.at_temperature(REFERENCE_TEMPERATURE)
     scene = plan(read_psd(psd_path), particles=50000, classes=TRUTH_CLASSES, courant=1.0, seed=99, suspension=water,
-                 t_end=1.05 * 86400)
+                 t_end=1.05 * 86400, mass=SOIL_MASS if soil else 0.060)
     # the run's water drifts as the laboratory's does: the inverse's mapping of the temperature record onto
     # one water is checked against a run in which the viscosity and density change with time
     scene.water_record = tuple((t, float(drift(t))) for t in (0.0, 1.05 * 86400))
@@ -57,6 +67,12 @@ def synthesise(psd_path: Path, folder: Path) -> list[Path]:
     lines = ["time_min,reading,temperature_C"] + [
         f"{t / 60:g},{np.round(r / 0.5) * 0.5:g},{np.round(c, 1):g}" for t, r, c in zip(hydro, readings, drift(hydro))]
     (folder / "hydrometer.csv").write_text("\n".join(lines) + "\n")
+    if soil:
+        truth = read_psd(folder / "truth" / "simulated_psd.csv")
+        passing = truth.at(np.array(SIEVES_MM) * 1e-3)
+        lines = ["opening_mm,percent_passing"] + [f"{o:g},{np.round(p, 1):g}" for o, p in zip(SIEVES_MM, passing)]
+        (folder / "sieve.csv").write_text("\n".join(lines) + "\n")
+        return [folder / "hydrometer.csv", folder / "sieve.csv"]
     pipette_times = np.sort(Pipette(0.10).default_times(water))
     concentration = [Pipette(0.10).read(column, [t]).reading[0] for t in pipette_times]
     lines = ["time_min,depth_cm,mass_g,temperature_C"] + [
@@ -79,33 +95,75 @@ def synthesise(psd_path: Path, folder: Path) -> list[Path]:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("psds", type=Path, nargs="*", default=PSDS)
+    parser.add_argument("psds", type=Path, nargs="*")
     parser.add_argument("--out", type=Path, default=Path("out/invert-validation"))
     parser.add_argument("--bins", type=int, default=24)
+    parser.add_argument("--soils", action="store_true", help="the soils with sand and clay, 152H and sieve sheets")
     parser.add_argument("--reuse-truth", action="store_true",
                         help="invert the sheets an earlier run of this script left in --out (no new truth runs)")
     args = parser.parse_args()
+    psds = args.psds or (SOILS if args.soils else PSDS)
+    if args.soils:
+        soils(psds, args)
+        return
     print("| PSD | readings | at the readings' diameters: mean / worst error, band holds | between them: mean / worst, "
           "band holds | standard reduction: mean / worst | chi2 per reading | time |")
     print("|---|---|---|---|---|---|---|")
-    for psd_path in args.psds:
+    for psd_path in psds:
         folder = args.out / psd_path.stem
         names = [folder / f"{name}.csv" for name in ("hydrometer", "pipette", "buoyancy")]
         sheets = [read_sheet(p) for p in (names if args.reuse_truth else synthesise(psd_path, folder))]
         start = time.perf_counter()
-        result = invert(sheets, LabTest(), folder / "runs", bins=args.bins)
+        result = invert(sheets, LabTest(0.060), folder / "runs", bins=args.bins)
         seconds = time.perf_counter() - start
         result.save(folder / "invert")
         truth_psd = read_psd(folder / "truth" / "simulated_psd.csv")
-        truth = truth_psd.at(result.edges)
+        truth = truth_psd.at(result.diameter)
         error = np.abs(result.percent - truth)
         held = (result.low <= truth) & (truth <= result.high)
         standard = np.abs(np.concatenate([p - truth_psd.at(d) for _, _, d, p in result.reduction]))
         cells = []
-        for part in (result.measured, ~result.measured):
+        for part in (result.basis == "reading", result.basis == "between"):
             cells.append(f"{error[part].mean():.2f} / {error[part].max():.2f}, {held[part].mean():.0%}" if part.any() else "-")
         print(f"| {psd_path.stem} | {len(result.fit_rows)} | {cells[0]} | {cells[1]} | {standard.mean():.2f} / "
               f"{standard.max():.2f} | {result.reduced_chi2:.2f} | {seconds:.0f} s |", flush=True)
+
+
+def soils(psds: list[Path], args: argparse.Namespace) -> None:
+    """The soils' table: each with and without its sieve sheet."""
+    print("| soil | sheets | readings' cuts: mean / worst, held | sieves: mean / worst, held | between: mean / worst, "
+          "held | tails: held | coarsest cut: error, held | all reported: held | USDA clay / silt / sand error | "
+          "class (draws) | chi2 | time |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|")
+    for psd_path in psds:
+        folder = args.out / psd_path.stem
+        names = [folder / "hydrometer.csv", folder / "sieve.csv"]
+        hydrometer, sieve = [read_sheet(p) for p in (names if args.reuse_truth else synthesise(psd_path, folder, True))]
+        truth_psd = read_psd(folder / "truth" / "simulated_psd.csv")
+        fine = np.geomspace(0.1e-6, 3e-3, 400)
+        truth_fractions = texture.fractions(fine, truth_psd.at(fine), "USDA")
+        for label, chosen in (("152H + sieves", sieve), ("152H", None)):
+            start = time.perf_counter()
+            result = invert([hydrometer], LabTest(SOIL_MASS), folder / "runs", sieve=chosen, bins=args.bins)
+            seconds = time.perf_counter() - start
+            result.save(folder / ("invert" if chosen is not None else "invert-no-sieve"))
+            truth = truth_psd.at(result.diameter)
+            error = np.abs(result.percent - truth)
+            held = (result.low <= truth + 1e-9) & (truth <= result.high + 1e-9)
+            reported = ~np.isin(result.basis, ("floor", "top"))
+            cells = []
+            for part in (result.basis == "reading", result.basis == "sieve", result.basis == "between"):
+                cells.append(f"{error[part].mean():.2f} / {error[part].max():.2f}, {held[part].mean():.0%}"
+                             if part.any() else "-")
+            tails = np.isin(result.basis, ("coarse tail", "fine tail"))
+            coarsest = np.flatnonzero(result.basis == "reading")[-1]
+            got = texture.fractions(result.diameter, result.percent, "USDA")
+            usda = " / ".join(f"{got[k] - truth_fractions[k]:+.2f}" for k in ("clay", "silt", "sand"))
+            report = result.texture()
+            print(f"| {psd_path.stem} | {label} | {cells[0]} | {cells[1]} | {cells[2]} | "
+                  f"{held[tails].mean():.0%} of {tails.sum()} | {result.percent[coarsest] - truth[coarsest]:+.2f}, "
+                  f"{'yes' if held[coarsest] else 'NO'} | {held[reported].mean():.0%} | {usda} | {report.usda_class_line()} | "
+                  f"{result.reduced_chi2:.2f} | {seconds:.0f} s |", flush=True)
 
 
 if __name__ == "__main__":

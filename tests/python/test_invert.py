@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from sediment import cli
-from sediment.lab.inverse import LabTest, effective_times, invert, whole_sample_reading
+from sediment.inverse import LabTest, effective_times, invert, whole_sample_reading
 from sediment.lab.psd import read_psd
 from sediment.lab.readout import Suspension
 from sediment.lab.sheet import SheetError, check_sheet, read_sheet
@@ -42,7 +42,7 @@ def test_sheets_that_cannot_be_a_test_are_refused(tmp_path, text, message):
 
 
 def test_readings_no_suspension_gives_are_refused(tmp_path):
-    test, water = LabTest(), Suspension()
+    test, water = LabTest(0.060), Suspension()
     rising = read_sheet(_sheet(tmp_path, HYDROMETER + "1,45,20\n2,40,20\n4,42,20\n"))
     whole = whole_sample_reading(rising, test, water)
     with pytest.raises(SheetError, match="at 4 min .* goes back towards the initial one"):
@@ -56,9 +56,9 @@ def test_readings_no_suspension_gives_are_refused(tmp_path):
 def test_an_inversion_needs_two_cuts_and_a_few_bins(tmp_path):
     one = read_sheet(_sheet(tmp_path, HYDROMETER + "15,28.5,20\n"))
     with pytest.raises(ValueError, match="cut the sample at one diameter only"):
-        invert([one], LabTest(), tmp_path / "one")
+        invert([one], LabTest(0.060), tmp_path / "one")
     with pytest.raises(ValueError, match="give at least 4 size bins"):
-        invert([read_sheet(EXAMPLE / "hydrometer.csv")], LabTest(), tmp_path / "bins", bins=1)
+        invert([read_sheet(EXAMPLE / "hydrometer.csv")], LabTest(0.060), tmp_path / "bins", bins=1)
 
 
 def test_a_warmer_day_is_a_longer_test_in_the_reference_water(tmp_path):
@@ -68,32 +68,55 @@ def test_a_warmer_day_is_a_longer_test_in_the_reference_water(tmp_path):
     assert 3600.0 < times[1] < 3600.0 * 1.122                # up to 25 C after: at most 12 % more fall
 
 
-def test_the_bins_have_an_edge_at_each_readings_cut_diameter():
-    from sediment.lab.inverse import MERGE, _penalty, bin_edges
+def test_the_bins_have_an_edge_at_each_readings_cut_and_sieve_and_tails_above_and_below():
+    from sediment.inverse.grid import MERGE, SIEVE_SERIES, size_grid
 
-    cuts = np.array([1.0, 1.02, 2.0, 8.0]) * 1e-6
-    edges, measured = bin_edges(cuts, 5)
+    cuts = np.array([3.0, 3.05, 6.0, 24.0]) * 1e-6
+    grid = size_grid(cuts, 5)
     ratio = 8.0 ** 0.25
-    assert measured.sum() == 3 and not measured[-1]              # 1 and 1.02 share one edge; the top one is not a cut
-    assert all(np.min(np.abs(np.log(edges[measured] / c))) < np.log(MERGE) for c in cuts)
-    assert np.all(np.diff(np.log(edges[:-1])) <= np.log(ratio) + 1e-12)    # no gap wider than the grid's
-    assert edges[-1] == pytest.approx(8e-6 * ratio)
-    # even bins: the penalty is the shares' second differences
-    even = np.geomspace(1e-6, 1e-5, 6)
-    rows = _penalty(even)
-    assert rows.shape == (len(even) - 3, len(even) + 1)
+    at_cuts = grid.edges[grid.basis == "reading"]
+    assert len(at_cuts) == 3                                      # 3 and 3.05 share one edge
+    assert all(np.min(np.abs(np.log(at_cuts / c))) < np.log(MERGE) for c in cuts)
+    between = (grid.edges >= at_cuts[0]) & (grid.edges <= at_cuts[-1])
+    assert np.all(np.diff(np.log(grid.edges[between])) <= np.log(ratio) + 1e-12)    # no gap wider than the grid's
+    # the clay limit below the finest cut is a fine-tail edge, and half of it; the sand up to 2 mm is the coarse
+    # tail, at the ASTM series and the texture limits
+    assert list(grid.basis[grid.edges < at_cuts[0]]) == ["fine tail"] * 2
+    assert np.allclose(grid.edges[:2], [1e-6, 2e-6])
+    coarse = grid.edges[grid.basis == "coarse tail"]
+    assert set(SIEVE_SERIES) <= set(coarse) and {50e-6, 63e-6} <= set(coarse)
+    assert grid.edges[-1] == 2e-3 and grid.basis[-1] == "top" and grid.floor == pytest.approx(1e-7)
+    assert list(grid.tail("fine")) == [0, 1, 2] and grid.tail("coarse")[0] == np.flatnonzero(grid.edges == at_cuts[-1])[0] + 1
+    # with a sieve sheet the sieves pin the coarse end: no series, no tail but the top bin
+    sieves = np.array([75e-6, 150e-6, 425e-6])
+    pinned = size_grid(cuts, 5, sieves, top=850e-6)
+    assert set(sieves) <= set(pinned.edges[pinned.basis == "sieve"]) and 250e-6 not in pinned.edges
+    assert list(pinned.tail("coarse")) == [pinned.bins - 1] and pinned.edges[-1] == 850e-6
+    with pytest.raises(ValueError, match="at or above its largest grain"):
+        size_grid(cuts, 5, top=24.5e-6)
+
+
+def test_the_penalty_is_the_shares_second_differences_on_even_bins_and_leaves_the_tails_free():
+    from sediment.inverse.fit import penalty
+    from sediment.inverse.grid import SizeGrid
+
+    edges = np.geomspace(1e-6, 1e-5, 6)
+    grid = SizeGrid(np.append(edges, 1e-4), np.array(["reading"] * 6 + ["top"]), 1e-7)
+    rows = penalty(grid)
+    assert rows.shape == (3, 7)                 # bins 1-5 lie between the pinned edges: three triples
     assert np.allclose(rows[0, :5], [0, 1, -2, 1, 0])
+    assert np.all(rows[:, [0, 6]] == 0)         # the tails (below the first, above the last edge) are free
 
 
 def test_a_cut_is_the_stokes_diameter_in_dilute_water_and_coarser_where_the_suspension_hinders():
-    from sediment.lab.inverse import cut_diameters
+    from sediment.inverse.model import cut_diameters
     from sediment.lab.sheet import Sheet
 
     water = Suspension.at_temperature(20.0)
     times = np.array([600.0, 3600.0, 86400.0])
     sheet = Sheet("pipette", Path("p"), times, np.zeros(3), np.full(3, np.nan), np.full(3, 0.10))
     for mass, percent, low, high in [(1e-6, 0.0, 0.995, 1.005), (0.06, 100.0, 1.03, 1.08)]:
-        test = LabTest(mass=mass)
+        test = LabTest(mass)
         reading = np.full(3, percent / 100 * test.initial_concentration)
         cuts = cut_diameters([sheet], [reading], [times], test, water)
         ratio = cuts / water.stokes_diameter(0.10, times)
@@ -116,13 +139,14 @@ def test_a_sheet_of_known_answer_is_inverted_closer_than_the_standard_reduction(
     true_percent = truth.at(rows["diameter_um"] * 1e-6)
     error = rows["percent_finer"] - true_percent
     measured = rows["measured"] == 1
+    inside = (rows["diameter_um"] >= rows["diameter_um"][measured][0]) & (rows["diameter_um"] <= rows["diameter_um"][measured][-1])
     reduction = np.genfromtxt(out / "reduction.csv", delimiter=",", names=True, dtype=None, encoding=None)
     standard = reduction["percent_finer"] - truth.at(reduction["diameter_um"] * 1e-6)
     held = (rows["low"] <= true_percent) & (true_percent <= rows["high"])
     print(f"inverse: mean {np.mean(np.abs(error[measured])):.2f} at the readings' diameters, worst "
-          f"{np.max(np.abs(error)):.2f}; standard reduction: mean {np.mean(np.abs(standard)):.2f}, worst "
+          f"{np.max(np.abs(error[inside])):.2f}; standard reduction: mean {np.mean(np.abs(standard)):.2f}, worst "
           f"{np.max(np.abs(standard)):.2f} points; band holds {held[measured].mean():.0%}")
-    assert measured.sum() >= 15 and np.mean(np.abs(error[measured])) < 0.5 and np.max(np.abs(error)) < 1.5
+    assert measured.sum() >= 15 and np.mean(np.abs(error[measured])) < 0.5 and np.max(np.abs(error[inside])) < 1.5
     assert np.mean(np.abs(standard)) > 3 * np.mean(np.abs(error[measured]))
     assert held[measured].mean() >= 0.8
     assert np.all(np.diff(rows["percent_finer"]) >= 0) and np.all(rows["low"] <= rows["percent_finer"])
@@ -163,7 +187,7 @@ def test_the_design_of_a_test_prefers_early_readings_for_a_steep_coarse_end(tmp_
     """Sample 2 (45 % of its mass between 50 and 60 um): the 152H read from 1 min (D7928) recovers it far
     better than from 2 min (D422), whose first reading comes after those grains have passed; a mass beyond
     the 152H's scale is reported as not readable."""
-    from sediment.lab.inverse import DESIGNS, design_test
+    from sediment.inverse import DESIGNS, design_test
 
     chosen = {k: DESIGNS[k] for k in ("152H, D422 times", "152H, D7928 times")}
     psd = read_psd(EXAMPLE.parent / "granulometry" / "psd" / "sample2.csv")
@@ -173,3 +197,74 @@ def test_the_design_of_a_test_prefers_early_readings_for_a_steep_coarse_end(tmp_
     (unread,) = design_test(fines, tmp_path / "3", masses=(0.080,), designs={"152H": DESIGNS["152H, D7928 times"]},
                             draws=2)
     assert unread[2] == 0 and np.isnan(unread[4])
+
+
+SIEVE = "opening_mm,percent_passing\n"
+
+
+@pytest.mark.parametrize("text, message", [
+    (SIEVE + "0.075,40\n0.15,45\n0.15,50\n", "appears twice"),
+    (SIEVE + "75,40\n150,60\n2000,100\n", "write the openings in millimetres"),
+    (SIEVE + "0.075,0.4\n0.15,0.6\n2,1\n", "not fractions"),
+    (SIEVE + "0.075,60\n0.15,55\n2,100\n", "more passes the 0.075 mm sieve"),
+    (SIEVE + "0.075,-1\n2,100\n", "within 0-100"),
+    ("time_min,reading,temperature_C,opening_mm,percent_passing\n1,40,20,2,100\n", "give each instrument a sheet"),
+    (HYDROMETER.strip() + ",blank\n1,45,20,2\n2,40,20,\n", "no blank in row(s) 3"),
+])
+def test_sieve_sheets_and_blank_columns_that_cannot_be_are_refused(tmp_path, text, message):
+    with pytest.raises(SheetError, match=message.replace("(", r"\(").replace(")", r"\)")):
+        read_sheet(_sheet(tmp_path, text))
+
+
+def test_a_sieve_sheet_is_read_in_any_order_and_a_blank_is_subtracted(tmp_path):
+    from sediment.lab.sheet import SieveSheet
+
+    sieve = read_sheet(_sheet(tmp_path, "\ufeff" + SIEVE + "2.0,100\n0.425,80\n0.075,52.5\n", "s.csv"))
+    assert isinstance(sieve, SieveSheet)
+    assert np.allclose(sieve.opening, [75e-6, 425e-6, 2e-3]) and list(sieve.passing) == [52.5, 80, 100]
+    sheet = read_sheet(_sheet(tmp_path, HYDROMETER.strip() + ",blank\n1,45,20,2\n2,40,21,1.5\n", "h.csv"))
+    assert list(LabTest(0.05, zero_correction=9.0).corrected(sheet)) == [43.0, 38.5]    # the column wins
+
+
+def test_what_the_sieves_say_of_the_specimen(tmp_path):
+    from sediment.inverse.invert import sieve_data
+
+    whole = read_sheet(_sheet(tmp_path, SIEVE + "4.75,100\n2.0,80\n0.425,60\n0.075,40\n"))
+    plain = sieve_data(whole, None, 0.5)
+    assert plain.top == 4.75e-3 and plain.share == 1 and list(plain.percent) == [40, 60, 80]
+    split = sieve_data(whole, 2e-3, 0.5)    # D422: the hydrometer tests the part passing 2 mm
+    assert split.top == 2e-3 and split.share == 0.8 and np.allclose(split.percent, [50, 75])
+    assert np.allclose(split.sigma, 0.625)
+    short = read_sheet(_sheet(tmp_path, SIEVE + "2.0,95\n0.075,40\n", "short.csv"))
+    with pytest.raises(SheetError, match="passes the largest sieve .* --split"):
+        sieve_data(short, None, 0.5)
+    with pytest.raises(SheetError, match="no sieve of 0.85 mm"):
+        sieve_data(short, 0.85e-3, 0.5)
+    with pytest.raises(ValueError, match="--split needs the sieve sheet"):
+        sieve_data(None, 2e-3, 0.5)
+
+
+@pytest.mark.parametrize("extra, message", [
+    ([], "--mass is required"),
+    (["--mass", "0.05", "--zero-correction", "2"], "the composite correction is given twice"),
+    (["SAME", "--mass", "0.05"], "are the same sheet"),
+    (["--mass", "0.05", "--split", "2"], "--split needs the sieve sheet"),
+])
+def test_what_the_command_refuses_to_guess(tmp_path, capsys, extra, message):
+    blank = _sheet(tmp_path, HYDROMETER.strip() + ",blank\n1,45,20,2\n2,40,20,2\n", "h.csv")
+    copy = _sheet(tmp_path, blank.read_text(), "copy.csv")
+    args = [str(copy) if a == "SAME" else a for a in extra]
+    code = cli.main(["invert", str(blank), *args, "--out", str(tmp_path / "out")])
+    assert code != 0 and message in capsys.readouterr().err
+    assert not (tmp_path / "out" / "psd.csv").exists()
+
+
+def test_the_inverse_psd_is_read_wherever_a_psd_is_and_one_that_does_not_fit_is_not(tmp_path):
+    from sediment.lab.psd import PSDError
+
+    table = ("diameter_um,percent_finer,low,high,measured,basis\n0.2,0,0,30,0,floor\n2,30,28,32,1,reading\n"
+             "75,60,58,62,1,sieve\n850,100,100,100,0,top\n")
+    psd = read_psd(_sheet(tmp_path, table, "psd.csv"))
+    assert psd.at([2e-6])[0] == 30 and psd.span() == (0.2e-6, 850e-6)
+    with pytest.raises(PSDError, match="does not explain its sheets"):
+        read_psd(_sheet(tmp_path, "# NOT CONSISTENT: these files ...\n" + table, "bad.csv"))

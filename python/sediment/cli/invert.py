@@ -10,6 +10,7 @@ from .types import count, finite, positive, positive_list
 
 
 EXAMPLES = [
+    'sediment invert examples/inverse/soil/hydrometer.csv examples/inverse/soil/sieve.csv --mass 0.05 --out out/soil',
     'sediment invert examples/inverse/hydrometer.csv examples/inverse/pipette.csv --mass 0.06 --out out/invert',
     'sediment invert --design examples/granulometry/psd/sample5.csv --out out/design',
 ]
@@ -18,22 +19,28 @@ EXAMPLES = [
 def add_parser(commands) -> argparse.ArgumentParser:
     """Adds the command and its options."""
     parser = commands.add_parser(
-        "invert", help="a laboratory's readings (hydrometer, pipette, buoyancy sphere) in, the sample's PSD out, "
-        "with a band, the standard reduction beside it and the fit's verdict",
+        "invert", help="a laboratory's sheets (hydrometer, pipette, buoyancy sphere, sieves) in, the sample's PSD, "
+        "texture and gradation out, with bands, the standard reduction beside it and the fit's verdict",
         description="Fits the PSD whose simulated test (the best physics: standard drag curve, Richardson & Zaki's "
         "hindrance, the water at the sheet's temperatures) reads what the sheets read. Sheets are CSV: "
-        "time_min,reading,temperature_C (152H, g/L); time_min,depth_cm,mass_g (pipette); "
-        "time_min,apparent_mass_g (buoyancy sphere). Writes OUT/psd.csv (diameter_um,percent_finer,low,high), "
-        "reduction.csv, fit.csv, invert.json, invert.png. See docs/inverse.md. "
-        "Example: sediment invert examples/inverse/hydrometer.csv examples/inverse/pipette.csv --mass 0.06 "
-        "--out out/invert")
+        "time_min,reading,temperature_C[,blank] (152H, g/L); time_min,depth_cm,mass_g (pipette); "
+        "time_min,apparent_mass_g (buoyancy sphere); opening_mm,percent_passing (sieves, of the whole sample). "
+        "Writes OUT/psd.csv (diameter_um,percent_finer,low,high,measured,basis), texture.csv, gradation.csv, "
+        "reduction.csv, fit.csv, invert.json and the figures invert.png, gradation.png, texture.png. Exit 3: no PSD "
+        "explains the sheets. See docs/inverse.md. "
+        "Example: sediment invert examples/inverse/soil/hydrometer.csv examples/inverse/soil/sieve.csv --mass 0.05 "
+        "--out out/soil")
     parser.add_argument("sheets", type=Path, nargs="*", help="the sheets of one sample (CSV)")
     parser.add_argument("--design", type=Path, metavar="PSD",
                         help="instead of sheets: the PSD a sample is expected to have; compares instruments, reading "
                         "times and sample masses by how well each recovers it (OUT/design.csv, design.png)")
     parser.add_argument("--masses", type=positive_list, default=[0.030, 0.045, 0.060, 0.080],
                         help="with --design: sample masses to compare [kg] (default 0.03,0.045,0.06,0.08)")
-    parser.add_argument("--mass", type=positive, default=0.060, help="dry sample mass [kg] (default 0.06)")
+    parser.add_argument("--mass", type=positive, help="dry mass of the hydrometer's specimen [kg] (required with "
+                        "sheets; the part passing --split where one is given)")
+    parser.add_argument("--split", type=positive, metavar="OPENING_MM",
+                        help="the hydrometer's specimen is the part of the sample passing this sieve (D422: 2.0); the "
+                        "sieve sheet gives the percent passing it")
     parser.add_argument("--particle-density", type=positive, default=SOIL_PARTICLE_DENSITY, help="[kg/m3] (default 2650)")
     parser.add_argument("--cylinder-area", type=positive, default=D422_CYLINDER_AREA, help="[m2] (default D422's)")
     parser.add_argument("--height", type=positive, default=D422_CYLINDER_HEIGHT, help="suspension height [m]")
@@ -48,6 +55,8 @@ def add_parser(commands) -> argparse.ArgumentParser:
                         help="standard uncertainty of a 152H reading [g/L] (default 0.25: read to 0.5 g/L)")
     parser.add_argument("--balance-noise", type=positive, default=1e-3, help="of a sphere's apparent mass [g]")
     parser.add_argument("--pipette-noise", type=positive, default=1e-4, help="of a pipette sample's mass [g]")
+    parser.add_argument("--sieve-noise", type=positive, default=0.5,
+                        help="standard uncertainty of a sieve's percent passing [points] (default 0.5)")
     parser.add_argument("--thermometer", type=positive, default=0.5, help="of the temperature record [C]")
     parser.add_argument("--budget", type=Path, help="budget.json of `sediment budget` for this test: its physical "
                         "total widens the band")
@@ -62,52 +71,82 @@ def add_parser(commands) -> argparse.ArgumentParser:
 
 def run(args: argparse.Namespace) -> int:
     """Reads the sheets, inverts, prints the PSD and the verdict, writes the report."""
-    from ..lab.inverse import LabTest
+    from ..inverse import LabTest
     from ..lab.sheet import read_sheet
     from ..sim.run import folder_lock
 
     if (args.design is None) == (not args.sheets):
         raise ValueError("give the sheets of a sample, or --design PSD to plan a test (not both)")
+    if args.design is None and args.mass is None:
+        raise ValueError("--mass is required: the dry mass of the hydrometer's specimen [kg] (0.05 for 50 g)")
     noise = {"hydrometer": args.hydrometer_noise, "buoyancy": args.balance_noise,
-             "pipette": args.pipette_noise / (args.pipette_volume * 1e3)}
-    test = LabTest(args.mass, args.particle_density, args.cylinder_area, args.height, zero_correction=args.zero_correction,
+             "pipette": args.pipette_noise / (args.pipette_volume * 1e3), "sieve": args.sieve_noise}
+    test = LabTest(0.060 if args.mass is None else args.mass, args.particle_density, args.cylinder_area, args.height, zero_correction=args.zero_correction,
                    meniscus=args.meniscus, sphere_depth=args.sphere_depth, sphere_diameter=args.sphere_diameter,
                    sphere_mass=args.sphere_mass, noise=noise, thermometer=args.thermometer)
     sheets = [read_sheet(p, args.pipette_volume) for p in args.sheets]
+    _refuse_repeats(args.sheets)
+    sieves = [s for s in sheets if s.instrument == "sieve"]
+    if len(sieves) > 1:
+        raise ValueError(f"two sieve sheets ({sieves[0].path}, {sieves[1].path}): give one sieve analysis per sample")
+    if args.design is None and len(sieves) == len(sheets):
+        raise ValueError("a sieve sheet alone: give the sedimentation sheet(s) of the same sample too")
+    if args.zero_correction and any(len(getattr(s, "blank", ())) for s in sheets):
+        raise ValueError("--zero-correction and a sheet with a blank column: the composite correction is given twice; "
+                         "keep one")
     with folder_lock(args.out, "invert"):    # its forward runs and report: one inversion per folder at a time
         return _design(args, test) if args.design is not None else _invert(args, test, sheets)
 
 
+def _refuse_repeats(paths: list[Path]) -> None:
+    """The same sheet given twice would count its readings twice and narrow the band."""
+    seen: dict[bytes, Path] = {}
+    for path in paths:
+        content = path.read_bytes()
+        if content in seen:
+            raise ValueError(f"{path} and {seen[content]} are the same sheet: give each sheet once")
+        seen[content] = path
+
+
 def _invert(args: argparse.Namespace, test, sheets) -> int:
     """Inverts the sheets; prints the PSD and the verdict, writes the report (exit 3: no PSD fits)."""
-    from ..lab.inverse import invert
+    from ..inverse import invert
 
     band = 0.0
     if args.budget is not None:
         from ..studies.budget import band_of
 
-        band = max(band_of(args.budget, args.budget_sample)[s.instrument] for s in sheets)
-    result = invert(sheets, test, args.out / "runs", bins=args.bins, particles=args.particles, seed=args.seed,
-                    budget_band=band)
+        band = max(band_of(args.budget, args.budget_sample)[s.instrument] for s in sheets if s.instrument != "sieve")
+    readings = [s for s in sheets if s.instrument != "sieve"]
+    sieve = next((s for s in sheets if s.instrument == "sieve"), None)
+    result = invert(readings, test, args.out / "runs", sieve=sieve, split=None if args.split is None else args.split * 1e-3,
+                    bins=args.bins, particles=args.particles, seed=args.seed, budget_band=band)
     written = result.save(args.out)    # before printing: a reader that leaves (`| head`) loses nothing
+    notes, result.notes = result.notes, []
     print(result.table().text(), end="")
+    print(result.texture().table().text(), end="")
     for path in written:
         print(f"wrote {path}")
+    print("\n".join(notes))           # the verdict last
     return 0 if result.consistent else 3
 
 
 def _design(args: argparse.Namespace, test) -> int:
     """Compares the designs of a test of the expected PSD; prints and writes the table and figure."""
     from .. import figures
-    from ..lab.inverse import design_test
+    from ..inverse import clay_reading_time, design_test
     from ..lab.psd import read_psd
     from ..results import Table, write_text
 
-    rows = design_test(read_psd(args.design), args.out / "runs", masses=tuple(args.masses), test=test, bins=args.bins,
+    rows = design_test(psd, args.out / "runs", masses=tuple(args.masses), test=test, bins=args.bins,
                        particles=args.particles, seed=args.seed)
+    psd = read_psd(args.design)
+    clay = "; ".join(f"{celsius:g} C: {seconds / 3600:.3g} h" for celsius, seconds in clay_reading_time(psd, test))
     table = Table(["design", "mass_g", "readings", "mean_error_pp", "worst_error_pp"],
                   notes=[f"{args.design.name}: the recovered PSD's error at the bin edges, mean over noise draws; "
-                         "the hindrance's own uncertainty, growing with the mass, is not in it"])
+                         "the hindrance's own uncertainty, growing with the mass, is not in it",
+                         f"the 152H's cut reaches 2 um (clay) after: {clay} (at {test.mass * 1e3:g} g); a sheet whose "
+                         "last reading comes earlier bounds the clay fraction instead of measuring it"])
     for name, mass, n, mean, worst in rows:
         table.add(name, f"{mass * 1e3:g}", n, f"{mean:.3g}" if n else "cannot read", f"{worst:.3g}" if n else "")
     print(table.text(), end="")

@@ -58,6 +58,9 @@ class PSD:
         return np.interp(np.log(np.asarray(diameter, float)), np.log(self.diameter), self.percent_finer)
 
 
+# `sediment invert`'s psd.csv: its first two columns are the PSD
+INVERSE_COLUMNS = ("diameter_um", "percent_finer", "low", "high", "measured", "basis")
+NOT_FITTING = "NOT CONSISTENT"    # the first line of an inversion's files whose fit fails
 MIN_DIAMETER_UM = 0.01       # below this a diameter_um column was written in another unit
 MAX_DIAMETER_LOW_UM = 5.0     # a table ending below this was written in mm, not um
 
@@ -87,20 +90,27 @@ def read_psd(path: str | Path) -> PSD:
         raise PSDError(f"{path}: no such PSD file")
     try:
         with open(path, newline="", encoding="utf-8-sig") as f:    # utf-8-sig: a spreadsheet's byte-order mark
-            rows = [row for row in csv.reader(f) if row and not row[0].lstrip().startswith("#")]
+            lines = [row for row in csv.reader(f) if row]
     except UnicodeDecodeError:
         raise PSDError(f"{path}: not a text (CSV) file") from None
+    refused = next((",".join(row) for row in lines if row[0].lstrip().startswith(f"# {NOT_FITTING}")), None)
+    if refused:
+        raise PSDError(f"{path}: written by an inversion whose fit does not explain its sheets ('{refused[2:60]}...'): "
+                       "it is no PSD of the sample")
+    rows = [row for row in lines if not row[0].lstrip().startswith("#")]
     if not rows:
         raise PSDError(f"{path}: empty PSD file (expected a header diameter_um,percent_finer and rows)")
     header, body = [h.strip() for h in rows[0]], rows[1:]
-    if header != ["diameter_um", "percent_finer"]:
-        raise PSDError(f"{path}: header must be 'diameter_um,percent_finer' (two columns), not '{','.join(header)}'")
+    width = 2 if header == ["diameter_um", "percent_finer"] else len(INVERSE_COLUMNS)
+    if header != ["diameter_um", "percent_finer"] and header != list(INVERSE_COLUMNS):
+        raise PSDError(f"{path}: header must be 'diameter_um,percent_finer' (two columns, or the columns of `sediment "
+                       f"invert`'s psd.csv), not '{','.join(header)}'")
     if not body:
         raise PSDError(f"{path}: no rows below the header")
-    wide = next((k for k, row in enumerate(body, start=2) if len([c for c in row if c.strip()]) != 2), None)
+    wide = next((k for k, row in enumerate(body, start=2) if len([c for c in row if c.strip()]) != width), None)
     if wide is not None:
-        raise PSDError(f"{path}, line {wide}: a row has {len(body[wide - 2])} values; every row needs exactly two "
-                       "(diameter in um, percent finer)")
+        raise PSDError(f"{path}, line {wide}: a row has {len(body[wide - 2])} values; every row needs exactly {width} "
+                       "(diameter in um, percent finer" + (")" if width == 2 else ", and the inverse's band)"))
     try:
         values = np.array([[float(row[0]), float(row[1])] for row in body])
     except (ValueError, IndexError):

@@ -4,9 +4,11 @@ row, and the standard ASTM reduction of it.
 
 A sheet is a CSV a laboratory already keeps, one kind per file, told apart by its header:
 
-- hydrometer (152H, reading in g/L of soil): ``time_min,reading,temperature_C``
+- hydrometer (152H, reading in g/L of soil): ``time_min,reading,temperature_C``, ``blank`` optional (the
+  composite correction measured beside each reading, g/L, subtracted from it)
 - pipette: ``time_min,depth_cm,mass_g`` (the dry solids of one pipette sample), ``temperature_C`` optional
 - buoyancy sphere: ``time_min,apparent_mass_g`` (what the balance shows), ``temperature_C`` optional
+- sieves: ``opening_mm,percent_passing`` (percent of the whole dry sample passing each sieve)
 
 A sheet that no sedimenting suspension can give is refused with the reason: times out of order,
 missing temperatures, hydrometer readings in g/cm3, readings rising with time or above what the whole
@@ -27,6 +29,7 @@ KINDS = {
     "hydrometer": ("time_min", "reading", "temperature_C"),
     "pipette": ("time_min", "depth_cm", "mass_g"),
     "buoyancy": ("time_min", "apparent_mass_g"),
+    "sieve": ("opening_mm", "percent_passing"),
 }
 
 
@@ -46,6 +49,7 @@ class Sheet:
     reading: np.ndarray
     temperature: np.ndarray
     depth: np.ndarray = field(default_factory=lambda: np.empty(0))
+    blank: np.ndarray = field(default_factory=lambda: np.empty(0))    # 152H composite correction per reading
 
     @property
     def label(self) -> str:
@@ -53,21 +57,40 @@ class Sheet:
         return f"{self.path.name} ({self.instrument})"
 
 
-def read_sheet(path: str | Path, pipette_volume: float = 25e-6) -> Sheet:
+@dataclass(frozen=True)
+class SieveSheet:
+    """A sieve analysis: openings [m], increasing, and the percent of the whole dry sample passing each."""
+
+    path: Path
+    opening: np.ndarray
+    passing: np.ndarray
+
+    instrument = "sieve"
+
+    @property
+    def label(self) -> str:
+        return f"{self.path.name} (sieve)"
+
+
+def read_sheet(path: str | Path, pipette_volume: float = 25e-6) -> Sheet | SieveSheet:
     """Reads and checks one sheet (its kind from its header); a pipette's masses become g/L of the sample."""
     path = Path(path)
     header, rows = _table(path)
-    kind = next((k for k, columns in KINDS.items() if set(columns) <= set(header)), None)
-    if kind is None:
+    kinds = [k for k, columns in KINDS.items() if set(columns) <= set(header)]
+    if not kinds:
         expected = "; ".join(",".join(c) for c in KINDS.values())
         raise SheetError(f"{path}: header {','.join(header)} is none of the sheets (expected {expected})")
+    if len(kinds) > 1:
+        raise SheetError(f"{path}: the header has the columns of {' and '.join(kinds)} sheets: give each instrument "
+                         "a sheet of its own")
+    kind = kinds[0]
     if not rows:
         raise SheetError(f"{path}: no readings below the header")
     values: dict[str, list[float]] = {name: [] for name in header}
     for number, row in enumerate(rows, start=2):
         for name, text in zip(header, row):
             text = text.strip()
-            if text == "" and name == "temperature_C":
+            if text == "" and name in ("temperature_C", "blank"):
                 values[name].append(math.nan)
                 continue
             try:
@@ -76,6 +99,8 @@ def read_sheet(path: str | Path, pipette_volume: float = 25e-6) -> Sheet:
                 raise SheetError(f"{path}, row {number}: {name} '{text}' is not a number") from None
             if not math.isfinite(values[name][-1]):
                 raise SheetError(f"{path}, row {number}: {name} is not finite")
+    if kind == "sieve":
+        return _sieve_sheet(path, np.array(values["opening_mm"]), np.array(values["percent_passing"]))
     time = np.array(values["time_min"]) * 60.0
     if time[0] <= 0 or np.any(np.diff(time) <= 0):
         raise SheetError(f"{path}: the times must be > 0 and increase from row to row")
@@ -87,12 +112,18 @@ def read_sheet(path: str | Path, pipette_volume: float = 25e-6) -> Sheet:
                          "it was taken at")
     if np.any(recorded & ((temperature < 0) | (temperature > 40))):
         raise SheetError(f"{path}: temperatures outside 0-40 C, the range of the water correlations")
-    depth = np.empty(0)
+    depth, blank = np.empty(0), np.empty(0)
     if kind == "hydrometer":
         reading = np.array(values["reading"])
         if np.all((reading > 0.95) & (reading < 1.15)):
             raise SheetError(f"{path}: the readings ({reading.min():g}-{reading.max():g}) look like specific gravities "
                              "(a 151H, g/cm3): the sheet takes a 152H's readings in g/L")
+        if "blank" in values:
+            blank = np.array(values["blank"])
+            if not np.isfinite(blank).all():
+                missing = ", ".join(str(k + 2) for k in np.flatnonzero(~np.isfinite(blank)))
+                raise SheetError(f"{path}: no blank in row(s) {missing}: give the composite correction beside every "
+                                 "reading, or drop the column and give --zero-correction")
     elif kind == "pipette":
         depth = np.array(values["depth_cm"]) / 100.0
         mass = np.array(values["mass_g"])
@@ -103,13 +134,37 @@ def read_sheet(path: str | Path, pipette_volume: float = 25e-6) -> Sheet:
         reading = np.array(values["apparent_mass_g"])
         if np.any(reading <= 0):
             raise SheetError(f"{path}: apparent masses must be > 0")
-    return Sheet(kind, path, time, reading, temperature, depth)
+    return Sheet(kind, path, time, reading, temperature, depth, blank)
+
+
+def _sieve_sheet(path: Path, opening_mm: np.ndarray, passing: np.ndarray) -> SieveSheet:
+    """Checks a sieve analysis: openings in mm, distinct; percents within 0-100 of the whole sample and
+    cumulative (never more passing a finer sieve)."""
+    if np.any(opening_mm <= 0):
+        raise SheetError(f"{path}: sieve openings must be > 0 mm")
+    if opening_mm.max() > 200:
+        raise SheetError(f"{path}: a sieve opening of {opening_mm.max():g} mm: write the openings in millimetres "
+                         "(0.075 for the 75 um sieve)")
+    if len(np.unique(opening_mm)) != len(opening_mm):
+        raise SheetError(f"{path}: a sieve opening appears twice")
+    if np.any((passing < 0) | (passing > 100)):
+        raise SheetError(f"{path}: percent passing must be within 0-100 (of the whole dry sample)")
+    if passing.max() <= 1.0:
+        raise SheetError(f"{path}: percent passing tops out at {passing.max():g}: write percent (0-100), not fractions")
+    order = np.argsort(opening_mm)
+    opening, passing = opening_mm[order] * 1e-3, passing[order]
+    rises = np.flatnonzero(np.diff(passing) < 0)
+    if len(rises):
+        k = rises[0]
+        raise SheetError(f"{path}: more passes the {opening[k] * 1e3:g} mm sieve ({passing[k]:g} %) than the coarser "
+                         f"{opening[k + 1] * 1e3:g} mm one ({passing[k + 1]:g} %): percent passing is cumulative")
+    return SieveSheet(path, opening, passing)
 
 
 def _table(path: Path) -> tuple[list[str], list[list[str]]]:
     """A CSV's header and rows (blank lines and # comments left out), each row as long as the header."""
     try:
-        with path.open(newline="") as handle:
+        with path.open(newline="", encoding="utf-8-sig") as handle:
             rows = [row for row in csv.reader(handle) if row and not row[0].lstrip().startswith("#")]
     except UnicodeDecodeError as exc:
         raise SheetError(f"{path}: not a text CSV ({exc.reason})") from None

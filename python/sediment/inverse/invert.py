@@ -1,0 +1,399 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
+"""From a laboratory's sheets to the sample's PSD (docs/inverse.md): `invert` and its result."""
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+
+import numpy as np
+
+from .. import figures
+from ..lab import texture
+from ..lab.psd import NOT_FITTING
+from ..lab.readout import Suspension
+from ..lab.sheet import Sheet, SieveSheet, SheetError, check_sheet, standard_reduction
+from ..results import Table, write_text
+from .fit import draw_placement, fit, penalty
+from .grid import NEAR, TOP, SizeGrid, size_grid
+from .model import LabTest, cut_diameters, effective_times, linearise, psd_of, run_forward, solids_signal, \
+    whole_sample_reading
+
+CONVERGED = 0.2           # points of percent finer between rounds
+
+
+@dataclass
+class Inversion:
+    """The recovered PSD of the whole sample with its band and draws, the standard reduction, the fit
+    and its verdict, and every value of the test it used."""
+
+    diameter: np.ndarray         # [m] the reported diameters: the bins' edges (and sieves above a split)
+    percent: np.ndarray          # recovered percent finer, of the whole dry sample
+    low: np.ndarray
+    high: np.ndarray
+    basis: np.ndarray            # what pins each diameter (sediment.inverse.grid)
+    draws: np.ndarray            # [draws, diameters] the PSDs the data allow, for the band and the texture
+    reduction: list[tuple[str, np.ndarray, np.ndarray, np.ndarray]]     # instrument, time, D, P (whole sample)
+    fit_rows: list[tuple[str, float, float, float, float, float]]       # instrument, time, opening, data, model, sigma
+    chi2: float
+    rounds: int
+    smoothness: float
+    resolution: str
+    inputs: dict
+    sieve: tuple[np.ndarray, np.ndarray] | None = None                  # openings [m], percent passing
+    notes: list[str] = field(default_factory=list)
+
+    @property
+    def measured(self) -> np.ndarray:
+        """Whether a reading or a sieve pins each diameter."""
+        return np.isin(self.basis, ("reading", "sieve"))
+
+    @property
+    def reduced_chi2(self) -> float:
+        """Chi-square per reading or sieve."""
+        return self.chi2 / max(len(self.fit_rows), 1)
+
+    @property
+    def consistent(self) -> bool:
+        """Whether some PSD explains the sheets within their noise (chi-square per reading < 4)."""
+        return self.reduced_chi2 < 4.0
+
+    @property
+    def verdict(self) -> str:
+        if self.consistent:
+            return f"verdict: fits (chi-square per reading {self.reduced_chi2:.3g})"
+        return (f"verdict: {NOT_FITTING}: chi-square per reading {self.reduced_chi2:.3g} (>= 4): no PSD of this sample "
+                "under this physics gives these readings within their noise")
+
+    def texture(self) -> texture.TextureReport:
+        """Clay, silt, sand and gravel, the USDA class, D10-D60, Cu and Cc, with their bands from the draws."""
+        return texture.texture_report(self.diameter, self.percent, self.draws)
+
+    def table(self) -> Table:
+        """Percent finer with its band at each reported diameter, and what pins it."""
+        table = Table(["diameter_um", "percent_finer", "low", "high", "measured", "basis"], notes=self.notes)
+        for d, p, low, high, measured, basis in zip(self.diameter * 1e6, self.percent, self.low, self.high,
+                                                    self.measured, self.basis):
+            table.add(float(d), float(p), float(low), float(high), int(measured), basis)
+        return table
+
+    def save(self, folder: Path) -> list[Path]:
+        """psd.csv, reduction.csv, fit.csv, texture.csv, gradation.csv, invert.json and the figures
+        invert.png, gradation.png, texture.png. Where the fit fails, every table's first line says so."""
+        folder = Path(folder)
+        first = "" if self.consistent else f"# {NOT_FITTING}: these files come from a fit that does not explain the " \
+                                           "sheets (invert.json, 'notes')\n"
+        reduction = Table(["instrument", "time_min", "diameter_um", "percent_finer"])
+        for name, t, d, p in self.reduction:
+            for row in zip(t / 60, d * 1e6, p):
+                reduction.add(name, *map(float, row))
+        fitted = Table(["instrument", "time_min", "opening_mm", "measured", "simulated", "residual_sigma"])
+        for name, t, opening, measured, model, sigma in self.fit_rows:
+            fitted.add(name, "" if math.isnan(t) else t / 60, "" if math.isnan(opening) else opening * 1e3,
+                       measured, model, (model - measured) / sigma)
+        report = self.texture()
+        summary = {"consistent": self.consistent, "chi2_per_reading": self.reduced_chi2, "verdict": self.verdict,
+                   "inputs": self.inputs,
+                   "psd": {"diameter_um": (self.diameter * 1e6).tolist(), "percent_finer": self.percent.tolist(),
+                           "low": self.low.tolist(), "high": self.high.tolist(), "basis": self.basis.tolist()},
+                   "texture": report.summary(), "rounds": self.rounds, "smoothness": self.smoothness,
+                   "resolution": self.resolution, "notes": self.notes}
+        written = [write_text(folder / "psd.csv", first + self.table().csv()),
+                   write_text(folder / "reduction.csv", first + reduction.csv()),
+                   write_text(folder / "fit.csv", first + fitted.csv())]
+        written += [write_text(path, first + path.read_text()) if first else path for path in report.save(folder)]
+        written += [write_text(folder / "invert.json", json.dumps(summary, indent=1) + "\n"), self.plot(folder / "invert.png")]
+        points = [(f"standard reduction ({name})", d, p) for name, _, d, p in self.reduction]
+        written.append(texture.gradation_figure(folder / "gradation.png", self.diameter, self.percent, self.low,
+                                                self.high, self.sieve, points))
+        return written
+
+    def plot(self, path: Path) -> Path:
+        """The recovered PSD with its band and the standard reduction; the fit's residuals."""
+        plt = figures.pyplot()
+        fig, (ax, res) = plt.subplots(1, 2, figsize=(11, 4.5), gridspec_kw={"width_ratios": [3, 2]})
+        d = self.diameter * 1e6
+        ax.fill_between(d, self.low, self.high, color="C0", alpha=0.25, label="band")
+        ax.plot(d, self.percent, "C0-", label="recovered PSD")
+        ax.plot(d[self.measured], self.percent[self.measured], "C0o", ms=4, label="at a reading's or a sieve's diameter")
+        ax.plot(d[~self.measured], self.percent[~self.measured], "o", mec="C0", mfc="white", ms=4,
+                label="between them, or in a tail")
+        for k, (name, _, dd, p) in enumerate(self.reduction):
+            ax.plot(dd * 1e6, p, "s", ms=5, color=f"C{k + 1}", label=f"standard reduction ({name})")
+        if self.sieve is not None:
+            ax.plot(self.sieve[0] * 1e6, self.sieve[1], "kv", ms=6, label="sieves")
+        ax.set(xscale="log", xlabel="diameter [um]", ylabel="percent finer [%]", ylim=(0, 100),
+               title="the sample's PSD from the sheets" + ("" if self.consistent else f" ({NOT_FITTING})"))
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=8)
+        for name in dict.fromkeys(r[0] for r in self.fit_rows if r[0] != "sieve"):
+            rows = [r for r in self.fit_rows if r[0] == name]
+            res.plot([r[1] / 60 for r in rows], [(r[4] - r[3]) / r[5] for r in rows], "o-", ms=4, label=name)
+        res.axhline(0, color="k", lw=0.8)
+        res.set(xscale="log", xlabel="time [min]", ylabel="(simulated - measured) / noise",
+                title=f"fit: chi2 per reading {self.reduced_chi2:.2g}")
+        res.legend(fontsize=8)
+        res.grid(alpha=0.3)
+        return figures.save(fig, path)
+
+
+@dataclass(frozen=True)
+class SieveData:
+    """The sieve sheet as the fit takes it: the openings below the specimen's top, their percent of the
+    specimen and its noise, and the specimen's share of the whole sample."""
+
+    opening: np.ndarray
+    percent: np.ndarray          # of the specimen
+    sigma: np.ndarray
+    top: float                   # the specimen's largest grain [m]
+    share: float                 # of the whole sample in the specimen (1 without a split)
+    whole: SieveSheet | None
+
+
+def sieve_data(sieve: SieveSheet | None, split: float | None, noise: float) -> SieveData:
+    """What the sieve sheet says of the hydrometer's specimen. Without a split the specimen is the whole
+    sample, so its coarsest grain is the finest sieve all of it passes; with one, the specimen is the
+    part passing the split sieve, whose percent passing scales the rest."""
+    if sieve is None:
+        if split is not None:
+            raise ValueError("--split needs the sieve sheet: the percent passing the split sieve sets the specimen's "
+                             "share of the sample")
+        return SieveData(np.empty(0), np.empty(0), np.empty(0), TOP, 1.0, None)
+    if split is not None:
+        at = np.flatnonzero(np.abs(np.log(sieve.opening / split)) < math.log(NEAR))
+        if not len(at):
+            raise SheetError(f"{sieve.label}: no sieve of {split * 1e3:g} mm, the split: the sheet must give the "
+                             "percent passing it")
+        share = sieve.passing[at[0]] / 100.0
+        if share <= 0:
+            raise SheetError(f"{sieve.label}: nothing passes the {split * 1e3:g} mm split: there is no specimen")
+        top = sieve.opening[at[0]]
+    else:
+        whole = np.flatnonzero(sieve.passing >= 100.0)
+        if not len(whole):
+            raise SheetError(f"{sieve.label}: {sieve.passing[-1]:g} % passes the largest sieve "
+                             f"({sieve.opening[-1] * 1e3:g} mm), so the sample has coarser grains: give the sieve "
+                             "the whole sample passes, or --split OPENING_MM where the hydrometer's specimen is the "
+                             "part passing one sieve")
+        share, top = 1.0, sieve.opening[whole[0]]
+    below = sieve.opening < top / NEAR
+    return SieveData(sieve.opening[below], sieve.passing[below] / share, np.full(below.sum(), noise / share), top,
+                     share, sieve)
+
+
+def invert(sheets: list[Sheet], test: LabTest, folder: Path, *, sieve: SieveSheet | None = None,
+           split: float | None = None, bins: int = 24, particles: int = 20000, courant: float = 4.0, rounds: int = 4,
+           draws: int = 64, seed: int = 1, budget_band: float = 0.0) -> Inversion:
+    """Recovers the PSD the sheets were read from (docs/inverse.md, the method).
+
+    Parameters
+    ----------
+    sheets : list of Sheet
+        The readings (any of hydrometer, pipette, buoyancy sphere, one sheet each or several).
+    test : LabTest
+        Specimen mass, particle density, cylinder and instruments.
+    folder : Path
+        Where the forward runs go.
+    sieve : SieveSheet, optional
+        The same sample's sieve analysis (percent of the whole sample passing each opening).
+    split : float, optional
+        [m] the sieve whose passing part is the hydrometer's specimen (D422's 2 mm); `test.mass` is then the
+        specimen's mass.
+    bins : int
+        Size bins between the finest and the coarsest reading's cut.
+    particles, courant : int, float
+        Resolution of the forward runs (`sediment sample`'s defaults).
+    rounds : int
+        Forward runs at most.
+    draws : int
+        Draws of the PSDs the data allow, for the band (their central 95 %) and the texture.
+    budget_band : float
+        Points of percent finer the physics' uncertainty adds (an error budget's physical total).
+    """
+    if not sheets:
+        raise ValueError("no sheet of readings to invert (a sieve sheet alone gives no sedimentation data)")
+    recorded = np.concatenate([s.temperature[np.isfinite(s.temperature)] for s in sheets])
+    mean_temperature = float(recorded.mean()) if len(recorded) else 20.0
+    water = Suspension.at_temperature(mean_temperature, test.particle_density)
+    c0 = test.initial_concentration
+    signals = [solids_signal(sheet, test, water) for sheet in sheets]
+    corrected = [test.corrected(sheet) for sheet in sheets]
+    for sheet, reading, signal in zip(sheets, corrected, signals):
+        # the tolerance: twice the reading's noise, and 2 % of the solids' signal for the sampling of a real
+        # suspension (a pipette's first samples can draw a little more than the mean)
+        check_sheet(replace(sheet, reading=reading), whole_sample_reading(sheet, test, water),
+                    max(2 * test.noise[sheet.instrument], 0.02 * signal))
+    sieves = sieve_data(sieve, split, test.noise["sieve"])
+    reduction = []
+    for sheet, reading in zip(sheets, corrected):
+        d, p = standard_reduction(replace(sheet, reading=reading), water, c0, test.hydrometer, test.cylinder_area,
+                                  test.sphere, test.meniscus)
+        reduction.append((sheet.instrument, sheet.time, d, p))
+    times = [effective_times(s, water) for s in sheets]
+    grid = size_grid(cut_diameters(sheets, corrected, times, test, water), bins, sieves.opening, sieves.top)
+    shares = first_guess(reduction, sieves, grid)
+    sieve_rows = 100.0 * grid.cumulative(sieves.opening)
+    data = np.concatenate(corrected + [sieves.percent])
+    readings = len(data) - len(sieves.opening)
+    sigma = np.concatenate([np.full(len(s.time), test.noise[s.instrument]) for s in sheets] + [sieves.sigma])
+    # the readings' times in water 1 C warmer: the runs reach the latest, and the band's thermometer
+    # offset (below) is linear in the readings there
+    warmer = [effective_times(s, water, 1.0) for s in sheets]
+    t_end = 1.02 * max(t[-1] for t in warmer)
+
+    def model(run, x, at=times):
+        base, jac = linearise(run, x, sheets, at)
+        return np.concatenate([base, sieve_rows @ x]), np.vstack([jac, sieve_rows])
+
+    previous, weight, reading_sigma = None, None, sigma
+    for round_number in range(1, rounds + 1):
+        # every bin keeps some mass in the run, so that its columns can be scaled to any share
+        spread = 0.8 * shares + 0.2 / len(shares)
+        run = run_forward(psd_of(spread, grid), grid, test, water, t_end, folder / f"round{round_number}",
+                          particles, courant, seed)
+        if round_number == 1:
+            # the forward model's own sampling error: the same PSD with another placement; its rms
+            # difference per instrument (over sqrt 2) adds to each reading's noise
+            other = run_forward(psd_of(spread, grid), grid, test, water, t_end, folder / "sampling", particles,
+                                courant, seed + 1)
+            gap = run.readings(shares, sheets, times) - other.readings(shares, sheets, times)
+            start = 0
+            model_sigma = np.zeros(len(data))
+            for sheet, signal in zip(sheets, signals):
+                n = len(sheet.time)
+                # and at least the resolution's 0.2 points of percent finer (the time step's, error budget)
+                model_sigma[start:start + n] = max(math.sqrt(np.mean(gap[start:start + n] ** 2) / 2), 0.002 * signal)
+                start += n
+            sigma = np.sqrt(reading_sigma ** 2 + model_sigma ** 2)
+        for _ in range(2):    # Gauss-Newton on this run's columns
+            base, jac = model(run, shares)
+            shares, chi2, weight = fit(jac, base, shares, data, sigma, grid)
+        percent = 100 * np.cumsum(shares)[:-1]
+        if previous is not None and np.max(np.abs(percent - previous)) < CONVERGED:
+            break
+        previous = percent
+    base, jac = model(run, shares)
+    chi2 = float(np.sum(((base - data) / sigma) ** 2))
+    # The band: draws of the PSDs the data allow, each fit again with the readings and sieves drawn from
+    # their noise (and the forward model's), the thermometer's offset drawn, the smoothness penalty aiming
+    # at a draw of its prior and each tail's mass placed as drawn (randomise-then-optimise). An offset moves
+    # every reading's time alike; its effect on the readings is taken as linear (the record 1 C warmer).
+    per_degree = np.concatenate([run.readings(shares, sheets, warmer) - base[:readings], np.zeros(len(sieves.opening))])
+    rng = np.random.default_rng(seed)
+    penalty_rows = len(penalty(grid))
+    specimen_draws = []
+    for _ in range(draws):
+        noisy = data + rng.normal(0.0, sigma) - rng.normal(0.0, test.thermometer) * per_degree
+        x, _, _ = fit(jac, base, shares, noisy, sigma, grid, weight, rng.normal(0.0, 1.0, penalty_rows),
+                      draw_placement(grid, rng))
+        specimen_draws.append(100 * np.cumsum(x))
+    # the tails' extreme placements the data allow: each tail's mass in its finest bin, then in its coarsest;
+    # the band in a tail covers both
+    extremes = []
+    for end in (0, -1):
+        placement = {which: np.eye(max(len(grid.tail(which)), 1))[end][:len(grid.tail(which))]
+                     for which in ("fine", "coarse")}
+        x, _, _ = fit(jac, base, shares, data, sigma, grid, weight, None, placement)
+        extremes.append(100 * np.cumsum(x))
+    specimen = 100 * np.cumsum(shares)
+    specimen[-1] = 100.0
+    result = _whole_sample(grid, specimen, np.array(specimen_draws).reshape(-1, grid.bins), np.array(extremes), sieves,
+                           budget_band)
+    rows = []
+    start = 0
+    for sheet in sheets:
+        n = len(sheet.time)
+        rows += [(sheet.instrument, float(t), math.nan, float(m), float(f), float(s))
+                 for t, m, f, s in zip(sheet.time, data[start:start + n], base[start:start + n], sigma[start:start + n])]
+        start += n
+    rows += [("sieve", math.nan, float(o), float(m), float(f), float(s))
+             for o, m, f, s in zip(sieves.opening, data[start:], base[start:], sigma[start:])]
+    resolution = (f"{particles} parcels, Courant {courant:g}, standard drag curve + Richardson & Zaki, water at "
+                  f"{mean_temperature:.3g} C")
+    inputs = test.record() | {
+        "sheets": [str(s.path) for s in sheets] + ([str(sieve.path)] if sieve is not None else []),
+        "composite_correction": {str(s.path): ("blank column" if len(s.blank) else test.zero_correction)
+                                 for s in sheets if s.instrument == "hydrometer"},
+        "temperatures_C": [float(recorded.min()), float(recorded.max())] if len(recorded) else None,
+        "split_mm": None if split is None else split * 1e3, "specimen_share": sieves.share,
+        "top_um": sieves.top * 1e6}
+    whole = [(name, t, d, p * sieves.share) for name, t, d, p in reduction]
+    out = Inversion(*result, whole, rows, chi2, round_number, float(weight), resolution, inputs,
+                    None if sieve is None else (sieve.opening, sieve.passing))
+    out.notes.append(f"forward model: {resolution}; {round_number} round(s)")
+    out.notes.append(_inputs_line(test, inputs))
+    out.notes.append("measured 1: a reading's cut or a sieve; 0: between them, where the value and its band are those of "
+                     "the smoothest PSDs the data allow (a step there is not seen), or in a tail (basis), where the "
+                     "band covers every placement of the tail's mass the data allow")
+    if split is not None:
+        out.notes.append(f"specimen: the {sieves.share * 100:.4g} % passing {split * 1e3:g} mm; the curve is of the whole "
+                         "sample")
+    flagged = [r for r in rows if abs(r[4] - r[3]) > 4 * r[5]]
+    for name, t, opening, measured, modelled, s in flagged:
+        where = f"{opening * 1e3:g} mm" if name == "sieve" else f"{t / 60:g} min"
+        out.notes.append(f"{name} at {where} is {abs(modelled - measured) / s:.1f} noise units off the fit: check it")
+    if not out.consistent:
+        out.notes.append(f"{NOT_FITTING}: a misread, a flocculated sample, or a wrong specimen mass or particle density "
+                         "(check the readings named above)")
+    out.notes.append(out.verdict)
+    return out
+
+
+def _inputs_line(test: LabTest, inputs: dict) -> str:
+    """The test's values as the inverse used them, for the console."""
+    correction = "; ".join(f"{Path(k).name}: {v if isinstance(v, str) else f'{v:g} g/L'}"
+                           for k, v in inputs["composite_correction"].items()) or "none"
+    temperatures = inputs["temperatures_C"]
+    return (f"inputs: specimen {test.mass * 1e3:g} g, particle density {test.particle_density:g} kg/m3, cylinder "
+            f"{test.cylinder_area * 1e4:g} cm2 x {test.height * 100:g} cm, composite correction {correction}, meniscus "
+            f"{test.meniscus:g} g/L, water " + (f"{temperatures[0]:g}-{temperatures[1]:g} C" if temperatures else
+                                               "20 C (no temperature recorded)")
+            + f", largest grain {inputs['top_um']:g} um")
+
+
+def _whole_sample(grid: SizeGrid, specimen: np.ndarray, draws: np.ndarray, extremes: np.ndarray, sieves: SieveData,
+                  budget_band: float):
+    """The curve of the whole sample from the floor (the finest bin's lower end, 0 % by assumption) up: the
+    specimen's scaled by its share, the sieves above the split; the band the draws' central 95 % (in the
+    tails also the extreme placements), widened by the physics' budget."""
+    diameter, basis = np.concatenate([[grid.floor], grid.edges]), np.concatenate([["floor"], grid.basis])
+    percent = np.concatenate([[0.0], specimen]) * sieves.share
+    draws = np.concatenate([np.zeros((len(draws), 1)), draws], axis=1) * sieves.share
+    extremes = np.concatenate([np.zeros((len(extremes), 1)), extremes], axis=1) * sieves.share
+    whole = sieves.whole
+    if whole is not None and sieves.share < 1.0:
+        above = whole.opening > sieves.top * NEAR
+        noise = sieves.sigma[0] * sieves.share if len(sieves.sigma) else 0.5
+        diameter = np.concatenate([diameter, whole.opening[above]])
+        basis = np.concatenate([basis[:-1], ["sieve"], ["sieve"] * above.sum()])
+        percent = np.concatenate([percent, whole.passing[above]])
+        rng = np.random.default_rng(len(draws))
+        drawn = whole.passing[above] + rng.normal(0.0, noise, (len(draws), above.sum()))
+        draws = np.concatenate([draws, np.maximum(drawn, draws[:, -1:])], axis=1)
+    low, high = np.percentile(draws, [2.5, 97.5], axis=0) if len(draws) > 1 else (percent.copy(), percent.copy())
+    tails = np.flatnonzero(np.isin(basis, ("fine tail", "coarse tail")))
+    low[tails] = np.minimum(low[tails], extremes[:, tails].min(axis=0))
+    high[tails] = np.maximum(high[tails], extremes[:, tails].max(axis=0))
+    below = np.sqrt(np.maximum(percent - low, 0.0) ** 2 + budget_band ** 2)
+    above_band = np.sqrt(np.maximum(high - percent, 0.0) ** 2 + budget_band ** 2)
+    low, high = np.clip(percent - below, 0, 100), np.clip(percent + above_band, 0, 100)
+    top = basis == "top"      # 100 % by the sheet's own statement
+    low[top], high[top] = percent[top], percent[top]
+    # 0 % at the floor is the forward model's assumption: the data allow anything up to the first edge's
+    low[0], high[0] = 0.0, high[1]
+    return diameter, percent, low, high, basis, draws
+
+
+def first_guess(reduction, sieves: SieveData, grid: SizeGrid) -> np.ndarray:
+    """Bin shares from the standard reduction's points and the sieves (of the specimen), 100 % at the top,
+    interpolated in log d and made non-decreasing, mixed with a tenth of an even split so that every bin
+    has mass for the run to scale."""
+    d = np.concatenate([r[2] for r in reduction] + [sieves.opening, [sieves.top]])
+    p = np.concatenate([r[3] for r in reduction] + [sieves.percent, [100.0]])
+    order = np.argsort(d)
+    d, p = d[order], np.maximum.accumulate(np.clip(p[order], 0, 100))
+    at_edges = np.interp(np.log(grid.edges), np.log(d), p, left=p[0], right=100.0)
+    shares = np.maximum(np.diff(np.concatenate([[0.0], at_edges])) / 100.0, 0.0)
+    shares[-1] += max(1.0 - shares.sum(), 0.0)
+    return 0.9 * shares / shares.sum() + 0.1 / len(shares)
