@@ -248,14 +248,17 @@ def main() -> None:
 
 REPO = HERE.parent
 # What a user runs, in order: make demo's two commands (the planner, then the test of sample 5 with
-# its decision, on 2 ranks), and the README's inversion of the example sheets.
+# its decision, on 2 ranks), and the inversions of the example sheets (the README's: the soil).
 JOBS = [("the planner: sediment plan sample5 --jobs 2", ["bin/sediment", "plan", "examples/granulometry/psd/sample5.csv",
                                                          "--out", "{out}/plan", "--jobs", "2"]),
         ("the test: sample, run (2 ranks) and readout of sample 5 with the plan's decision",
          ["examples/granulometry/run.sh", "sample5", "{out}/sample5", "--plan", "{out}/plan/report.json"]),
         ("sediment invert of examples/inverse's three sheets",
          ["bin/sediment", "invert", "examples/inverse/hydrometer.csv", "examples/inverse/pipette.csv",
-          "examples/inverse/buoyancy.csv", "--mass", "0.06", "--out", "{out}/invert"])]
+          "examples/inverse/buoyancy.csv", "--mass", "0.06", "--out", "{out}/invert"]),
+        ("sediment invert of examples/inverse/soil's 152H and sieve sheets (the README's)",
+         ["bin/sediment", "invert", "examples/inverse/soil/hydrometer.csv", "examples/inverse/soil/sieve.csv",
+          "--mass", "0.05", "--out", "{out}/soil"])]
 
 
 def time_jobs() -> None:

@@ -59,7 +59,7 @@ def synthesise(psd_path: Path, folder: Path, soil: bool = False) -> list[Path]:
     # the run's water drifts as the laboratory's does: the inverse's mapping of the temperature record onto
     # one water is checked against a run in which the viscosity and density change with time
     scene.water_record = tuple((t, float(drift(t))) for t in (0.0, 1.05 * 86400))
-    write(scene, folder / "truth")
+    write(scene, folder / "truth", force=True)    # the script's own truth run: a new one replaces it
     run_batch(folder / "truth" / "in.sedimentation", {"overwrite": "yes"})
     column = Column.from_layers(read_layers(folder / "truth" / "layers.h5"))
     hydro = np.array(SCHEDULES["d7928"], float) * 60

@@ -287,7 +287,7 @@ def invert(sheets: list[Sheet], test: LabTest, folder: Path, *, sieve: SieveShee
         noisy = data + rng.normal(0.0, sigma) - rng.normal(0.0, test.thermometer) * per_degree
         x, _, _ = fit(jac, base, shares, noisy, sigma, grid, weight, rng.normal(0.0, 1.0, penalty_rows),
                       draw_placement(grid, rng))
-        specimen_draws.append(100 * np.cumsum(x))
+        specimen_draws.append(100 * np.cumsum(x) / x.sum())    # the top at 100 % exactly, as the sheet says
     # the tails' extreme placements the data allow: each tail's mass in its finest bin, then in its coarsest;
     # the band in a tail covers both
     extremes = []
@@ -295,7 +295,7 @@ def invert(sheets: list[Sheet], test: LabTest, folder: Path, *, sieve: SieveShee
         placement = {which: np.eye(max(len(grid.tail(which)), 1))[end][:len(grid.tail(which))]
                      for which in ("fine", "coarse")}
         x, _, _ = fit(jac, base, shares, data, sigma, grid, weight, None, placement)
-        extremes.append(100 * np.cumsum(x))
+        extremes.append(100 * np.cumsum(x) / x.sum())
     specimen = 100 * np.cumsum(shares)
     specimen[-1] = 100.0
     result = _whole_sample(grid, specimen, np.array(specimen_draws).reshape(-1, grid.bins), np.array(extremes), sieves,
