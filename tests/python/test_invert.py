@@ -328,3 +328,33 @@ def test_without_sieves_the_coarse_end_is_an_unknown_whose_band_holds_the_truth(
     held = (result.low - 0.05 <= truth) & (truth <= result.high + 0.05)
     assert held[coarse].all(), np.c_[result.diameter[coarse] * 1e6, result.low[coarse], truth[coarse], result.high[coarse]]
     assert np.all(result.high[coarse][-3:] - result.low[coarse][-3:] > 15)    # the placement is open, and says so
+
+
+def test_design_says_when_the_152h_reaches_the_clay_limit():
+    """A 2 um grain's Stokes time to the bulb's depth at the reading the PSD gives there: between 10 and 15 h
+    at 20 C for a 152H (Stokes depths 10-16 cm), shorter in warmer water by the viscosity's ratio."""
+    from sediment.inverse import clay_reading_time
+
+    times = dict(clay_reading_time(read_psd(EXAMPLE / "soils" / "clay_loam.csv"), LabTest(0.05)))
+    assert 10 * 3600 < times[20.0] < 15 * 3600
+    water = {t: Suspension.at_temperature(t).viscosity for t in (20.0, 25.0)}
+    assert times[25.0] / times[20.0] == pytest.approx(water[25.0] / water[20.0], rel=0.01)
+
+
+def test_sheets_no_psd_explains_are_fitted_as_well_as_they_can_be_and_marked_so(tmp_path, capsys):
+    """The soil's 152H sheet with a sieve sheet of another sample (40 % passing 75 um, where the hydrometer
+    reads 70 % finer at 46 um): exit 3, the verdict last and the sieve named, every table's first line
+    saying so, and its psd.csv refused as a PSD."""
+    from sediment.lab.psd import PSDError
+
+    sieve = _sheet(tmp_path, SIEVE + "2.0,100\n0.425,70\n0.15,50\n0.075,40\n", "other_sieve.csv")
+    out = tmp_path / "out"
+    code = cli.main(["invert", str(SOIL / "hydrometer.csv"), str(sieve), "--mass", "0.05", "--out", str(out)])
+    printed = capsys.readouterr().out.rstrip().splitlines()
+    assert code == 3 and printed[-1].startswith("verdict: NOT CONSISTENT")
+    assert any(line.startswith("sieve at 0.075 mm is") for line in printed)
+    for name in ("psd.csv", "texture.csv", "gradation.csv", "fit.csv", "reduction.csv"):
+        assert (out / name).read_text().startswith("# NOT CONSISTENT"), name
+    assert (out / "texture.png").stat().st_size > 0 and not json.loads((out / "invert.json").read_text())["consistent"]
+    with pytest.raises(PSDError, match="does not explain its sheets"):
+        read_psd(out / "psd.csv")

@@ -12,6 +12,9 @@ from .grid import SizeGrid
 
 SMOOTHNESS = np.geomspace(1e-6, 1e2, 17)    # penalty weights tried, largest that still fits the noise
 PLACEMENT_POINT = 1.0     # a tail bin's share off its prior by this many points costs one unit of chi-square
+# the band's draws take the smoothness weight log-uniform over this many decades below the chosen one: the
+# discrepancy principle picks the smoothest PSD that fits, and rougher ones fit the data as well
+ROUGHNESS_DECADES = 2.0
 TAIL_CONCENTRATION = 0.3  # the band's draws of a tail's placement: Dirichlet, mostly near one bin or another
 
 

@@ -15,7 +15,7 @@ from ..lab.psd import NOT_FITTING
 from ..lab.readout import Suspension
 from ..lab.sheet import Sheet, SieveSheet, SheetError, check_sheet, standard_reduction
 from ..results import Table, write_text
-from .fit import draw_placement, fit, penalty
+from .fit import ROUGHNESS_DECADES, draw_placement, fit, penalty
 from .grid import NEAR, TOP, SizeGrid, size_grid
 from .model import LabTest, cut_diameters, effective_times, linearise, psd_of, run_forward, solids_signal, \
     whole_sample_reading
@@ -102,7 +102,8 @@ class Inversion:
         written = [write_text(folder / "psd.csv", first + self.table().csv()),
                    write_text(folder / "reduction.csv", first + reduction.csv()),
                    write_text(folder / "fit.csv", first + fitted.csv())]
-        written += [write_text(path, first + path.read_text()) if first else path for path in report.save(folder)]
+        written += [write_text(path, first + path.read_text()) if first and path.suffix == ".csv" else path
+                    for path in report.save(folder)]
         written += [write_text(folder / "invert.json", json.dumps(summary, indent=1) + "\n"), self.plot(folder / "invert.png")]
         points = [(f"standard reduction ({name})", d, p) for name, _, d, p in self.reduction]
         written.append(texture.gradation_figure(folder / "gradation.png", self.diameter, self.percent, self.low,
@@ -277,15 +278,17 @@ def invert(sheets: list[Sheet], test: LabTest, folder: Path, *, sieve: SieveShee
     chi2 = float(np.sum(((base - data) / sigma) ** 2))
     # The band: draws of the PSDs the data allow, each fit again with the readings and sieves drawn from
     # their noise (and the forward model's), the thermometer's offset drawn, the smoothness penalty aiming
-    # at a draw of its prior and each tail's mass placed as drawn (randomise-then-optimise). An offset moves
-    # every reading's time alike; its effect on the readings is taken as linear (the record 1 C warmer).
+    # at a draw of its prior with a weight drawn below the chosen one, and each tail's mass placed as drawn
+    # (randomise-then-optimise). An offset moves every reading's time alike; its effect on the readings is
+    # taken as linear (the record 1 C warmer).
     per_degree = np.concatenate([run.readings(shares, sheets, warmer) - base[:readings], np.zeros(len(sieves.opening))])
     rng = np.random.default_rng(seed)
     penalty_rows = len(penalty(grid))
     specimen_draws = []
     for _ in range(draws):
         noisy = data + rng.normal(0.0, sigma) - rng.normal(0.0, test.thermometer) * per_degree
-        x, _, _ = fit(jac, base, shares, noisy, sigma, grid, weight, rng.normal(0.0, 1.0, penalty_rows),
+        x, _, _ = fit(jac, base, shares, noisy, sigma, grid, weight * 10 ** -rng.uniform(0, ROUGHNESS_DECADES),
+                      rng.normal(0.0, 1.0, penalty_rows),
                       draw_placement(grid, rng))
         specimen_draws.append(100 * np.cumsum(x) / x.sum())    # the top at 100 % exactly, as the sheet says
     # the tails' extreme placements the data allow: each tail's mass in its finest bin, then in its coarsest;
