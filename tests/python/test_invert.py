@@ -203,13 +203,16 @@ SIEVE = "opening_mm,percent_passing\n"
 
 
 @pytest.mark.parametrize("text, message", [
-    (SIEVE + "0.075,40\n0.15,45\n0.15,50\n", "appears twice"),
+    (SIEVE + "0.075,40\n0.15,45\n0.15,50\n", "opening 0.15 mm appears twice"),
     (SIEVE + "75,40\n150,60\n2000,100\n", "write the openings in millimetres"),
     (SIEVE + "0.075,0.4\n0.15,0.6\n2,1\n", "not fractions"),
     (SIEVE + "0.075,60\n0.15,55\n2,100\n", "more passes the 0.075 mm sieve"),
     (SIEVE + "0.075,-1\n2,100\n", "within 0-100"),
     ("time_min,reading,temperature_C,opening_mm,percent_passing\n1,40,20,2,100\n", "give each instrument a sheet"),
     (HYDROMETER.strip() + ",blank\n1,45,20,2\n2,40,20,\n", "no blank in row(s) 3"),
+    (HYDROMETER.strip() + ",Blank\n1,45,20,2\n2,40,20,2\n", "column(s) Blank are not of a hydrometer sheet"),
+    ("opening_mm;percent_passing\n0,075;40\n2;100\n", "separated by ';'"),
+    (SIEVE + "75,40\n106,60\n150,100\n", "the finest sieve is 75 mm"),
 ])
 def test_sieve_sheets_and_blank_columns_that_cannot_be_are_refused(tmp_path, text, message):
     with pytest.raises(SheetError, match=message.replace("(", r"\(").replace(")", r"\)")):
@@ -219,7 +222,8 @@ def test_sieve_sheets_and_blank_columns_that_cannot_be_are_refused(tmp_path, tex
 def test_a_sieve_sheet_is_read_in_any_order_and_a_blank_is_subtracted(tmp_path):
     from sediment.lab.sheet import SieveSheet
 
-    sieve = read_sheet(_sheet(tmp_path, "\ufeff" + SIEVE + "2.0,100\n0.425,80\n0.075,52.5\n", "s.csv"))
+    sieve = read_sheet(_sheet(tmp_path, "\ufeff" + SIEVE.replace("\n", ",\n") + "2.0,100,\n0.425,80,\n0.075,52.5,\n",
+                              "s.csv"))    # a spreadsheet's BOM and trailing empty column
     assert isinstance(sieve, SieveSheet)
     assert np.allclose(sieve.opening, [75e-6, 425e-6, 2e-3]) and list(sieve.passing) == [52.5, 80, 100]
     sheet = read_sheet(_sheet(tmp_path, HYDROMETER.strip() + ",blank\n1,45,20,2\n2,40,21,1.5\n", "h.csv"))
@@ -245,16 +249,22 @@ def test_what_the_sieves_say_of_the_specimen(tmp_path):
 
 
 @pytest.mark.parametrize("extra, message", [
-    ([], "--mass is required"),
-    (["--mass", "0.05", "--zero-correction", "2"], "the composite correction is given twice"),
-    (["SAME", "--mass", "0.05"], "are the same sheet"),
-    (["--mass", "0.05", "--split", "2"], "--split needs the sieve sheet"),
+    (["h.csv"], "--mass is required"),
+    (["h.csv", "--mass", "0.05", "--zero-correction", "2"], "the composite correction is given twice"),
+    (["h.csv", "copy.csv", "--mass", "0.05"], "hold the same readings"),
+    (["h.csv", "crlf.csv", "--mass", "0.05"], "hold the same readings"),
+    (["h.csv", "--mass", "0.05", "--split", "2"], "--split needs the sieve sheet"),
+    (["h.csv", "--mass", "0.05", "--particle-density", "1000"], "grains must be denser than water"),
+    (["big_blank.csv", "--mass", "0.05"], "is larger than the reading"),
 ])
 def test_what_the_command_refuses_to_guess(tmp_path, capsys, extra, message):
-    blank = _sheet(tmp_path, HYDROMETER.strip() + ",blank\n1,45,20,2\n2,40,20,2\n", "h.csv")
-    copy = _sheet(tmp_path, blank.read_text(), "copy.csv")
-    args = [str(copy) if a == "SAME" else a for a in extra]
-    code = cli.main(["invert", str(blank), *args, "--out", str(tmp_path / "out")])
+    sheet = HYDROMETER.strip() + ",blank\n1,45,20,2\n2,40,20,2\n"
+    _sheet(tmp_path, sheet, "h.csv")
+    _sheet(tmp_path, sheet, "copy.csv")
+    (tmp_path / "crlf.csv").write_bytes(sheet.replace("\n", "\r\n").encode())    # the same sheet saved on Windows
+    _sheet(tmp_path, HYDROMETER.strip() + ",blank\n1,45,20,2\n2,40,20,46\n", "big_blank.csv")
+    args = [str(tmp_path / a) if a.endswith(".csv") else a for a in extra]
+    code = cli.main(["invert", *args, "--out", str(tmp_path / "out")])
     assert code != 0 and message in capsys.readouterr().err
     assert not (tmp_path / "out" / "psd.csv").exists()
 
@@ -358,3 +368,13 @@ def test_sheets_no_psd_explains_are_fitted_as_well_as_they_can_be_and_marked_so(
     assert (out / "texture.png").stat().st_size > 0 and not json.loads((out / "invert.json").read_text())["consistent"]
     with pytest.raises(PSDError, match="does not explain its sheets"):
         read_psd(out / "psd.csv")
+
+
+def test_the_design_of_a_test_from_the_command_line(tmp_path, capsys):
+    """`invert --design` with one mass and few parcels: the table, the clay limit's time, the figure."""
+    out = tmp_path / "design"
+    code = cli.main(["invert", "--design", str(EXAMPLE / "soils" / "clay_loam.csv"), "--masses", "0.05", "--particles",
+                     "3000", "--out", str(out)])
+    printed = capsys.readouterr().out
+    assert code == 0 and "the 152H's cut reaches 2 um (clay) after: 18 C:" in printed
+    assert (out / "design.csv").read_text().startswith("design,mass_g,readings") and (out / "design.png").exists()

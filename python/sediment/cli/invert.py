@@ -79,13 +79,16 @@ def run(args: argparse.Namespace) -> int:
         raise ValueError("give the sheets of a sample, or --design PSD to plan a test (not both)")
     if args.design is None and args.mass is None:
         raise ValueError("--mass is required: the dry mass of the hydrometer's specimen [kg] (0.05 for 50 g)")
+    if args.particle_density <= 1000.0:
+        raise ValueError(f"--particle-density {args.particle_density:g} kg/m3: grains must be denser than water to "
+                         "settle (a soil's is about 2650; give kg/m3, not g/cm3)")
     noise = {"hydrometer": args.hydrometer_noise, "buoyancy": args.balance_noise,
              "pipette": args.pipette_noise / (args.pipette_volume * 1e3), "sieve": args.sieve_noise}
     test = LabTest(0.060 if args.mass is None else args.mass, args.particle_density, args.cylinder_area, args.height, zero_correction=args.zero_correction,
                    meniscus=args.meniscus, sphere_depth=args.sphere_depth, sphere_diameter=args.sphere_diameter,
                    sphere_mass=args.sphere_mass, noise=noise, thermometer=args.thermometer)
     sheets = [read_sheet(p, args.pipette_volume) for p in args.sheets]
-    _refuse_repeats(args.sheets)
+    _refuse_repeats(sheets)
     sieves = [s for s in sheets if s.instrument == "sieve"]
     if len(sieves) > 1:
         raise ValueError(f"two sieve sheets ({sieves[0].path}, {sieves[1].path}): give one sieve analysis per sample")
@@ -98,14 +101,17 @@ def run(args: argparse.Namespace) -> int:
         return _design(args, test) if args.design is not None else _invert(args, test, sheets)
 
 
-def _refuse_repeats(paths: list[Path]) -> None:
-    """The same sheet given twice would count its readings twice and narrow the band."""
-    seen: dict[bytes, Path] = {}
-    for path in paths:
-        content = path.read_bytes()
-        if content in seen:
-            raise ValueError(f"{path} and {seen[content]} are the same sheet: give each sheet once")
-        seen[content] = path
+def _refuse_repeats(sheets: list) -> None:
+    """The same sheet given twice (however saved) would count its readings twice and narrow the band."""
+    import numpy as np
+
+    seen: dict[tuple, Path] = {}
+    for sheet in sheets:
+        arrays = (sheet.opening, sheet.passing) if sheet.instrument == "sieve" else (sheet.time, sheet.reading, sheet.depth)
+        key = (sheet.instrument, *(tuple(np.round(a, 9)) for a in arrays))
+        if key in seen:
+            raise ValueError(f"{sheet.path} and {seen[key]} hold the same readings: give each sheet once")
+        seen[key] = sheet.path
 
 
 def _invert(args: argparse.Namespace, test, sheets) -> int:
@@ -138,9 +144,9 @@ def _design(args: argparse.Namespace, test) -> int:
     from ..lab.psd import read_psd
     from ..results import Table, write_text
 
+    psd = read_psd(args.design)
     rows = design_test(psd, args.out / "runs", masses=tuple(args.masses), test=test, bins=args.bins,
                        particles=args.particles, seed=args.seed)
-    psd = read_psd(args.design)
     clay = "; ".join(f"{celsius:g} C: {seconds / 3600:.3g} h" for celsius, seconds in clay_reading_time(psd, test))
     table = Table(["design", "mass_g", "readings", "mean_error_pp", "worst_error_pp"],
                   notes=[f"{args.design.name}: the recovered PSD's error at the bin edges, mean over noise draws; "

@@ -43,9 +43,9 @@ def even_placement(grid: SizeGrid, tail: np.ndarray) -> np.ndarray:
     return width / width.sum()
 
 
-def placement_rows(grid: SizeGrid, weights: dict[str, np.ndarray]) -> np.ndarray:
+def placement_rows(grid: SizeGrid, weights: dict[str, np.ndarray], strength: float = 1.0) -> np.ndarray:
     """Rows (x_k - w_k sum of the tail's x) for each tail of two bins or more, in units of
-    PLACEMENT_POINT: linear in the shares, so the tail's total stays free for the data to set."""
+    PLACEMENT_POINT / strength: linear in the shares, so the tail's total stays free for the data to set."""
     rows = []
     for which in ("fine", "coarse"):
         tail = grid.tail(which)
@@ -56,7 +56,7 @@ def placement_rows(grid: SizeGrid, weights: dict[str, np.ndarray]) -> np.ndarray
             row = np.zeros(grid.bins)
             row[tail] = -wk
             row[k] += 1.0
-            rows.append(100.0 / PLACEMENT_POINT * row)
+            rows.append(strength * 100.0 / PLACEMENT_POINT * row)
     return np.array(rows).reshape(-1, grid.bins)
 
 
@@ -69,7 +69,8 @@ def draw_placement(grid: SizeGrid, rng: np.random.Generator) -> dict[str, np.nda
 
 def fit(jacobian: np.ndarray, base: np.ndarray, shares0: np.ndarray, data: np.ndarray, sigma: np.ndarray,
         grid: SizeGrid, smoothness: float | None = None, prior_draw: np.ndarray | None = None,
-        placement: dict[str, np.ndarray] | None = None) -> tuple[np.ndarray, float, float]:
+        placement: dict[str, np.ndarray] | None = None, placement_strength: float = 1.0
+        ) -> tuple[np.ndarray, float, float]:
     """The shares that fit the linearised data, >= 0, summing to 1, with the largest smoothness penalty
     whose chi-square stays within the data's count (or the one given); returns the shares, the
     chi-square and the penalty weight.
@@ -77,7 +78,8 @@ def fit(jacobian: np.ndarray, base: np.ndarray, shares0: np.ndarray, data: np.nd
     With `prior_draw` (one standard normal number per penalty row) the penalty aims at it instead of
     zero, and with `placement` the tails' mass is spread as drawn: with data drawn from their noise, that
     makes the answer a draw of the PSDs the data and the priors allow (randomise-then-optimise). Without,
-    each tail's mass is spread evenly in log d."""
+    each tail's mass is spread evenly in log d. `placement_strength` scales the placement's rows (an
+    extreme placement held firmly, so that it is not a compromise with the data where they hardly see it)."""
     from scipy.optimize import lsq_linear
 
     n = len(shares0)
@@ -87,7 +89,7 @@ def fit(jacobian: np.ndarray, base: np.ndarray, shares0: np.ndarray, data: np.nd
     smooth = penalty(grid)
     if placement is None:
         placement = {which: even_placement(grid, grid.tail(which)) for which in ("fine", "coarse")}
-    tails = placement_rows(grid, placement)
+    tails = placement_rows(grid, placement, placement_strength)
 
     def solve(weight: float) -> tuple[np.ndarray, float]:
         matrix = np.vstack([a, total, math.sqrt(weight) * smooth * n, tails])

@@ -21,6 +21,7 @@ from .model import LabTest, cut_diameters, effective_times, linearise, psd_of, r
     whole_sample_reading
 
 CONVERGED = 0.2           # points of percent finer between rounds
+EXTREME_PLACEMENT = 100.0  # the tails' extreme placements: 0.01 point off costs a unit of chi-square
 
 
 @dataclass
@@ -102,12 +103,14 @@ class Inversion:
         written = [write_text(folder / "psd.csv", first + self.table().csv()),
                    write_text(folder / "reduction.csv", first + reduction.csv()),
                    write_text(folder / "fit.csv", first + fitted.csv())]
+        mark = "" if self.consistent else f" ({NOT_FITTING}: no PSD explains the sheets)"
         written += [write_text(path, first + path.read_text()) if first and path.suffix == ".csv" else path
-                    for path in report.save(folder)]
+                    for path in report.save(folder, mark)]
         written += [write_text(folder / "invert.json", json.dumps(summary, indent=1) + "\n"), self.plot(folder / "invert.png")]
         points = [(f"standard reduction ({name})", d, p) for name, _, d, p in self.reduction]
         written.append(texture.gradation_figure(folder / "gradation.png", self.diameter, self.percent, self.low,
-                                                self.high, self.sieve, points))
+                                                self.high, self.sieve, points, title="gradation" + mark))
+
         return written
 
     def plot(self, path: Path) -> Path:
@@ -220,6 +223,13 @@ def invert(sheets: list[Sheet], test: LabTest, folder: Path, *, sieve: SieveShee
     c0 = test.initial_concentration
     signals = [solids_signal(sheet, test, water) for sheet in sheets]
     corrected = [test.corrected(sheet) for sheet in sheets]
+    for sheet, reading in zip(sheets, corrected):
+        below = np.flatnonzero(reading < -2 * test.noise[sheet.instrument]) if sheet.instrument == "hydrometer" else []
+        if len(below):
+            k = below[0]
+            raise SheetError(f"{sheet.label}: the reading at {sheet.time[k] / 60:g} min is {reading[k]:.3g} g/L after "
+                             "its composite correction: the correction (blank or --zero-correction) is larger than the "
+                             "reading; check both")
     for sheet, reading, signal in zip(sheets, corrected, signals):
         # the tolerance: twice the reading's noise, and 2 % of the solids' signal for the sampling of a real
         # suspension (a pipette's first samples can draw a little more than the mean)
@@ -247,7 +257,7 @@ def invert(sheets: list[Sheet], test: LabTest, folder: Path, *, sieve: SieveShee
         base, jac = linearise(run, x, sheets, at)
         return np.concatenate([base, sieve_rows @ x]), np.vstack([jac, sieve_rows])
 
-    previous, weight, reading_sigma = None, None, sigma
+    previous, weight, reading_sigma, converged = None, None, sigma, False
     for round_number in range(1, rounds + 1):
         # every bin keeps some mass in the run, so that its columns can be scaled to any share
         spread = 0.8 * shares + 0.2 / len(shares)
@@ -272,6 +282,7 @@ def invert(sheets: list[Sheet], test: LabTest, folder: Path, *, sieve: SieveShee
             shares, chi2, weight = fit(jac, base, shares, data, sigma, grid)
         percent = 100 * np.cumsum(shares)[:-1]
         if previous is not None and np.max(np.abs(percent - previous)) < CONVERGED:
+            converged = True
             break
         previous = percent
     base, jac = model(run, shares)
@@ -297,7 +308,7 @@ def invert(sheets: list[Sheet], test: LabTest, folder: Path, *, sieve: SieveShee
     for end in (0, -1):
         placement = {which: np.eye(max(len(grid.tail(which)), 1))[end][:len(grid.tail(which))]
                      for which in ("fine", "coarse")}
-        x, _, _ = fit(jac, base, shares, data, sigma, grid, weight, None, placement)
+        x, _, _ = fit(jac, base, shares, data, sigma, grid, weight, None, placement, EXTREME_PLACEMENT)
         extremes.append(100 * np.cumsum(x) / x.sum())
     specimen = 100 * np.cumsum(shares)
     specimen[-1] = 100.0
@@ -324,7 +335,12 @@ def invert(sheets: list[Sheet], test: LabTest, folder: Path, *, sieve: SieveShee
     whole = [(name, t, d, p * sieves.share) for name, t, d, p in reduction]
     out = Inversion(*result, whole, rows, chi2, round_number, float(weight), resolution, inputs,
                     None if sieve is None else (sieve.opening, sieve.passing))
-    out.notes.append(f"forward model: {resolution}; {round_number} round(s)")
+    out.notes.append(f"forward model: {resolution}; {round_number} round(s)" + (
+        "" if converged else f", not converged: the last round moved the PSD by more than {CONVERGED:g} points (more "
+                             "--particles steady the runs)"))
+    step = _sieves_step(grid, shares, sieves)
+    if step is not None:
+        out.notes.append(step)
     out.notes.append(_inputs_line(test, inputs))
     out.notes.append("measured 1: a reading's cut or a sieve; 0: between them, where the value and its band are those of "
                      "the smoothest PSDs the data allow (a step there is not seen), or in a tail (basis), where the "
@@ -341,6 +357,25 @@ def invert(sheets: list[Sheet], test: LabTest, folder: Path, *, sieve: SieveShee
                          "(check the readings named above)")
     out.notes.append(out.verdict)
     return out
+
+
+STEP_WARNING = 15.0        # points between the coarsest cut and the next sieve that deserve a second look
+
+
+def _sieves_step(grid: SizeGrid, shares: np.ndarray, sieves: SieveData) -> str | None:
+    """A note where the readings and the sieves meet with a step: a real gap in the grading, or a wrong
+    --mass or another sample's sieve sheet, which such a step can absorb and still fit."""
+    cut = np.flatnonzero(grid.basis == "reading")[-1]
+    above = np.flatnonzero((grid.basis == "sieve") & (np.arange(grid.bins) > cut))
+    if not len(above):
+        return None
+    cumulative = 100 * np.cumsum(shares)
+    rise = cumulative[above[0]] - cumulative[cut]
+    if rise < STEP_WARNING:
+        return None
+    return (f"check: the curve rises by {rise:.3g} points between the coarsest reading's cut ({grid.edges[cut] * 1e6:.3g} "
+            f"um) and the {grid.edges[above[0]] * 1e3:g} mm sieve: a gap in the grading, or a wrong --mass or a sieve "
+            "sheet of another sample, which a step there absorbs")
 
 
 def _inputs_line(test: LabTest, inputs: dict) -> str:

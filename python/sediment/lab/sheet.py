@@ -31,6 +31,7 @@ KINDS = {
     "buoyancy": ("time_min", "apparent_mass_g"),
     "sieve": ("opening_mm", "percent_passing"),
 }
+OPTIONAL = {"hydrometer": ("blank",), "pipette": ("temperature_C",), "buoyancy": ("temperature_C",), "sieve": ()}
 
 
 class SheetError(ValueError):
@@ -84,6 +85,11 @@ def read_sheet(path: str | Path, pipette_volume: float = 25e-6) -> Sheet | Sieve
         raise SheetError(f"{path}: the header has the columns of {' and '.join(kinds)} sheets: give each instrument "
                          "a sheet of its own")
     kind = kinds[0]
+    unknown = [name for name in header if name not in KINDS[kind] + OPTIONAL[kind]]
+    if unknown:
+        known = ", ".join(KINDS[kind] + OPTIONAL[kind])
+        raise SheetError(f"{path}: column(s) {', '.join(unknown)} are not of a {kind} sheet (its columns: {known}): "
+                         "rename or remove them, as a misspelt column would be left out silently")
     if not rows:
         raise SheetError(f"{path}: no readings below the header")
     values: dict[str, list[float]] = {name: [] for name in header}
@@ -145,8 +151,12 @@ def _sieve_sheet(path: Path, opening_mm: np.ndarray, passing: np.ndarray) -> Sie
     if opening_mm.max() > 200:
         raise SheetError(f"{path}: a sieve opening of {opening_mm.max():g} mm: write the openings in millimetres "
                          "(0.075 for the 75 um sieve)")
-    if len(np.unique(opening_mm)) != len(opening_mm):
-        raise SheetError(f"{path}: a sieve opening appears twice")
+    if opening_mm.min() >= 20:
+        raise SheetError(f"{path}: the finest sieve is {opening_mm.min():g} mm: write the openings in millimetres (0.075 "
+                         "for the 75 um sieve), not micrometres")
+    values, counts = np.unique(opening_mm, return_counts=True)
+    if np.any(counts > 1):
+        raise SheetError(f"{path}: the sieve opening {values[counts > 1][0]:g} mm appears twice")
     if np.any((passing < 0) | (passing > 100)):
         raise SheetError(f"{path}: percent passing must be within 0-100 (of the whole dry sample)")
     if passing.max() <= 1.0:
@@ -170,6 +180,12 @@ def _table(path: Path) -> tuple[list[str], list[list[str]]]:
         raise SheetError(f"{path}: not a text CSV ({exc.reason})") from None
     if not rows:
         raise SheetError(f"{path}: empty sheet")
+    if len(rows[0]) == 1 and ";" in rows[0][0]:
+        raise SheetError(f"{path}: the columns are separated by ';' (a spreadsheet's export with decimal commas): save "
+                         "it as CSV with ',' between columns and '.' as the decimal point")
+    # a spreadsheet's trailing empty column: left out where the header names none
+    while len(rows[0]) > 1 and not rows[0][-1].strip() and all(len(r) == len(rows[0]) and not r[-1].strip() for r in rows):
+        rows = [r[:-1] for r in rows]
     header = [h.strip() for h in rows[0]]
     for number, row in enumerate(rows[1:], start=2):
         if len(row) != len(header):

@@ -337,14 +337,14 @@ class TextureReport:
                               for name, value in self.gradation.items()},
                 "gradation_notes": self.gradation_table().notes}
 
-    def save(self, folder: Path) -> list[Path]:
+    def save(self, folder: Path, mark: str = "") -> list[Path]:
         """Writes texture.csv, gradation.csv (its notes as ``#`` lines at the end) and texture.png (the USDA
-        triangle) into `folder`; returns their paths."""
+        triangle, `mark` added to its title) into `folder`; returns their paths."""
         folder = Path(folder)
         gradation = self.gradation_table()
         return [write_text(folder / "texture.csv", self.texture_table().csv()),
                 write_text(folder / "gradation.csv", gradation.csv() + "".join(f"# {n}\n" for n in gradation.notes)),
-                texture_triangle(folder / "texture.png", self)]
+                texture_triangle(folder / "texture.png", self, title="USDA texture" + mark)]
 
 
 def _why_not_reached(diameter: np.ndarray, percent: np.ndarray, level: float) -> str:
