@@ -42,6 +42,7 @@ class SizeGrid:
 
     @property
     def bins(self) -> int:
+        """How many bins: one below each edge."""
         return len(self.edges)
 
     @property

@@ -62,6 +62,7 @@ class Inversion:
 
     @property
     def verdict(self) -> str:
+        """The console's last line: whether a PSD explains the sheets."""
         if self.consistent:
             return f"verdict: fits (chi-square per reading {self.reduced_chi2:.3g})"
         return (f"verdict: {NOT_FITTING}: chi-square per reading {self.reduced_chi2:.3g} (>= 4): no PSD of this sample "
@@ -153,6 +154,7 @@ class SieveData:
     top: float                   # the specimen's largest grain [m]
     share: float                 # of the whole sample in the specimen (1 without a split)
     whole: SieveSheet | None
+    noise: float = 0.5           # of a sieve's percent passing [points]
 
 
 def sieve_data(sieve: SieveSheet | None, split: float | None, noise: float) -> SieveData:
@@ -163,7 +165,7 @@ def sieve_data(sieve: SieveSheet | None, split: float | None, noise: float) -> S
         if split is not None:
             raise ValueError("--split needs the sieve sheet: the percent passing the split sieve sets the specimen's "
                              "share of the sample")
-        return SieveData(np.empty(0), np.empty(0), np.empty(0), TOP, 1.0, None)
+        return SieveData(np.empty(0), np.empty(0), np.empty(0), TOP, 1.0, None, noise)
     if split is not None:
         at = np.flatnonzero(np.abs(np.log(sieve.opening / split)) < math.log(NEAR))
         if not len(at):
@@ -183,7 +185,7 @@ def sieve_data(sieve: SieveSheet | None, split: float | None, noise: float) -> S
         share, top = 1.0, sieve.opening[whole[0]]
     below = sieve.opening < top / NEAR
     return SieveData(sieve.opening[below], sieve.passing[below] / share, np.full(below.sum(), noise / share), top,
-                     share, sieve)
+                     share, sieve, noise)
 
 
 def invert(sheets: list[Sheet], test: LabTest, folder: Path, *, sieve: SieveSheet | None = None,
@@ -338,6 +340,11 @@ def invert(sheets: list[Sheet], test: LabTest, folder: Path, *, sieve: SieveShee
     out.notes.append(f"forward model: {resolution}; {round_number} round(s)" + (
         "" if converged else f", not converged: the last round moved the PSD by more than {CONVERGED:g} points (more "
                              "--particles steady the runs)"))
+    in_tails = [f"D{level}" for level in (10, 30, 50, 60)
+                if _in_tail(out.diameter, out.percent, out.basis, level)]
+    if in_tails:
+        out.notes.append(f"{', '.join(in_tails)} lie(s) in a tail, where the data give the mass but not its placement: "
+                         "read them with their band")
     step = _sieves_step(grid, shares, sieves)
     if step is not None:
         out.notes.append(step)
@@ -359,6 +366,13 @@ def invert(sheets: list[Sheet], test: LabTest, folder: Path, *, sieve: SieveShee
     return out
 
 
+def _in_tail(diameter: np.ndarray, percent: np.ndarray, basis: np.ndarray, level: float) -> bool:
+    """Whether the curve reaches `level` percent finer within a tail (or below the floor's edge)."""
+    k = int(np.argmax(percent >= level))
+    return percent[k] >= level and basis[k] in ("fine tail", "coarse tail", "floor")
+
+
+NOISE_UNITS = {"hydrometer": "g/L", "pipette": "g/L", "buoyancy": "g", "sieve": "points"}
 STEP_WARNING = 15.0        # points between the coarsest cut and the next sieve that deserve a second look
 
 
@@ -387,7 +401,12 @@ def _inputs_line(test: LabTest, inputs: dict) -> str:
             f"{test.cylinder_area * 1e4:g} cm2 x {test.height * 100:g} cm, composite correction {correction}, meniscus "
             f"{test.meniscus:g} g/L, water " + (f"{temperatures[0]:g}-{temperatures[1]:g} C" if temperatures else
                                                "20 C (no temperature recorded)")
-            + f", largest grain {inputs['top_um']:g} um")
+            + f", the specimen's largest grain {inputs['top_um']:g} um"
+            + (f" (the part passing {inputs['split_mm']:g} mm, {100 * inputs['specimen_share']:.4g} % of the sample)"
+               if inputs["split_mm"] else "")
+            + "; noise: " + ", ".join(f"{k} {v:g} {NOISE_UNITS[k]}" for k, v in test.noise.items())
+            + f", thermometer {test.thermometer:g} C"
+            + "; sheets: " + ", ".join(Path(s).name for s in inputs["sheets"]))
 
 
 def _whole_sample(grid: SizeGrid, specimen: np.ndarray, draws: np.ndarray, extremes: np.ndarray, sieves: SieveData,
@@ -397,18 +416,20 @@ def _whole_sample(grid: SizeGrid, specimen: np.ndarray, draws: np.ndarray, extre
     tails also the extreme placements), widened by the physics' budget."""
     diameter, basis = np.concatenate([[grid.floor], grid.edges]), np.concatenate([["floor"], grid.basis])
     percent = np.concatenate([[0.0], specimen]) * sieves.share
-    draws = np.concatenate([np.zeros((len(draws), 1)), draws], axis=1) * sieves.share
+    rng = np.random.default_rng(len(draws))
+    # each draw's share of the specimen in the sample, from the split sieve's own noise
+    shares = np.clip(sieves.share + rng.normal(0.0, sieves.noise / 100, len(draws)), 0.0, 1.0) \
+        if sieves.share < 1.0 else np.ones(len(draws))
+    draws = np.concatenate([np.zeros((len(draws), 1)), draws], axis=1) * shares[:, None]
     extremes = np.concatenate([np.zeros((len(extremes), 1)), extremes], axis=1) * sieves.share
     whole = sieves.whole
     if whole is not None and sieves.share < 1.0:
         above = whole.opening > sieves.top * NEAR
-        noise = sieves.sigma[0] * sieves.share if len(sieves.sigma) else 0.5
         diameter = np.concatenate([diameter, whole.opening[above]])
         basis = np.concatenate([basis[:-1], ["sieve"], ["sieve"] * above.sum()])
         percent = np.concatenate([percent, whole.passing[above]])
-        rng = np.random.default_rng(len(draws))
-        drawn = whole.passing[above] + rng.normal(0.0, noise, (len(draws), above.sum()))
-        draws = np.concatenate([draws, np.maximum(drawn, draws[:, -1:])], axis=1)
+        drawn = whole.passing[above] + rng.normal(0.0, sieves.noise, (len(draws), above.sum()))
+        draws = np.concatenate([draws, np.clip(np.maximum(drawn, draws[:, -1:]), 0.0, 100.0)], axis=1)
     low, high = np.percentile(draws, [2.5, 97.5], axis=0) if len(draws) > 1 else (percent.copy(), percent.copy())
     tails = np.flatnonzero(np.isin(basis, ("fine tail", "coarse tail")))
     low[tails] = np.minimum(low[tails], extremes[:, tails].min(axis=0))

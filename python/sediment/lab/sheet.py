@@ -70,6 +70,7 @@ class SieveSheet:
 
     @property
     def label(self) -> str:
+        """The sheet's file, as messages name it."""
         return f"{self.path.name} (sieve)"
 
 

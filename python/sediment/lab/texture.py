@@ -127,7 +127,8 @@ def fractions(diameter, percent, system: str) -> dict[str, np.ndarray]:
         scale = np.where(below > 0, 100.0 / np.where(below > 0, below, 1.0), np.nan)
         out = {name: value * scale for name, value in out.items()}
     # interpolation leaves -1e-14 in an empty fraction
-    return {name: np.clip(value, 0.0, 100.0) for name, value in out.items()}
+    # rounding leaves 1e-14 where a fraction is empty: 0 there
+    return {name: np.clip(np.where(np.abs(value) < 1e-9, 0.0, value), 0.0, 100.0) for name, value in out.items()}
 
 
 def _usda_rules(clay, silt, sand) -> list[np.ndarray]:
