@@ -225,14 +225,13 @@ def invert(sheets: list[Sheet], test: LabTest, folder: Path, *, sieve: SieveShee
     c0 = test.initial_concentration
     signals = [solids_signal(sheet, test, water) for sheet in sheets]
     corrected = [test.corrected(sheet) for sheet in sheets]
-    for sheet, reading in zip(sheets, corrected):
+    for sheet, reading, signal in zip(sheets, corrected, signals):
         below = np.flatnonzero(reading < -2 * test.noise[sheet.instrument]) if sheet.instrument == "hydrometer" else []
         if len(below):
             k = below[0]
             raise SheetError(f"{sheet.label}: the reading at {sheet.time[k] / 60:g} min is {reading[k]:.3g} g/L after "
                              "its composite correction: the correction (blank or --zero-correction) is larger than the "
                              "reading; check both")
-    for sheet, reading, signal in zip(sheets, corrected, signals):
         # the tolerance: twice the reading's noise, and 2 % of the solids' signal for the sampling of a real
         # suspension (a pipette's first samples can draw a little more than the mean)
         check_sheet(replace(sheet, reading=reading), whole_sample_reading(sheet, test, water),
