@@ -67,6 +67,16 @@ def draw_placement(grid: SizeGrid, rng: np.random.Generator) -> dict[str, np.nda
             else np.ones(len(grid.tail(which))) for which in ("fine", "coarse")}
 
 
+def end_placement(grid: SizeGrid, end: int) -> dict[str, np.ndarray]:
+    """Each tail's mass all in one of its ends: its finest bin (`end` 0) or its coarsest (-1)."""
+    placement = {}
+    for which in ("fine", "coarse"):
+        weights = np.zeros(len(grid.tail(which)))
+        weights[end] = 1.0
+        placement[which] = weights
+    return placement
+
+
 def fit(jacobian: np.ndarray, base: np.ndarray, shares0: np.ndarray, data: np.ndarray, sigma: np.ndarray,
         grid: SizeGrid, smoothness: float | None = None, prior_draw: np.ndarray | None = None,
         placement: dict[str, np.ndarray] | None = None, placement_strength: float = 1.0

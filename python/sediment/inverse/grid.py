@@ -55,17 +55,21 @@ class SizeGrid:
         """Edges a reading or a sieve constrains."""
         return np.isin(self.basis, ("reading", "sieve"))
 
+    def _pinned_edges(self) -> np.ndarray:
+        """Indices of the pinned edges below the top."""
+        return np.flatnonzero(self.pinned[:-1])
+
     def tail(self, which: str) -> np.ndarray:
         """Indices of the bins of the coarse or fine tail (the bins whose upper edge is in it, and for
         the coarse tail the top bin above it)."""
-        pinned = np.flatnonzero(self.pinned[:-1])
+        pinned = self._pinned_edges()
         if which == "fine":
             return np.arange(pinned[0] + 1)
         return np.arange(pinned[-1] + 1, self.bins)
 
     def smooth(self) -> np.ndarray:
         """Indices of the bins between the finest and the coarsest pinned edge: the smoothness penalty's."""
-        pinned = np.flatnonzero(self.pinned[:-1])
+        pinned = self._pinned_edges()
         return np.arange(pinned[0] + 1, pinned[-1] + 1)
 
     def cumulative(self, diameters: np.ndarray) -> np.ndarray:

@@ -15,7 +15,7 @@ from ..lab.psd import NOT_FITTING
 from ..lab.readout import Suspension
 from ..lab.sheet import Sheet, SieveSheet, SheetError, check_sheet, standard_reduction
 from ..results import Table, write_text
-from .fit import ROUGHNESS_DECADES, draw_placement, fit, penalty
+from .fit import ROUGHNESS_DECADES, draw_placement, end_placement, fit, penalty
 from .grid import NEAR, TOP, SizeGrid, size_grid
 from .model import LabTest, cut_diameters, effective_times, linearise, psd_of, run_forward, solids_signal, \
     whole_sample_reading
@@ -111,7 +111,6 @@ class Inversion:
         points = [(f"standard reduction ({name})", d, p) for name, _, d, p in self.reduction]
         written.append(texture.gradation_figure(folder / "gradation.png", self.diameter, self.percent, self.low,
                                                 self.high, self.sieve, points, title="gradation" + mark))
-
         return written
 
     def plot(self, path: Path) -> Path:
@@ -150,11 +149,15 @@ class SieveData:
 
     opening: np.ndarray
     percent: np.ndarray          # of the specimen
-    sigma: np.ndarray
     top: float                   # the specimen's largest grain [m]
     share: float                 # of the whole sample in the specimen (1 without a split)
     whole: SieveSheet | None
-    noise: float = 0.5           # of a sieve's percent passing [points]
+    noise: float                 # of a sieve's percent passing [points of the whole sample]
+
+    @property
+    def sigma(self) -> np.ndarray:
+        """Each sieve's noise in points of the specimen."""
+        return np.full(len(self.opening), self.noise / self.share)
 
 
 def sieve_data(sieve: SieveSheet | None, split: float | None, noise: float) -> SieveData:
@@ -165,7 +168,7 @@ def sieve_data(sieve: SieveSheet | None, split: float | None, noise: float) -> S
         if split is not None:
             raise ValueError("--split needs the sieve sheet: the percent passing the split sieve sets the specimen's "
                              "share of the sample")
-        return SieveData(np.empty(0), np.empty(0), np.empty(0), TOP, 1.0, None, noise)
+        return SieveData(np.empty(0), np.empty(0), TOP, 1.0, None, noise)
     if split is not None:
         at = np.flatnonzero(np.abs(np.log(sieve.opening / split)) < math.log(NEAR))
         if not len(at):
@@ -184,8 +187,7 @@ def sieve_data(sieve: SieveSheet | None, split: float | None, noise: float) -> S
                              "part passing one sieve")
         share, top = 1.0, sieve.opening[whole[0]]
     below = sieve.opening < top / NEAR
-    return SieveData(sieve.opening[below], sieve.passing[below] / share, np.full(below.sum(), noise / share), top,
-                     share, sieve, noise)
+    return SieveData(sieve.opening[below], sieve.passing[below] / share, top, share, sieve, noise)
 
 
 def invert(sheets: list[Sheet], test: LabTest, folder: Path, *, sieve: SieveSheet | None = None,
@@ -247,8 +249,11 @@ def invert(sheets: list[Sheet], test: LabTest, folder: Path, *, sieve: SieveShee
     shares = first_guess(reduction, sieves, grid)
     sieve_rows = 100.0 * grid.cumulative(sieves.opening)
     data = np.concatenate(corrected + [sieves.percent])
-    readings = len(data) - len(sieves.opening)
     sigma = np.concatenate([np.full(len(s.time), test.noise[s.instrument]) for s in sheets] + [sieves.sigma])
+    # each sheet's rows among the data (the sieves' after them)
+    ends = np.cumsum([0] + [len(s.time) for s in sheets])
+    rows_of = [slice(a, b) for a, b in zip(ends[:-1], ends[1:])]
+    readings = int(ends[-1])
     # the readings' times in water 1 C warmer: the runs reach the latest, and the band's thermometer
     # offset (below) is linear in the readings there
     warmer = [effective_times(s, water, 1.0) for s in sheets]
@@ -270,13 +275,10 @@ def invert(sheets: list[Sheet], test: LabTest, folder: Path, *, sieve: SieveShee
             other = run_forward(psd_of(spread, grid), grid, test, water, t_end, folder / "sampling", particles,
                                 courant, seed + 1)
             gap = run.readings(shares, sheets, times) - other.readings(shares, sheets, times)
-            start = 0
             model_sigma = np.zeros(len(data))
-            for sheet, signal in zip(sheets, signals):
-                n = len(sheet.time)
+            for rows, signal in zip(rows_of, signals):
                 # and at least the resolution's 0.2 points of percent finer (the time step's, error budget)
-                model_sigma[start:start + n] = max(math.sqrt(np.mean(gap[start:start + n] ** 2) / 2), 0.002 * signal)
-                start += n
+                model_sigma[rows] = max(math.sqrt(np.mean(gap[rows] ** 2) / 2), 0.002 * signal)
             sigma = np.sqrt(reading_sigma ** 2 + model_sigma ** 2)
         for _ in range(2):    # Gauss-Newton on this run's columns
             base, jac = model(run, shares)
@@ -307,23 +309,18 @@ def invert(sheets: list[Sheet], test: LabTest, folder: Path, *, sieve: SieveShee
     # the band in a tail covers both
     extremes = []
     for end in (0, -1):
-        placement = {which: np.eye(max(len(grid.tail(which)), 1))[end][:len(grid.tail(which))]
-                     for which in ("fine", "coarse")}
-        x, _, _ = fit(jac, base, shares, data, sigma, grid, weight, None, placement, EXTREME_PLACEMENT)
+        x, _, _ = fit(jac, base, shares, data, sigma, grid, weight, None, end_placement(grid, end), EXTREME_PLACEMENT)
         extremes.append(100 * np.cumsum(x) / x.sum())
     specimen = 100 * np.cumsum(shares)
     specimen[-1] = 100.0
     result = _whole_sample(grid, specimen, np.array(specimen_draws).reshape(-1, grid.bins), np.array(extremes), sieves,
-                           budget_band)
+                           budget_band, rng)
     rows = []
-    start = 0
-    for sheet in sheets:
-        n = len(sheet.time)
+    for sheet, at in zip(sheets, rows_of):
         rows += [(sheet.instrument, float(t), math.nan, float(m), float(f), float(s))
-                 for t, m, f, s in zip(sheet.time, data[start:start + n], base[start:start + n], sigma[start:start + n])]
-        start += n
+                 for t, m, f, s in zip(sheet.time, data[at], base[at], sigma[at])]
     rows += [("sieve", math.nan, float(o), float(m), float(f), float(s))
-             for o, m, f, s in zip(sieves.opening, data[start:], base[start:], sigma[start:])]
+             for o, m, f, s in zip(sieves.opening, data[readings:], base[readings:], sigma[readings:])]
     resolution = (f"{particles} parcels, Courant {courant:g}, standard drag curve + Richardson & Zaki, water at "
                   f"{mean_temperature:.3g} C")
     inputs = test.record() | {
@@ -339,8 +336,7 @@ def invert(sheets: list[Sheet], test: LabTest, folder: Path, *, sieve: SieveShee
     out.notes.append(f"forward model: {resolution}; {round_number} round(s)" + (
         "" if converged else f", not converged: the last round moved the PSD by more than {CONVERGED:g} points (more "
                              "--particles steady the runs)"))
-    in_tails = [f"D{level}" for level in (10, 30, 50, 60)
-                if _in_tail(out.diameter, out.percent, out.basis, level)]
+    in_tails = [f"D{level}" for level in texture.LEVELS if _in_tail(out.diameter, out.percent, out.basis, level)]
     if in_tails:
         out.notes.append(f"{', '.join(in_tails)} lie(s) in a tail, where the data give the mass but not its placement: "
                          "read them with their band")
@@ -409,13 +405,12 @@ def _inputs_line(test: LabTest, inputs: dict) -> str:
 
 
 def _whole_sample(grid: SizeGrid, specimen: np.ndarray, draws: np.ndarray, extremes: np.ndarray, sieves: SieveData,
-                  budget_band: float):
+                  budget_band: float, rng: np.random.Generator):
     """The curve of the whole sample from the floor (the finest bin's lower end, 0 % by assumption) up: the
     specimen's scaled by its share, the sieves above the split; the band the draws' central 95 % (in the
     tails also the extreme placements), widened by the physics' budget."""
     diameter, basis = np.concatenate([[grid.floor], grid.edges]), np.concatenate([["floor"], grid.basis])
     percent = np.concatenate([[0.0], specimen]) * sieves.share
-    rng = np.random.default_rng(len(draws))
     # each draw's share of the specimen in the sample, from the split sieve's own noise
     shares = np.clip(sieves.share + rng.normal(0.0, sieves.noise / 100, len(draws)), 0.0, 1.0) \
         if sieves.share < 1.0 else np.ones(len(draws))
