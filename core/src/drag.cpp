@@ -25,6 +25,7 @@ constexpr Named<DragLaw> law_names[] = {
     {DragLaw::ZhangLiSmooth, "zhang-li/smooth"},
     {DragLaw::DiFelice, "difelice"},
     {DragLaw::Standard, "standard"},
+    {DragLaw::Bingham, "bingham"},
 };
 
 constexpr Named<Hindrance> hindrance_names_table[] = {
@@ -72,20 +73,24 @@ bool law_takes_hindrance(DragLaw law, Hindrance hindrance)
 {
   if (hindrance == Hindrance::None) return true;
   if (law == DragLaw::DiFelice) return hindrance == Hindrance::DiFelice;
-  if (law == DragLaw::ZhangLi || law == DragLaw::ZhangLiSmooth) return false;
+  if (law == DragLaw::ZhangLi || law == DragLaw::ZhangLiSmooth || law == DragLaw::Bingham) return false;
   return law != DragLaw::SchillerNaumann || hindrance == Hindrance::DiFelice;
 }
 
 double drag_coefficient(DragLaw law, double re) { return drag_curve(law, re).g / re; }
 
-DragModel::DragModel(DragLaw law, const Fluid &fluid, HindranceBuoyancy buoyancy, Hindrance hindrance) :
-    law_(law), single_law_(law == DragLaw::DiFelice ? DragLaw::Dallavalle : law),
+DragModel::DragModel(DragLaw law, const Fluid &fluid, HindranceBuoyancy buoyancy, Hindrance hindrance,
+                     bingham_law::Constants bingham) :
+    law_(law),
+    single_law_(law == DragLaw::DiFelice ? DragLaw::Dallavalle : law == DragLaw::Bingham ? DragLaw::Standard : law),
     hindrance_(law == DragLaw::DiFelice ? Hindrance::DiFelice : hindrance),
     exponent_fit_(hindrance == Hindrance::Garside ? garside_exponent : rowe_exponent),
     log_scale_(std::log(exponent_fit_.scale)), hindrance_offset_(buoyancy == HindranceBuoyancy::Plain ? 1.0 : 0.0),
     fluid_(fluid),
     density_per_viscosity_(fluid.viscosity > 0.0 ? fluid.density / fluid.viscosity : 0.0),
-    yield_per_viscosity_(fluid.viscosity > 0.0 ? fluid.yield_stress / fluid.viscosity : 0.0), smooth_(false)
+    yield_per_viscosity_(fluid.viscosity > 0.0 ? fluid.yield_stress / fluid.viscosity : 0.0),
+    split_yield_(law == DragLaw::Bingham), yield_weight_(split_yield_ ? bingham.yield_weight : 1.0),
+    yield_rise_(bingham.rise), smooth_(false)
 {
   if (law_ == DragLaw::ZhangLi) {
     switches_.reynolds[switches_.count++] = zhang_li_low;
@@ -98,7 +103,7 @@ DragModel::DragModel(DragLaw law, const Fluid &fluid, HindranceBuoyancy buoyancy
 
 double DragModel::viscous_scale(double d, double speed) const
 {
-  return fluid_.yield_stress + fluid_.viscosity * speed / d;
+  return yield_weight_ * fluid_.yield_stress + fluid_.viscosity * speed / d;
 }
 
 double DragModel::reynolds(double d, double speed) const
@@ -109,47 +114,66 @@ double DragModel::reynolds(double d, double speed) const
 
 double DragModel::speed_at_reynolds(double d, double re) const
 {
-  // rho s^2 - (re eta / d) s - re tau_y = 0, positive root
+  // rho s^2 - (re eta / d) s - re w tau_y = 0, positive root
   const double b = re * fluid_.viscosity / d;
-  const double disc = b * b + 4.0 * fluid_.density * re * fluid_.yield_stress;
+  const double disc = b * b + 4.0 * fluid_.density * re * yield_weight_ * fluid_.yield_stress;
   return (b + std::sqrt(disc)) / (2.0 * fluid_.density);
 }
 
-double DragModel::force_at(double d, double speed, double g, DragScale scale) const
+double DragModel::force_at(double d, double speed, double g, double g_yield, DragScale scale) const
 {
-  return yield_force(d, scale) + scale.area * 0.5 * sphere_area(d) * viscous_scale(d, speed) * g;
+  const double half_area = 0.5 * sphere_area(d);
+  if (!split_yield_) return yield_force(d, scale) + scale.area * half_area * viscous_scale(d, speed) * g;
+  return half_area * (scale.area * fluid_.viscosity * speed / d * g + scale.wetted * fluid_.yield_stress * g_yield);
 }
 
 double DragModel::force(double d, double speed, DragScale scale) const
 {
-  return force_at(d, speed, curve(reynolds(d, speed), scale.voidage).g, scale);
+  const double re = reynolds(d, speed);
+  const DragCurve g = curve(re, scale.voidage);
+  return force_at(d, speed, g.g, yield_part(re, g).g, scale);
 }
 
 double DragModel::static_force(double d, DragScale scale) const
 {
   if (fluid_.yield_stress <= 0.0) return 0.0;
-  return force_at(d, 0.0, curve(0.0, scale.voidage).g, scale);
+  const DragCurve g = curve(0.0, scale.voidage);
+  return force_at(d, 0.0, g.g, yield_part(0.0, g).g, scale);
 }
 
-double DragModel::slope_at(double d, double speed, DragCurve g, DragScale scale) const
+double DragModel::slope_at(double d, double speed, DragCurve g, DragCurve g_yield, DragScale scale) const
 {
-  double dforce = fluid_.viscosity / d * g.g;
-  // (tau_y + eta s / d) G' dRe'/ds with dRe'/ds = Re' (2 tau_y + eta s / d) / (s (tau_y + eta s / d))
-  if (speed > 0.0) dforce += g.re_dg * (2.0 * fluid_.yield_stress + fluid_.viscosity * speed / d) / speed;
-  return scale.area * 0.5 * sphere_area(d) * dforce;
+  const double half_area = 0.5 * sphere_area(d);
+  const double eta_d = fluid_.viscosity / d;
+  if (!split_yield_) {
+    double dforce = eta_d * g.g;
+    // (tau_y + eta s / d) G' dRe'/ds with dRe'/ds = Re' (2 tau_y + eta s / d) / (s (tau_y + eta s / d))
+    if (speed > 0.0) dforce += g.re_dg * (2.0 * fluid_.yield_stress + eta_d * speed) / speed;
+    return scale.area * half_area * dforce;
+  }
+  // d/ds of (eta s / d) G + tau_y H at Re_w: dRe_w/ds = Re_w (2 w tau_y + eta s / d) / (s (w tau_y + eta s / d))
+  double dforce = scale.area * eta_d * g.g;
+  if (speed > 0.0) {
+    const double yield = yield_weight_ * fluid_.yield_stress;
+    const double stretch = (2.0 * yield + eta_d * speed) / (speed * (yield + eta_d * speed));
+    dforce += (scale.area * eta_d * speed * g.re_dg + scale.wetted * fluid_.yield_stress * g_yield.re_dg) * stretch;
+  }
+  return half_area * dforce;
 }
 
 double DragModel::tangent(double d, double speed, DragScale scale) const
 {
   const double re = reynolds(d, speed);
-  return slope_at(d, speed, curve(re, scale.voidage), scale);
+  const DragCurve g = curve(re, scale.voidage);
+  return slope_at(d, speed, g, yield_part(re, g), scale);
 }
 
 DragModel::ForceSlope DragModel::force_and_tangent(double d, double speed, DragScale scale) const
 {
   const double re = reynolds(d, speed);
   const DragCurve g = curve(re, scale.voidage);
-  return {force_at(d, speed, g.g, scale), slope_at(d, speed, g, scale)};
+  const DragCurve g_yield = yield_part(re, g);
+  return {force_at(d, speed, g.g, g_yield.g, scale), slope_at(d, speed, g, g_yield, scale)};
 }
 
 int DragModel::jumps(double d, std::array<ForceJump, max_jumps> &out, DragScale scale) const
@@ -160,7 +184,7 @@ int DragModel::jumps(double d, std::array<ForceJump, max_jumps> &out, DragScale 
     const double speed = speed_at_reynolds(d, re);
     const double g_below = drag_curve(single_law_, std::nextafter(re, 0.0)).g;
     const double g_above = drag_curve(single_law_, std::nextafter(re, inf)).g;
-    out[k] = {speed, force_at(d, speed, g_below, scale), force_at(d, speed, g_above, scale)};
+    out[k] = {speed, force_at(d, speed, g_below, g_below, scale), force_at(d, speed, g_above, g_above, scale)};
   }
   return switches_.count;
 }

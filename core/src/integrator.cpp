@@ -358,16 +358,20 @@ AlongSlip advance_along(const SphereDrag &drag, double mass, double s, double a_
 // F / s = k G and c = a_par + k s Re G', with no division. Under one, F = F_y + k (s + s_y) G(Re'),
 // Re' = K s^2 / (s + s_y): F' = k (G + Re' G' (2 s_y + s) / s) and c = a_par - F / m + F' s / m; a
 // sphere at rest (s = 0) takes the step in pieces, which replaces what its division by s gives here.
+// Under `bingham` (split_rates), F = k s G(Re_w) + k_w s_y H(Re_w) with Re_w = K s^2 / (s + w s_y).
 template <bool yield>
 [[gnu::always_inline]] inline void DragBlock::rates(const DragModel &model, double dt, BatchMath kind)
 {
-  if constexpr (yield)
+  if constexpr (yield) {
+    const double weight = model.yield_weight();
     for (int n = 0; n < size_; ++n) {
       yield_speed_[n] = model.yield_speed(diameter_[n]);
       yield_accel_[n] = model.yield_force(diameter_[n], {area_[n], wetted_[n], voidage_[n]}) * inverse_mass_[n];
       const double s = speed_[n];
-      reynolds_[n] = reynolds_per_speed_[n] * s * s / (s + yield_speed_[n]);
+      reynolds_[n] = reynolds_per_speed_[n] * s * s / (s + weight * yield_speed_[n]);
     }
+    if (model.split_yield()) return split_rates(model, dt, kind);
+  }
   model.curves(reynolds_, voidage_, curve_, size_, kind);
   for (int n = 0; n < size_; ++n) {
     const double k = rate_per_g_[n];
@@ -383,6 +387,27 @@ template <bool yield>
       z_[0][n] = k * (g + re_dg) * dt;
       z_[1][n] = k * g * dt;
     }
+  }
+}
+
+// rates() under `bingham`: with D = (k s Re G' + k_w s_y Re H') (s + 2 w s_y) / (s + w s_y), the slope
+// is F' = k G + D / s and c = a_par - F / m + F' s / m = a_par - k_w s_y H + D (per unit mass).
+void DragBlock::split_rates(const DragModel &model, double dt, BatchMath kind)
+{
+  const double weight = model.yield_weight();
+  DragCurve yield_curve[capacity];
+  model.curves(reynolds_, voidage_, curve_, size_, kind);
+  model.yield_curves(reynolds_, yield_curve, size_);
+  for (int n = 0; n < size_; ++n) {
+    const double k = rate_per_g_[n];
+    // the yield part scales with the wetted surface
+    const double k_yield = model.smooth_drag_per_speed(diameter_[n], {wetted_[n], wetted_[n], 1.0}) * inverse_mass_[n];
+    const double s = speed_[n], sy = yield_speed_[n], wsy = weight * sy;
+    const double inverse = 1.0 / s;
+    const double d = (k * s * curve_[n].re_dg + k_yield * sy * yield_curve[n].re_dg) * (s + 2.0 * wsy) / (s + wsy);
+    c_[n] = a_par_[n] - k_yield * sy * yield_curve[n].g + d;
+    z_[0][n] = (k * curve_[n].g + d * inverse) * dt;
+    z_[1][n] = (k * curve_[n].g + k_yield * sy * yield_curve[n].g * inverse) * dt;
   }
 }
 
@@ -424,7 +449,7 @@ template <bool yield>
   if constexpr (yield) {
     for (int n = 0; n < size_; ++n) {
       const double s0 = speed_[n], s1 = end_speed[n];
-      const double re_end = reynolds_per_speed_[n] * s1 * s1 / (s1 + yield_speed_[n]);
+      const double re_end = reynolds_per_speed_[n] * s1 * s1 / (s1 + model.yield_weight() * yield_speed_[n]);
       low[n] = std::min(reynolds_[n], re_end) * (1.0 - margin);
       high[n] = std::max(reynolds_[n], re_end) * (1.0 + margin);
       meets_point_[n] = (!(s0 > 0.0)) | (s1 < 0.0);

@@ -83,9 +83,9 @@ double time_to_fraction(const DragModel &model, double d, double particle_densit
 
 double critical_yield_number(const DragModel &model)
 {
-  // (pi/6) (rho_p - rho_f) g d^3 = F(0+) = d^2 tau_y (pi^2/4 + pi G(0)/8)
-  const double g0 = drag_curve(model.law(), 0.0).g;
-  return (pi / 6.0) / (pi * pi / 4.0 + pi * g0 / 8.0);
+  // (pi/6) (rho_p - rho_f) g d^3 = F(0+), which is d^2 tau_y times a number of the law
+  // (Dedegil form: pi^2/4 + pi G(0)/8; bingham: pi H(0)/8)
+  return (pi / 6.0) * model.fluid().yield_stress / model.static_force(1.0);
 }
 
 }    // namespace sediment

@@ -13,6 +13,7 @@
 #include <pybind11/stl.h>
 
 #include <cmath>
+#include <optional>
 #include <stdexcept>
 
 namespace py = pybind11;
@@ -85,7 +86,7 @@ PYBIND11_MODULE(_core, m)
   m.def("drag_law_names", [] {
     std::vector<std::string> names;
     for (auto law : {DragLaw::Stokes, DragLaw::SchillerNaumann, DragLaw::Dallavalle, DragLaw::ZhangLi,
-                     DragLaw::ZhangLiSmooth, DragLaw::DiFelice, DragLaw::Standard})
+                     DragLaw::ZhangLiSmooth, DragLaw::DiFelice, DragLaw::Standard, DragLaw::Bingham})
       names.emplace_back(drag_law_name(law));
     return names;
   }, "Names of the drag laws.");
@@ -102,13 +103,24 @@ PYBIND11_MODULE(_core, m)
 
   py::class_<DragModel>(m, "DragModel", "Resisting-force curve of a sphere under one drag law.")
       .def(py::init([](const std::string &law, double density, double viscosity, double yield_stress,
-                       const std::string &buoyancy, const std::string &hindrance) {
+                       const std::string &buoyancy, const std::string &hindrance, std::optional<double> yield_weight,
+                       std::optional<double> yield_rise) {
              const DragLaw parsed = parse_law(law);
+             bingham_law::Constants constants = bingham_law::fitted;
+             if (yield_weight || yield_rise) {
+               if (parsed != DragLaw::Bingham)
+                 throw py::value_error("yield_weight and yield_rise are constants of law bingham, not of " + law);
+               constants = {yield_weight.value_or(constants.yield_weight), yield_rise.value_or(constants.rise)};
+               if (!(constants.yield_weight > 0.0) || !(constants.rise >= 0.0) || !std::isfinite(constants.rise))
+                 throw py::value_error("yield_weight must be > 0 and yield_rise >= 0");
+             }
              return DragModel(parsed, make_fluid(density, viscosity, yield_stress), parse_buoyancy(buoyancy),
-                              parse_hindrance(hindrance, parsed));
+                              parse_hindrance(hindrance, parsed), constants);
            }),
            py::arg("law"), py::arg("density"), py::arg("viscosity"), py::arg("yield_stress") = 0.0,
-           py::arg("buoyancy") = "plain", py::arg("hindrance") = "none")
+           py::arg("buoyancy") = "plain", py::arg("hindrance") = "none", py::arg("yield_weight") = py::none(),
+           py::arg("yield_rise") = py::none(),
+           "yield_weight, yield_rise: other constants for law bingham (its fit tries them; default: the fitted ones).")
       .def("reynolds", &DragModel::reynolds, py::arg("d"), py::arg("speed"))
       .def("force", [](const DragModel &model, double d, double speed, double voidage, double area,
                        double wetted) {

@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <memory>
 
 using namespace sediment;
 
@@ -20,7 +21,7 @@ double newtonian_force(double cd, double d, double v) { return 0.5 * water.densi
 TEST(DragLaw, NamesRoundTrip)
 {
   for (auto law : {DragLaw::Stokes, DragLaw::SchillerNaumann, DragLaw::Dallavalle, DragLaw::ZhangLi,
-                   DragLaw::ZhangLiSmooth, DragLaw::DiFelice, DragLaw::Standard})
+                   DragLaw::ZhangLiSmooth, DragLaw::DiFelice, DragLaw::Standard, DragLaw::Bingham})
     EXPECT_EQ(drag_law_from_name(drag_law_name(law)), law);
   EXPECT_FALSE(drag_law_from_name("stokes2").has_value());
   EXPECT_NE(drag_law_names().find("schiller-naumann"), std::string::npos);
@@ -37,6 +38,7 @@ TEST(DragLaw, WhichLawsTakeAHindrance)
   // A stretched speed would move Schiller-Naumann's jump with each sphere's fraction.
   EXPECT_FALSE(law_takes_hindrance(DragLaw::SchillerNaumann, Hindrance::RichardsonZaki));
   EXPECT_FALSE(law_takes_hindrance(DragLaw::ZhangLi, Hindrance::DiFelice));
+  EXPECT_FALSE(law_takes_hindrance(DragLaw::Bingham, Hindrance::RichardsonZaki));
   EXPECT_FALSE(law_takes_hindrance(DragLaw::DiFelice, Hindrance::Garside));    // Bravo et al.'s model is whole
   // law difelice is Dallavalle's curve under Di Felice's hindrance, named so for the paper.
   const DragModel bravo(DragLaw::DiFelice, water);
@@ -239,7 +241,7 @@ TEST(DragLaw, SmoothVariantIsContinuousAndKeepsTheStaticForce)
 TEST(DragLaw, TangentMatchesFiniteDifference)
 {
   for (auto law : {DragLaw::Stokes, DragLaw::SchillerNaumann, DragLaw::Dallavalle, DragLaw::ZhangLi,
-                   DragLaw::ZhangLiSmooth}) {
+                   DragLaw::ZhangLiSmooth, DragLaw::Bingham}) {
     for (const Fluid &fluid : {water, clay}) {
       const DragModel model(law, fluid);
       for (double v : {1e-4, 3e-2, 0.7, 2.5}) {
@@ -346,7 +348,7 @@ TEST(DragLaw, ForceAndTangentInOneEvaluationAreBitwiseTheSeparateOnes)
 {
   const DragScale hindered{0.7, 0.6, 0.8};
   for (auto law : {DragLaw::Stokes, DragLaw::SchillerNaumann, DragLaw::Dallavalle, DragLaw::ZhangLi,
-                   DragLaw::ZhangLiSmooth, DragLaw::DiFelice})
+                   DragLaw::ZhangLiSmooth, DragLaw::DiFelice, DragLaw::Bingham})
     for (const Fluid &fluid : {water, clay})
       for (double speed : {0.0, 1e-6, 3e-3, 0.4, 7.0}) {
         const DragModel model(law, fluid);
@@ -366,6 +368,64 @@ TEST(DragLaw, SmoothLawsAreThoseWithoutYieldOrJumps)
   EXPECT_FALSE(DragModel(DragLaw::ZhangLi, water).smooth());            // steps at Re' 1 and 150
   EXPECT_FALSE(DragModel(DragLaw::ZhangLiSmooth, clay).smooth());       // yield stress
   EXPECT_FALSE(DragModel(DragLaw::Stokes, clay).smooth());
+  EXPECT_TRUE(DragModel(DragLaw::Bingham, water).smooth());             // the standard curve
+  EXPECT_FALSE(DragModel(DragLaw::Bingham, clay).smooth());
+}
+
+// docs/physics.md 4.1: the plastic viscosity's part is the standard curve at Re_w, the yield
+// stress's part (pi d^2 / 8) tau_y H(Re_w).
+TEST(BinghamLaw, IsItsClosedForm)
+{
+  const DragModel model(DragLaw::Bingham, clay);
+  const DragScale surface{0.4, 0.7};
+  for (double d : {0.0095, 0.0571})
+    for (double v : {1e-7, 1e-3, 0.05, 0.6, 2.5}) {
+      const double yield = bingham_law::fitted.yield_weight * clay.yield_stress;
+      const double re = clay.density * v * v / (yield + clay.viscosity * v / d);
+      const double x = bingham_law::fitted.yield_weight * re;
+      const double h = 4.0 / (3.0 * 0.048) + bingham_law::fitted.rise * x / (1.0 + x);
+      const double viscous = pi * d * d / 8.0 * clay.viscosity * v / d * standard_curve::curve(re).g;
+      const double plastic = pi * d * d / 8.0 * clay.yield_stress * h;
+      EXPECT_NEAR(model.force(d, v), viscous + plastic, 1e-13 * (viscous + plastic)) << d << " " << v;
+      // partly submerged: the plastic viscosity's part with the area, the yield stress's with the surface
+      EXPECT_NEAR(model.force(d, v, surface), 0.4 * viscous + 0.7 * plastic, 1e-13 * (viscous + plastic));
+    }
+}
+
+TEST(BinghamLaw, IsTheStandardCurveInANewtonianFluid)
+{
+  const DragModel bingham(DragLaw::Bingham, water), standard(DragLaw::Standard, water);
+  for (double v : {1e-6, 1e-3, 0.1, 3.0}) {
+    EXPECT_NEAR(bingham.force(1e-3, v), standard.force(1e-3, v), 1e-14 * standard.force(1e-3, v));
+    EXPECT_NEAR(bingham.tangent(1e-3, v), standard.tangent(1e-3, v), 1e-14 * standard.tangent(1e-3, v));
+  }
+  EXPECT_EQ(bingham.static_force(1e-3), 0.0);
+}
+
+TEST(BinghamLaw, HoldsUpToBerisCriticalYieldNumber)
+{
+  const DragModel model(DragLaw::Bingham, clay);
+  EXPECT_NEAR(critical_yield_number(model), 0.048, 1e-15);
+  EXPECT_EQ(model.jumps(0.02, *std::make_unique<std::array<ForceJump, DragModel::max_jumps>>()), 0);
+}
+
+// Continuous and increasing from rest to a Reynolds number of 1e5: a unique terminal speed for any
+// drive above the static force, and no speed band without one (zhang-li's jumps leave such bands).
+TEST(BinghamLaw, IsContinuousAndIncreasing)
+{
+  for (const Fluid &fluid : {clay, Fluid{1843.0, 0.7, 136.0}, Fluid{1000.0, 1e-3, 0.01}}) {
+    const DragModel model(DragLaw::Bingham, fluid);
+    const double d = 0.016;
+    double previous = model.static_force(d);
+    for (double v = 1e-9; v < 30.0; v *= 1.0 + 1e-3) {
+      const double f = model.force(d, v);
+      ASSERT_GT(f, previous) << "tau_y " << fluid.yield_stress << " v " << v;
+      ASSERT_LT(f - previous, 1e-2 * f) << "tau_y " << fluid.yield_stress << " v " << v;    // no jump
+      EXPECT_GT(model.tangent(d, v), 0.0);
+      previous = f;
+    }
+    EXPECT_NEAR(model.force(d, 1e-14), model.static_force(d), 1e-9 * model.static_force(d));
+  }
 }
 
 TEST(Hindrance, ContinuousWhereTheSuspensionClears)

@@ -164,15 +164,18 @@ class Bingham : public ::testing::Test {
 
 TEST_F(Bingham, JustAboveTheCriterionStaysExactlyStill)
 {
-  const double rho = density_for_yield_number(critical_yield_number(model) * 1.0001);
-  const double mass = rho * sphere_volume(d);
-  const SphereDrag drag{&model, d, {}};
-  auto accel = [&](const double *, double *a) { a[0] = a[1] = 0; a[2] = -(rho - clay.density) / rho * g; };
-  State s;
-  for (double dt : {1e-6, 1e-3, 0.1}) {
-    run(drag, mass, accel, dt, 100000, s);
-    EXPECT_EQ(s.v[2], 0.0);
-    EXPECT_EQ(s.x[2], 0.0);
+  for (auto law : {DragLaw::ZhangLi, DragLaw::Bingham}) {
+    const DragModel law_model(law, clay);
+    const double rho = density_for_yield_number(critical_yield_number(law_model) * 1.0001);
+    const double mass = rho * sphere_volume(d);
+    const SphereDrag drag{&law_model, d, {}};
+    auto accel = [&](const double *, double *a) { a[0] = a[1] = 0; a[2] = -(rho - clay.density) / rho * g; };
+    State s;
+    for (double dt : {1e-6, 1e-3, 0.1}) {
+      run(drag, mass, accel, dt, 100000, s);
+      EXPECT_EQ(s.v[2], 0.0) << drag_law_name(law);
+      EXPECT_EQ(s.x[2], 0.0) << drag_law_name(law);
+    }
   }
 }
 
@@ -181,11 +184,11 @@ TEST_F(Bingham, JustAboveTheCriterionStaysExactlyStill)
 // speed; the smooth variant has a true root there. Both must be reached at any step.
 TEST_F(Bingham, JustBelowTheCriterionSettlesAtTheLawsTerminalVelocity)
 {
-  const double rho = density_for_yield_number(critical_yield_number(model) * 0.99);
-  const double mass = rho * sphere_volume(d);
-  auto accel = [&](const double *, double *a) { a[0] = a[1] = 0; a[2] = -(rho - clay.density) / rho * g; };
-  for (auto law : {DragLaw::ZhangLi, DragLaw::ZhangLiSmooth}) {
+  for (auto law : {DragLaw::ZhangLi, DragLaw::ZhangLiSmooth, DragLaw::Bingham}) {
     const DragModel law_model(law, clay);
+    const double rho = density_for_yield_number(critical_yield_number(law_model) * 0.99);
+    const double mass = rho * sphere_volume(d);
+    auto accel = [&](const double *, double *a) { a[0] = a[1] = 0; a[2] = -(rho - clay.density) / rho * g; };
     const TerminalState terminal = terminal_velocity(law_model, d, rho, g);
     EXPECT_EQ(terminal.regime, law == DragLaw::ZhangLi ? TerminalRegime::AtJump : TerminalRegime::Moving);
     const SphereDrag drag{&law_model, d, {}};
@@ -414,7 +417,8 @@ TEST(DragBlock, LawsWithSetValuedPointsStepAsInPieces)
   const Fluid water{998.2, 1.002e-3, 0.0}, paste{998.2, 1.002e-3, 0.01}, clay{1280.0, 0.0131, 30.5};
   const std::pair<DragLaw, Fluid> laws[] = {
       {DragLaw::SchillerNaumann, water}, {DragLaw::ZhangLi, water},       {DragLaw::ZhangLi, paste},
-      {DragLaw::ZhangLi, clay},          {DragLaw::ZhangLiSmooth, paste}, {DragLaw::Stokes, paste}};
+      {DragLaw::ZhangLi, clay},          {DragLaw::ZhangLiSmooth, paste}, {DragLaw::Stokes, paste},
+      {DragLaw::Bingham, clay},          {DragLaw::Bingham, paste}};
   const double dt = 1e-4;
   int stuck = 0, held = 0, one_piece = 0;
   for (const auto &[law, fluid] : laws) {

@@ -128,7 +128,7 @@ def case_c(np_ranks: int):
     data = DATA / "vw1965_dev.csv"
     with open(data) as f:
         rows = [{k: float(v) for k, v in r.items()} for r in csv.DictReader(f)]
-    for law in ("zhang-li", "zhang-li/smooth"):
+    for law in ("zhang-li", "zhang-li/smooth", "bingham"):
         with tempfile.TemporaryDirectory() as tmp:
             deck = Path(tmp) / "case_c.lmp"
             case_c_deck(rows, deck, law)
@@ -271,17 +271,18 @@ def bingham_vars(law: str, y_ratio: float, **extra) -> dict:
 
 @check
 def bingham_rest(np_ranks: int):
-    out = run_deck("single_sphere.lmp", bingham_vars("zhang-li", 1.0001, dt=1e-3, steps=100000, every=1000),
-                   np_ranks)
-    report(f"Bingham Y = 1.0001 Y_c: max |vz| over 1e5 steps = {np.max(np.abs(out.samples[:, 2])):.1e}, "
-           f"max |z| = {np.max(np.abs(out.samples[:, 1])):.1e}, stuck spheres = {out.results['stuck']:.0f}")
-    assert np.all(out.samples[:, 1:] == 0.0)
-    assert out.results["stuck"] == 1
+    for law in ("zhang-li", "bingham"):
+        out = run_deck("single_sphere.lmp", bingham_vars(law, 1.0001, dt=1e-3, steps=100000, every=1000),
+                       np_ranks)
+        report(f"Bingham {law} Y = 1.0001 Y_c: max |vz| over 1e5 steps = {np.max(np.abs(out.samples[:, 2])):.1e}, "
+               f"max |z| = {np.max(np.abs(out.samples[:, 1])):.1e}, stuck spheres = {out.results['stuck']:.0f}")
+        assert np.all(out.samples[:, 1:] == 0.0)
+        assert out.results["stuck"] == 1
 
 
 @check
 def bingham_settles(np_ranks: int):
-    for law in ("zhang-li", "zhang-li/smooth"):
+    for law in ("zhang-li", "zhang-li/smooth", "bingham"):
         for dt in (1e-3, 0.1):
             out = run_deck("single_sphere.lmp", bingham_vars(law, 0.99, dt=dt, steps=round(300 / dt),
                                                                  every=round(300 / dt)), np_ranks)
@@ -1043,6 +1044,8 @@ BAD_INPUT = [
     ("fix f all fluid density 1000 viscosity 1e-3\nfix d all fluid/drag f law standard hindrance rz concentration c_x", "unknown hindrance 'rz'"),
     ("fix f all fluid density 1000 viscosity 1e-3\nfix d all fluid/drag f law zhang-li hindrance difelice concentration c_x", "law zhang-li takes no hindrance difelice"),
     ("fix f all fluid density 1000 viscosity 1e-3\nfix d all fluid/drag f law schiller-naumann hindrance garside concentration c_x", "jump in Cd at Re = 1000"),
+    ("fix f all fluid density 1000 bingham 10 0.01\nfix d all fluid/drag f law bingham hindrance richardson-zaki concentration c_x", "law bingham takes no hindrance richardson-zaki"),
+    ("fix f all fluid density 1000 bingham 10 0.01\nfix d all fluid/drag f law Bingham", "unknown law 'Bingham'"),
     ("fix f all fluid density 1000 viscosity 1e-3\nfix d all fluid/drag f law difelice hindrance garside concentration c_x", "law difelice is Dallavalle's drag with Di Felice's hindrance"),
     ("fix f all fluid density 1000 viscosity 1e-3\nfix d all fluid/drag f law standart", "unknown law 'standart'"),
     ("fix f all fluid density 1000 viscosity 1e-3\nfix b all fluid/buoyancy f max_fraction 1", "max_fraction must be in (0, 1)"),

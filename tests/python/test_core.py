@@ -19,7 +19,7 @@ def test_case_a_terminal_velocity_and_tau():
 
 def test_law_names_and_coefficients():
     assert sediment.drag_law_names() == ["stokes", "schiller-naumann", "dallavalle", "zhang-li", "zhang-li/smooth",
-                                         "difelice", "standard"]
+                                         "difelice", "standard", "bingham"]
     assert sediment.drag_coefficient("schiller-naumann", 10.0) == pytest.approx(2.4 * (1 + 0.15 * 10**0.687))
     assert sediment.drag_coefficient("dallavalle", 4.0) == pytest.approx((0.63 + 2.4) ** 2)
     assert sediment.drag_coefficient("zhang-li", 10.0) == pytest.approx(2.912 + 0.195)
@@ -32,6 +32,15 @@ def test_bingham_rest_criterion_and_jumps():
     assert [round(model.reynolds(0.0254, v), 9) for v, _, _ in jumps] == [1.0, 150.0]
     assert all(above > below for _, below, above in jumps)
     assert model.static_force(0.02) == pytest.approx((math.pi**2 / 4 + 3 * math.pi) * 0.02**2 * 30.5)
+    # law bingham: Beris et al.'s critical yield number, no jump, the standard curve in water
+    assert sediment.critical_yield_number("bingham") == pytest.approx(0.048, rel=1e-12)
+    bingham = sediment.DragModel("bingham", 1280.0, 0.0131, 30.5)
+    assert bingham.jumps(0.0254) == []
+    assert bingham.static_force(0.02) == pytest.approx(math.pi / 6 / 0.048 * 0.02**2 * 30.5, rel=1e-12)
+    water = sediment.DragModel("bingham", 998.2, 1.002e-3), sediment.DragModel("standard", 998.2, 1.002e-3)
+    assert water[0].force(1e-3, 0.05) == pytest.approx(water[1].force(1e-3, 0.05), rel=1e-14)
+    with pytest.raises(ValueError, match="yield_weight must be > 0"):
+        sediment.DragModel("bingham", 1280.0, 0.0131, 30.5, yield_weight=0.0)
 
 
 def test_submergence_half():

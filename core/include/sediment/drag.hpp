@@ -7,6 +7,8 @@
 // which is the Dedegil form of Zhang & Li (2024) for a Bingham fluid and, with tau_y = 0, exactly
 // the Newtonian drag 1/2 rho A Cd(Re) s^2 with Re = rho s d / mu (Stokes: F = 3 pi mu d s).
 // s_A and s_w scale the projected area and the yield term for a partly submerged sphere.
+// The law `bingham` splits the force into the plastic viscosity's and the yield stress's parts
+// (bingham_law below): F(s) = s_A (A / 2) (eta s / d) G(Re_w) + s_w (A / 2) tau_y H(Re_w).
 #pragma once
 
 #include "sediment/batch_math.hpp"
@@ -24,7 +26,7 @@ namespace sediment {
 
 // The single-sphere laws; DiFelice is Bravo et al.'s model, Dallavalle's curve under Di Felice's
 // hindrance, kept under its own name to reproduce the paper (DragModel splits it into the two).
-enum class DragLaw { Stokes, SchillerNaumann, Dallavalle, ZhangLi, ZhangLiSmooth, DiFelice, Standard };
+enum class DragLaw { Stokes, SchillerNaumann, Dallavalle, ZhangLi, ZhangLiSmooth, DiFelice, Standard, Bingham };
 
 // How the local solid fraction phi = 1 - eps hinders the drag of any Newtonian law (docs/physics.md 3):
 // - DiFelice: the force times eps^-(chi(Re) + 1) (Di Felice 1994's voidage function);
@@ -148,6 +150,34 @@ inline DragCurve curve(double re)
 }
 }    // namespace standard_curve
 
+// SEDIMENT's law for a sphere in a Bingham fluid (docs/physics.md 4.1), continuous and increasing in s:
+//   F = (pi d^2 / 8) [ (eta s / d) G_std(Re_w) + tau_y H(Re_w) ],   Re_w = rho s^2 / (w tau_y + eta s / d),
+//   H = 4 / (3 Y_c) + rise x / (1 + x),   x = w Re_w.
+// The plastic viscosity's part is the standard curve of a sphere (so a Newtonian fluid gets exactly
+// the `standard` law), at a Reynolds number in which the yield stress counts with the weight w; the
+// yield stress's part holds a sphere at rest up to Beris et al.'s (1985) critical yield number
+// Y_c = 0.048 (full flow simulations of creeping flow) and rises by `rise` where inertia starts to
+// count: x = rho s^2 / (tau_y + eta s / (w d)) is Dedegil's Re' where the yield stress dominates, and
+// Zhang & Li's law jumps at Re' = 1. w and rise are fitted on Valentik & Whitmore's (1965) suspensions
+// 1, 3 and 5 alone by benchmarks/fit_bingham.py (its output: docs/physics.md 4.1).
+namespace bingham_law {
+constexpr double critical_yield_number = 0.048;
+constexpr double static_curve = 4.0 / (3.0 * critical_yield_number);    // H(0)
+struct Constants {
+  double yield_weight;    // w
+  double rise;
+};
+constexpr Constants fitted{0.0101, 8.05};
+// H and Re dH/dRe.
+inline DragCurve yield_curve(double re, Constants constants)
+{
+  const double x = constants.yield_weight * re;
+  const double inverse = 1.0 / (1.0 + x);
+  const double share = x * inverse;
+  return {static_curve + constants.rise * share, constants.rise * share * inverse};
+}
+}    // namespace bingham_law
+
 // Inline: the integrator's per-atom loops evaluate it with the law fixed for the whole run.
 inline DragCurve drag_curve(DragLaw law, double re)
 {
@@ -157,6 +187,7 @@ inline DragCurve drag_curve(DragLaw law, double re)
     case DragLaw::SchillerNaumann:
       return schiller_naumann_curve(re, re <= schiller_naumann_switch ? std::pow(re, schiller_naumann_exponent) : 0.0);
     case DragLaw::Standard:
+    case DragLaw::Bingham:    // the plastic viscosity's part; yield_curve() gives the yield stress's
       return standard_curve::curve(re);
     case DragLaw::Dallavalle:
     case DragLaw::DiFelice: {    // the single-sphere curve; hindrance is applied per sphere
@@ -239,9 +270,10 @@ class DragModel {
   static constexpr int max_jumps = 2;
 
   // law DiFelice is Dallavalle's curve with the Di Felice hindrance, whatever `hindrance` says;
-  // any other law takes `hindrance` (law_takes_hindrance must hold).
+  // any other law takes `hindrance` (law_takes_hindrance must hold). `bingham` takes its fitted
+  // constants (another set: benchmarks/fit_bingham.py trying them).
   DragModel(DragLaw law, const Fluid &fluid, HindranceBuoyancy buoyancy = HindranceBuoyancy::Plain,
-            Hindrance hindrance = Hindrance::None);
+            Hindrance hindrance = Hindrance::None, bingham_law::Constants bingham = bingham_law::fitted);
 
   DragLaw law() const { return law_; }
   DragLaw single_law() const { return single_law_; }    // the single-sphere curve (Dallavalle's for DiFelice)
@@ -263,13 +295,29 @@ class DragModel {
   // True when F(s) is single-valued and continuous: no yield stress and no Cd jump, so a step
   // needs no event handling (Stokes, Dallavalle, Di Felice, zhang-li/smooth in a Newtonian fluid).
   bool smooth() const { return smooth_; }
+  // True for `bingham`, whose yield stress's part has a curve of its own (yield_curve), scaled with the
+  // wetted surface, and whose Reynolds number weighs the yield stress by yield_weight(); false for the
+  // Dedegil form, where both parts share G(Re') and the area's scale.
+  bool split_yield() const { return split_yield_; }
+  double yield_weight() const { return yield_weight_; }
+  // H(Re) and Re H'(Re) of the yield stress's part under `bingham` (G of the law otherwise).
+  DragCurve yield_curve(double re) const { return bingham_law::yield_curve(re, {yield_weight_, yield_rise_}); }
+  // yield_curve() of n spheres.
+  [[gnu::always_inline]] void yield_curves(const double *re, DragCurve *out, int n) const
+  {
+    for (int k = 0; k < n; ++k) out[k] = bingham_law::yield_curve(re[k], {yield_weight_, yield_rise_});
+  }
   // Every law is F(s) = F_y + k (s + s_y) G(Re'), Re' = K s^2 / (s + s_y), with k = s_A pi eta d / 8,
   // K = rho d / eta, the yield force F_y = s_w (pi d / 2)^2 tau_y and the yield speed s_y = tau_y d / eta
   // (both 0 in a Newtonian fluid, where Re = K s): a step takes its rates from k, G and Re G' without
-  // dividing by the slip where there is no yield stress.
+  // dividing by the slip where there is no yield stress. Under `bingham`, F(s) = k s G(Re_w) +
+  // k_w s_y H(Re_w), Re_w = K s^2 / (s + w s_y), k_w = s_w pi eta d / 8 and no F_y.
   double smooth_drag_per_speed(double d, DragScale scale) const { return scale.area * pi / 8.0 * fluid_.viscosity * d; }
   double smooth_reynolds_per_speed(double d) const { return density_per_viscosity_ * d; }
-  double yield_force(double d, DragScale scale) const { return scale.wetted * (pi * pi * d * d / 4.0 * fluid_.yield_stress); }
+  double yield_force(double d, DragScale scale) const
+  {
+    return split_yield_ ? 0.0 : scale.wetted * (pi * pi * d * d / 4.0 * fluid_.yield_stress);
+  }
   double yield_speed(double d) const { return yield_per_viscosity_ * d; }
   // The Reynolds numbers Re' at which Cd jumps (where a step may have to stop: jumps()), in increasing order.
   struct Switches {
@@ -331,7 +379,8 @@ class DragModel {
         }
         return;
       }
-      case DragLaw::Standard: {
+      case DragLaw::Standard:
+      case DragLaw::Bingham: {
         constexpr int chunk = 64;
         double log_re[chunk];
         for (int start = 0; start < n; start += chunk) {
@@ -482,11 +531,14 @@ class DragModel {
     const double g = prefactor * at_stretched.g;
     return {g, l * g + prefactor * (1.0 + l) * at_stretched.re_dg};
   }
-  double viscous_scale(double d, double speed) const;    // tau_y + eta s / d
+  double viscous_scale(double d, double speed) const;    // w tau_y + eta s / d (w = 1 but under `bingham`)
   double speed_at_reynolds(double d, double re) const;  // inverse of reynolds()
-  double force_at(double d, double speed, double g, DragScale scale) const;
-  // dF/ds from the law's curve evaluated at this speed.
-  double slope_at(double d, double speed, DragCurve g, DragScale scale) const;
+  // F from the curves of the viscous and the yield part (the same curve but under `bingham`).
+  double force_at(double d, double speed, double g, double g_yield, DragScale scale) const;
+  // dF/ds from the law's curves evaluated at this speed.
+  double slope_at(double d, double speed, DragCurve g, DragCurve g_yield, DragScale scale) const;
+  // The curve of the yield part at Re: yield_curve() under `bingham`, else `single` (the law's own).
+  DragCurve yield_part(double re, DragCurve single) const { return split_yield_ ? yield_curve(re) : single; }
 
   DragLaw law_;
   DragLaw single_law_;
@@ -497,6 +549,9 @@ class DragModel {
   Fluid fluid_;
   double density_per_viscosity_;    // rho / eta (0 without viscosity)
   double yield_per_viscosity_;      // tau_y / eta (0 without viscosity)
+  bool split_yield_;                // `bingham`
+  double yield_weight_;             // w of the Reynolds number (1 but under `bingham`)
+  double yield_rise_;               // rise of H under `bingham`
   Switches switches_;
   bool smooth_;
 };

@@ -270,6 +270,7 @@ class DragBlock {
   template <bool yield> void stages_of(const DragModel &model, double dt, BatchMath kind);
   void slip();
   template <bool yield> void rates(const DragModel &model, double dt, BatchMath kind);
+  void split_rates(const DragModel &model, double dt, BatchMath kind);
   void advance_all(double dt);
   template <bool yield> void find_set_valued_points(const DragModel &model, double dt);
   void step_in_pieces(const DragModel &model, double dt);

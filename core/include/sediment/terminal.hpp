@@ -41,7 +41,8 @@ TerminalState terminal_velocity(const DragModel &model, double d, double particl
 double time_to_fraction(const DragModel &model, double d, double particle_density, double g,
                         double fraction);
 
-// Yield number Y = tau_y / ((rho_p - rho_f) g d) below which a sphere moves (spec: 0.0440).
+// Yield number Y = tau_y / ((rho_p - rho_f) g d) below which a sphere moves (zhang-li: 0.0440, bingham:
+// 0.048); the model's fluid must have a yield stress.
 double critical_yield_number(const DragModel &model);
 
 }    // namespace sediment
