@@ -16,6 +16,8 @@ BRAVO_CYLINDER_HEIGHT = 0.457     # m
 # tests/python/test_cli.py checks them against the core's own lists.
 DRAG_LAWS = ("stokes", "schiller-naumann", "dallavalle", "zhang-li", "zhang-li/smooth", "difelice", "standard",
              "bingham")
+# The laws for a sphere in a Bingham fluid: SEDIMENT's (the default), the paper's and its continuous variant.
+BINGHAM_LAWS = ("bingham", "zhang-li", "zhang-li/smooth")
 # The single-sphere drag of a test: the measured standard drag curve (the default), Schiller &
 # Naumann's, Dallavalle's, Stokes' law; and Bravo et al.'s model, Dallavalle's curve under Di Felice's
 # hindrance, named difelice as in the paper (docs/physics.md).

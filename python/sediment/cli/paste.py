@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from ..constants import BINGHAM_LAWS
 from .types import count, nonnegative, positive, setting
 
 
@@ -26,10 +27,20 @@ def add_parser(commands) -> argparse.ArgumentParser:
                                  "submergence: settling distances")):
         study = studies.add_parser(name, help=text)
         study.add_argument("--out", type=Path, default=Path("out/paste"), help="output folder")
+        if name == "balls":
+            study.add_argument("--law", default="bingham", choices=BINGHAM_LAWS, help="the paste's drag law")
+            study.add_argument("--viscosity", type=positive, help="the paste's plastic viscosity [Pa s] (default: "
+                               "the law's calibration, 0.279 for bingham and Zhang & Li's 0.7 for theirs; see the "
+                               "viscosity study)")
+    calibration = studies.add_parser("viscosity", help="the paste's plastic viscosity with which a law puts "
+                                     "Zhang & Li's calibration drop (12.6 mm from 255 mm) where their law puts it")
+    calibration.add_argument("--law", default="bingham", choices=BINGHAM_LAWS, help="the paste's drag law")
+    calibration.add_argument("--out", type=Path, help="also write viscosity_calibration.csv into this folder")
     energy = studies.add_parser("energy", help="energy balance of one ball entering the paste")
     energy.add_argument("--diameter", type=positive, default=0.0126, help="[m]")
     energy.add_argument("--fall", type=nonnegative, default=0.255, help="fall height above the paste [m]")
     energy.add_argument("--dt", type=positive, default=1e-5, help="[s]")
+    energy.add_argument("--law", default="bingham", choices=BINGHAM_LAWS, help="the paste's drag law")
     energy.add_argument("--out", type=Path, help="also write energy_balance.csv into this folder")
     pour = studies.add_parser("funnel", help="68 balls poured from a funnel, several random packings")
     pour.add_argument("--runs", type=count, default=15)
@@ -58,9 +69,11 @@ def run(args: argparse.Namespace) -> int:
     if args.study == "drop-test":
         result = paste.drop_study()
     elif args.study == "balls":
-        result = paste.ball_study()
+        result = paste.ball_study(law=args.law, plastic_viscosity=args.viscosity)
+    elif args.study == "viscosity":
+        result = paste.calibrate_viscosity(args.law)
     elif args.study == "energy":
-        result = paste.energy_balance(args.diameter, args.fall, args.dt)
+        result = paste.energy_balance(args.diameter, args.fall, args.dt, law=args.law)
     elif args.study == "funnel-compare":
         result = funnel.compare(args.folders)
     else:

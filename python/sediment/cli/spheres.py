@@ -5,6 +5,8 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from ..constants import BINGHAM_LAWS
+
 
 EXAMPLES = [
     'sediment spheres tests/data/vw1965_dev.csv --out out/spheres',
@@ -16,8 +18,8 @@ def add_parser(commands) -> argparse.ArgumentParser:
     parser = commands.add_parser("spheres", help="terminal velocities of spheres in Bingham suspensions, simulated "
                                  "vs the law and the measurement (Valentik & Whitmore 1965 columns)")
     parser.add_argument("csv", type=Path, help="CSV with suspension,rho_f,eta_B,tau_y,d,rho_p,v_ter_measured (SI)")
-    parser.add_argument("--law", nargs="+", default=["zhang-li", "zhang-li/smooth"],
-                        choices=["zhang-li", "zhang-li/smooth"])
+    parser.add_argument("--law", nargs="+", default=["bingham", "zhang-li"], choices=BINGHAM_LAWS,
+                        help="drag laws to settle each sphere under (default: %(default)s)")
     parser.add_argument("--out", type=Path, default=Path("out/spheres"), help="output folder")
     return parser
 

@@ -24,7 +24,7 @@ from .. import figures
 from ..results import Table, write_text
 from ..sim.deck import index_variables
 from ..sim.run import run_batch
-from .paste import EXAMPLES, PASTE
+from .paste import EXAMPLES, PASTE, PLASTIC_VISCOSITY
 
 BALLS = 68
 DIAMETER = 0.0126
@@ -260,6 +260,8 @@ def funnel_study(runs: int = 15, jobs: int = 2, dt: float = 1e-6, settings: dict
 
     settings = dict(settings or {})
     check_settings(settings)    # before any run
+    if settings.get("law") in PLASTIC_VISCOSITY and "eta_B" not in settings:    # the viscosity goes with the law
+        settings["eta_B"] = f"{PLASTIC_VISCOSITY[settings['law']]:g}"
     with ThreadPoolExecutor(max_workers=jobs) as pool:
         pours = pool.map(lambda seed: pour(seed, dt, settings=settings), range(1, runs + 1))
         return FunnelStudy(list(tqdm(pours, total=runs, desc="pours", unit="run", disable=not progress)), settings, dt)

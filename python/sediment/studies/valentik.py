@@ -88,7 +88,7 @@ def read_spheres(path: Path) -> list[Sphere]:
     return spheres
 
 
-def settle(sphere: Sphere, law: str = "zhang-li", steps: int = 2000) -> Settling:
+def settle(sphere: Sphere, law: str = "bingham", steps: int = 2000) -> Settling:
     """Runs the deck for five times the law's time to 99 % of the terminal speed (or 1 s at rest)."""
     args = (law, sphere.rho_f, sphere.eta_B, sphere.tau_y, sphere.d, sphere.rho_p, GRAVITY)
     speed, regime = _core.terminal_velocity(*args)
@@ -193,7 +193,7 @@ class SpheresStudy:
                 plot(self.results, Path(folder) / "terminal_velocities.png")]
 
 
-def study(csv_path: Path, laws=("zhang-li", "zhang-li/smooth"), progress: bool = True) -> SpheresStudy:
+def study(csv_path: Path, laws=("bingham", "zhang-li"), progress: bool = True) -> SpheresStudy:
     """Settles every sphere of the CSV under every law."""
     from tqdm import tqdm
 
