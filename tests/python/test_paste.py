@@ -30,6 +30,22 @@ def test_tsuji_damping_input_is_not_the_restitution():
     assert paste.simulated_restitution(0.612) == pytest.approx(0.709, abs=0.002)
 
 
+def test_the_paste_viscosity_goes_with_its_law():
+    """mould.lmp's defaults are law bingham with the viscosity that puts Zhang & Li's calibration drop where
+    their law with 0.7 Pa s puts it; the studies set the viscosity with the law."""
+    from sediment.sim.deck import index_variables
+
+    defaults = index_variables(paste.EXAMPLES / "in.ball_in_paste")
+    assert defaults["law"] == paste.LAW == "bingham"
+    assert float(defaults["eta_B"]) == paste.PLASTIC_VISCOSITY["bingham"]
+    calibration = paste.calibrate_viscosity("bingham", tolerance=1e-3)
+    assert calibration.plastic_viscosity == pytest.approx(paste.PLASTIC_VISCOSITY["bingham"], abs=2e-3)
+    assert calibration.depth == pytest.approx(calibration.target_depth, rel=2e-3)
+    assert calibration.depth_at_paper_viscosity < 0.9 * calibration.target_depth    # 0.7 Pa s is zhang-li's
+    paper = paste.drop_ball(**paste.CALIBRATION_DROP, law="zhang-li")
+    assert paper.depth == pytest.approx(calibration.target_depth, rel=1e-12)
+
+
 def test_ball_stops_inside_the_paste_and_stays_exactly_still():
     ball = paste.drop_ball(0.0126, 0.255)
     assert 0 < ball.depth < paste.PASTE["surface"] - 0.0126
