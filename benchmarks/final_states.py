@@ -29,7 +29,8 @@ from cost import TAU  # noqa: E402  (of in.cost's grains)
 from sediment.cli.types import count  # noqa: E402
 from sediment.sim.paths import lmp_executable  # noqa: E402
 
-LAWS = ("drag", "nonlinear", "standard", "hindered", "richardson", "bingham", "cells", "zhangli", "schiller")
+LAWS = ("drag", "nonlinear", "standard", "hindered", "richardson", "bingham", "binghamlaw", "cells", "zhangli",
+        "schiller")
 RATIOS = (1e-4, 1e-2, 1.0, 1e2, 1e4)
 FLOOR = "floor z 0.006"    # a floor a third of the way up the box: spheres come to rest on it
 BED_LAWS = ("standard", "dallavalle", "stokes")
