@@ -166,6 +166,7 @@ class ViscosityCalibration:
     in_use: float               # what the decks use with the law (PLASTIC_VISCOSITY) [Pa s]
 
     def table(self) -> Table:
+        """The calibrated viscosity, the drop's depths with it and with 0.7 Pa s, and the viscosity in use."""
         table = Table(["law", "eta_B [Pa s]", "depth [mm]", "depth at 0.7 Pa s [mm]", "zhang-li's depth [mm]",
                        "eta_B in the decks"])
         table.add(self.law, f"{self.plastic_viscosity:.4g}", f"{self.depth * 1e3:.2f}",

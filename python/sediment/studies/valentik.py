@@ -117,14 +117,17 @@ class LawScore:
 
     @property
     def median(self) -> float:
+        """Median of |error|."""
         return float(np.median(np.abs(self.errors)))
 
     @property
     def mean(self) -> float:
+        """Mean of |error|."""
         return float(np.mean(np.abs(self.errors)))
 
     @property
     def worst(self) -> float:
+        """Largest |error|."""
         return float(np.max(np.abs(self.errors)))
 
     @property
