@@ -119,4 +119,4 @@ bench: build
 	$(BUILD)/bench_core_kernels --benchmark_min_time=0.2
 
 clean:
-	rm -rf $(BUILD) $(SANITIZE_BUILD) $(OUT) python/sediment/_core*.so
+	rm -rf $(BUILD) $(SANITIZE_BUILD) $(OUT) build-pip python/sediment/_core*.so
