@@ -13,7 +13,7 @@ export OMPI_ALLOW_RUN_AS_ROOT := 1
 export OMPI_ALLOW_RUN_AS_ROOT_CONFIRM := 1
 export OMP_NUM_THREADS := 1
 
-.PHONY: deps build demo docs test test-cpp test-python check-sanitize test-lammps-current test-lammps-2022 bench clean
+.PHONY: deps build build-demo demo docs test test-cpp test-python check-sanitize test-lammps-current test-lammps-2022 bench clean
 
 deps:
 	@scripts/install-deps.sh
@@ -24,11 +24,17 @@ $(BUILD)/CMakeCache.txt:
 build: deps $(BUILD)/CMakeCache.txt
 	cmake --build $(BUILD) -j $(JOBS)
 
+# What the demo runs, and no more (no tests, benchmarks or plugin): the driver with its styles
+# library, and the Python module.
+DEMO_TARGETS := lmp_sediment _core
+build-demo: deps $(BUILD)/CMakeCache.txt
+	cmake --build $(BUILD) -j $(JOBS) --target $(DEMO_TARGETS)
+
 # Sample 5 of Bravo et al. end to end: the effects planner decides what the test calls for (drag,
 # hindrance, parcels, Courant number; its runs take about a minute on 2 cores), then the decided scene
 # runs in the D422 column for 24 h of settling, then the hydrometer, buoyancy-sphere and pipette readouts.
 # A rerun replaces the demo's previous results.
-demo: build
+demo: build-demo
 	bin/sediment plan examples/granulometry/psd/sample5.csv --out $(OUT)/sample5/plan --jobs $(JOBS)
 	SEDIMENT_RANKS=$(JOBS) SEDIMENT_REPLACE=1 examples/granulometry/run.sh sample5 $(OUT)/sample5 \
 	    --plan $(OUT)/sample5/plan/report.json
