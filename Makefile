@@ -1,8 +1,9 @@
 # SPDX-License-Identifier: GPL-2.0-or-later
 # SEDIMENT: the two commands of the README, and their steps.
 #   make demo   installs what is missing, builds, runs the main example and says where its output is
-#   make test   installs what is missing, builds, runs every test (also under the sanitizers, and the
-#               deck tests on the current LAMMPS release, and the documentation site)
+#   make test   installs what is missing, builds, runs every test (also under the sanitizers, the deck
+#               tests on LAMMPS built from source with SEDIMENT in its tree, Debian 12's release and the
+#               current one, and the documentation site)
 #   make docs   the documentation site in build/docs (Sphinx, warnings as errors)
 BUILD   ?= build
 PYTHON  := /usr/bin/python3
@@ -12,7 +13,7 @@ export OMPI_ALLOW_RUN_AS_ROOT := 1
 export OMPI_ALLOW_RUN_AS_ROOT_CONFIRM := 1
 export OMP_NUM_THREADS := 1
 
-.PHONY: deps build demo docs test test-cpp test-python check-sanitize test-lammps-current bench clean
+.PHONY: deps build build-demo demo docs test test-cpp test-python check-sanitize test-lammps-current test-lammps-2022 bench clean
 
 deps:
 	@scripts/install-deps.sh
@@ -23,11 +24,17 @@ $(BUILD)/CMakeCache.txt:
 build: deps $(BUILD)/CMakeCache.txt
 	cmake --build $(BUILD) -j $(JOBS)
 
+# What the demo runs, and no more (no tests, benchmarks or plugin): the driver with its styles
+# library, and the Python module.
+DEMO_TARGETS := lmp_sediment _core
+build-demo: deps $(BUILD)/CMakeCache.txt
+	cmake --build $(BUILD) -j $(JOBS) --target $(DEMO_TARGETS)
+
 # Sample 5 of Bravo et al. end to end: the effects planner decides what the test calls for (drag,
 # hindrance, parcels, Courant number; its runs take about a minute on 2 cores), then the decided scene
 # runs in the D422 column for 24 h of settling, then the hydrometer, buoyancy-sphere and pipette readouts.
 # A rerun replaces the demo's previous results.
-demo: build
+demo: build-demo
 	bin/sediment plan examples/granulometry/psd/sample5.csv --out $(OUT)/sample5/plan --jobs $(JOBS)
 	SEDIMENT_RANKS=$(JOBS) SEDIMENT_REPLACE=1 examples/granulometry/run.sh sample5 $(OUT)/sample5 \
 	    --plan $(OUT)/sample5/plan/report.json
@@ -54,15 +61,18 @@ check-sanitize: build
 	  UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1 && ctest -j $(JOBS) --output-on-failure -E '\.np2$$' && \
 	  ctest -j $(JOBS) --output-on-failure -R '(lubrication|layers_hdf5|restart_state|uniform_fast_path)\.np2$$'
 
-# The current LAMMPS (Debian sid's source package, about 7 min to build at -j2 the first time): SEDIMENT
-# installed in its tree runs every deck test (in-tree route), and this project built against it runs
-# the style checks as a plugin loaded at start and through its lmp_sediment (plugin and driver
-# routes). The LAMMPS tree and build are a cache outside the checkout, shared by every clone on the
-# machine: a later run reinstalls this checkout's SEDIMENT files and recompiles only those.
-CURRENT ?= $(or $(XDG_CACHE_HOME),$(HOME)/.cache)/sediment/lammps-current
+# LAMMPS built from Debian's source packages with SEDIMENT installed in the tree (the in-tree route),
+# by scripts/build-lammps.sh: the tree and its build are a cache outside the checkout, shared by every
+# clone on the machine, built once per machine; a later run reinstalls this checkout's SEDIMENT files
+# and recompiles only those.
+LAMMPS_CACHE ?= $(or $(XDG_CACHE_HOME),$(HOME)/.cache)/sediment
+# The current LAMMPS (Debian sid's source package, about 7 min to build at -j2 the first time): every
+# deck test on its lmp (in-tree route), and this project built against it runs the style checks as a
+# plugin loaded at start and through its lmp_sediment (plugin and driver routes).
+CURRENT ?= $(LAMMPS_CACHE)/lammps-current
 CURRENT_SEDIMENT ?= $(BUILD)/lammps-current-sediment
 test-lammps-current: build
-	scripts/build-lammps-current.sh $(CURRENT)
+	scripts/build-lammps.sh current $(CURRENT)
 	cmake -S . -B $(CURRENT_SEDIMENT) -DCMAKE_BUILD_TYPE=Release -DSEDIMENT_BUILD_PYTHON=OFF \
 	      -DLAMMPS_SOURCE_DIR=$(abspath $(CURRENT))/lammps/src \
 	      -DLAMMPS_LIBRARY=$(abspath $(CURRENT))/build/liblammps.so \
@@ -78,6 +88,23 @@ test-lammps-current: build
 	@! grep -E "missing" $(CURRENT)/check-packages.txt
 	@echo "check-packages: $$(head -1 $(CURRENT)/check-packages.txt), none missing"
 
+# Debian 12's LAMMPS, 29 Sep 2021 (Debian 20220106), built from its source package with SEDIMENT in the
+# tree (its CMake sets C++11; the package's module raises the lammps target to C++17; about 5 min to
+# build at -j2 the first time): on its lmp, the style checks (every style's pinned regression and
+# restart replay, 1 and 2 ranks) and the comparison of rank counts. Every other deck test runs on
+# the same release through test-cpp's lmp_sediment (Debian's liblammps). Nothing is built in
+# LAMMPS_2022_SEDIMENT: it is this project configured to register the deck tests on that lmp; the
+# decks' checks use the Python module of $(BUILD).
+LAMMPS_2022 ?= $(LAMMPS_CACHE)/lammps-2022
+LAMMPS_2022_SEDIMENT ?= $(BUILD)/lammps-2022-sediment
+test-lammps-2022: build
+	scripts/build-lammps.sh 2022 $(LAMMPS_2022)
+	cmake -S . -B $(LAMMPS_2022_SEDIMENT) -DCMAKE_BUILD_TYPE=Release -DSEDIMENT_BUILD_PYTHON=OFF \
+	      -DLAMMPS_SOURCE_DIR=$(abspath $(LAMMPS_2022))/lammps/src \
+	      -DLAMMPS_LIBRARY=$(abspath $(LAMMPS_2022))/build/liblammps.so \
+	      -DSEDIMENT_DECK_LMP=$(abspath $(LAMMPS_2022))/build/lmp >/dev/null
+	cd $(LAMMPS_2022_SEDIMENT) && ctest -j $(JOBS) -L deck -R '^deck\.(style_|mpi_consistency)' --output-on-failure
+
 # The documentation site (Sphinx from Debian's packages, warnings as errors): the README and docs/,
 # the style pages, the notebook as a tutorial and the Python API from its docstrings.
 docs: build
@@ -85,7 +112,7 @@ docs: build
 	SEDIMENT_PYTHON=$(abspath python) $(PYTHON) -m sphinx -W --keep-going -q -b html $(BUILD)/docs-src $(BUILD)/docs
 	@echo "docs: $(BUILD)/docs/index.html"
 
-test: test-cpp test-python docs check-sanitize test-lammps-current
+test: test-cpp test-python docs check-sanitize test-lammps-current test-lammps-2022
 
 # Cost of each effect per particle-step, as ratios measured in one run; the same against the peer at
 # every dt/tau from 1e-4 to 1e4; the settling bed with contacts under each law against fix viscous;
@@ -98,4 +125,4 @@ bench: build
 	$(BUILD)/bench_core_kernels --benchmark_min_time=0.2
 
 clean:
-	rm -rf $(BUILD) $(SANITIZE_BUILD) $(OUT) python/sediment/_core*.so
+	rm -rf $(BUILD) $(SANITIZE_BUILD) $(OUT) build-pip python/sediment/_core*.so

@@ -1,5 +1,8 @@
 # SPDX-License-Identifier: GPL-2.0-or-later
-"""Builds the extension sediment._core from the physics core (pyproject.toml has the rest)."""
+"""Builds the extension sediment._core from the physics core (pyproject.toml has the rest).
+
+setuptools works in build-pip/, not in build/: build/ is CMake's (make build), and pip install .
+must not write into it."""
 from glob import glob
 
 from pybind11.setup_helpers import Pybind11Extension
@@ -12,4 +15,4 @@ core = Pybind11Extension(
     cxx_std=17,
 )
 
-setup(ext_modules=[core])
+setup(ext_modules=[core], options={"build": {"build_base": "build-pip"}})

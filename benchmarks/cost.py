@@ -14,14 +14,18 @@ ratio of the best times and as the median of the ratios of back-to-back pairs (r
 machine's drift during the run): on a machine whose speed drifts by 10 % between runs, the way to
 measure one change.
 
-With --counts the scenes run under valgrind's cachegrind instead of the clock, on a model of one
+With --counts the scenes run under valgrind's callgrind instead of the clock, on a model of one
 core of this machine (32 KiB L1 data cache, the 512 KiB L2 as the last level; what misses it comes
 from the 32 MiB L3): instructions, L1 and L2 data misses per particle-step, from the difference of a
-run of `steps` and one of 3 x `steps` (so start-up cancels), and a rough estimate of cycles that
+run of `steps` and one of 3 x `steps` (so the run's set-up cancels), and a rough estimate of cycles that
 charges each L1 miss the L2's latency and each L2 miss the L3's (12 and 40 cycles; no overlap, no
-prefetch). The counts are the same from run to run within 0.1 % at the default size (start-up, which
-varies by some ten thousand instructions, cancels but for that): a change of 2 % shows where the
-clock's noise on a shared machine hides it. Default 20 000 particles x 50 steps (about 10 minutes for all scenes).
+prefetch). Only the time-step loop is counted (LAMMPS_NS::Verlet::run; callgrind's --toggle-collect):
+outside it, MPI's start-up polls for as long as its daemon takes to answer, so a whole-program count
+moved with the machine's load (cachegrind, plain scene: 214.8 and 215.2 per particle-step in two runs
+beside a LAMMPS build, 215.9 and 211.0 on a busier machine). Inside it
+the instruction counts are the same from run to run, to the instruction; the misses move by a few
+per million particle-steps with where the heap lands. A change of 2 % shows where the clock's noise
+on a shared machine hides it. Default 20 000 particles x 50 steps (about 10 minutes for all scenes).
 """
 from __future__ import annotations
 
@@ -79,34 +83,42 @@ L2_LATENCY, L3_LATENCY = 12, 40    # cycles charged per L1 miss and per L2 miss 
 EVENTS = ("Ir", "D1mr", "D1mw", "DLmr", "DLmw")
 
 
-def cachegrind_totals(text: str) -> dict[str, int]:
-    """The program totals of a cachegrind output file (its "events:" and "summary:" lines)."""
+# The time-step loop, the only part of a run counted: the scenes' decks make one `run` each.
+COUNTED = "LAMMPS_NS::Verlet::run(int)"
+
+
+def valgrind_totals(text: str) -> dict[str, int]:
+    """The totals of a callgrind (or cachegrind) output file (its "events:" and "summary:" lines)."""
     lines = dict(line.split(":", 1) for line in text.splitlines() if line.startswith(("events:", "summary:")))
     if "events" not in lines or "summary" not in lines:
-        raise ValueError("not a cachegrind output file (no events or summary line)")
+        raise ValueError("not a callgrind or cachegrind output file (no events or summary line)")
     names, values = lines["events"].split(), lines["summary"].split()
     if len(names) != len(values):
-        raise ValueError("cachegrind output: the summary does not match the events")
+        raise ValueError("valgrind output: the summary does not match the events")
     return dict(zip(names, map(int, values)))
 
 
 def counts_per_step(scene: str, particles: int, steps: int, lmp: Path | None = None,
                     dt: float = 1e-4) -> dict[str, float]:
-    """Instructions, L1 and L2 data misses per particle-step, and the estimate of cycles."""
+    """Instructions, L1 and L2 data misses per particle-step in the time-step loop, and the estimate
+    of cycles."""
     if shutil.which("valgrind") is None:
         sys.exit("cost.py --counts needs valgrind (Debian package valgrind)")
     totals = []
     with tempfile.TemporaryDirectory() as tmp:
         for run_steps in (steps, 3 * steps):
             out = Path(tmp) / f"{scene}.{run_steps}"
-            cmd = ["valgrind", "--tool=cachegrind", *CACHE_MODEL, f"--cachegrind-out-file={out}",
+            cmd = ["valgrind", "--tool=callgrind", *CACHE_MODEL, "--collect-atstart=no", f"--toggle-collect={COUNTED}",
+                   f"--callgrind-out-file={out}",
                    str(lmp or lmp_executable()), "-in", str(HERE / "in.cost"), "-log", "none", "-screen", "none",
                    "-var", "scene", scene, "-var", "n", str(particles), "-var", "steps", str(run_steps),
                    "-var", "dt", repr(dt)]
             done = subprocess.run(cmd, capture_output=True, text=True, env=dict(os.environ, OMP_NUM_THREADS="1"))
             if done.returncode != 0:
-                sys.exit(f"cost.py --counts: scene {scene} failed under cachegrind:\n{done.stderr[-2000:]}")
-            totals.append(cachegrind_totals(out.read_text()))
+                sys.exit(f"cost.py --counts: scene {scene} failed under callgrind:\n{done.stderr[-2000:]}")
+            totals.append(valgrind_totals(out.read_text()))
+            if totals[-1]["Ir"] == 0:
+                sys.exit(f"cost.py --counts: no instruction counted in {COUNTED} (a LAMMPS without its symbols?)")
     per = {e: (totals[1][e] - totals[0][e]) / (particles * 2 * steps) for e in EVENTS}
     l1, l2 = per["D1mr"] + per["D1mw"], per["DLmr"] + per["DLmw"]
     return {"instructions": per["Ir"], "L1 misses": l1, "L2 misses": l2,
@@ -148,7 +160,7 @@ def report_counts(scenes: dict[str, str], args: argparse.Namespace) -> None:
     steps = args.steps if args.steps_given else 50
     columns = ("instructions", "L1 misses", "L2 misses", "cycles (est.)")
     print(f"{args.particles} particles x ({steps}, {3 * steps}) steps at dt {args.dt:g} s (dt/tau {args.dt / TAU:.3g}) "
-          "under cachegrind, per particle-step")
+          "in the time-step loop under callgrind, per particle-step")
     print(f"{'scene':10s} " + " ".join(f"{c:>13s}" for c in columns) + (f" {'this/baseline':>14s}" if args.baseline
                                                                          else "") + "  what")
     cycles = {}
@@ -192,7 +204,7 @@ def main() -> None:
     parser.add_argument("--scenes", type=scene_list, default=list(SCENES),
                         help="comma-separated scenes to run (default: all; plain and peer always run, the ratios need them)")
     parser.add_argument("--counts", action="store_true",
-                        help="instructions and cache misses under cachegrind instead of the clock (see above)")
+                        help="instructions and cache misses under callgrind instead of the clock (see above)")
     parser.add_argument("--dt", type=float, default=1e-4,
                         help="time step of the scenes [s] (default 1e-4: dt/tau = 0.76 for their 30 um grains)")
     parser.add_argument("--sweep", action="store_true",

@@ -3,6 +3,11 @@
 # sources (installed by lammps-pkg/install-in-tree.sh). fix layers/hdf5 writes HDF5 (serial
 # interface, rank 0 only); the physics core's headers sit in src/SEDIMENT/sediment/.
 enable_language(C)
+# The styles and the physics core are C++17 (std::optional, std::string_view, std::clamp). A tree may set
+# less for itself (LAMMPS 29 Sep 2021, Debian 12's, sets CMAKE_CXX_STANDARD 11 unconditionally, so
+# -D CMAKE_CXX_STANDARD=17 is ignored): ask for C++17 on the target, which raises the standard where
+# the tree's is lower and leaves a higher one as it is.
+target_compile_features(lammps PUBLIC cxx_std_17)
 set(HDF5_PREFER_PARALLEL FALSE)
 find_package(HDF5 COMPONENTS C REQUIRED)
 if((NOT BUILD_MPI) AND HDF5_IS_PARALLEL)

@@ -9,8 +9,6 @@ LAMMPS, scenes, layer files), `sediment.studies` (validation and accuracy studie
 The names below are loaded when first used, so that the parts that need no compiled code (running
 decks, reading layer files) import before the extension is built.
 """
-from __future__ import annotations
-
 __version__ = "0.1.0"
 
 _CORE = ("DragModel", "critical_yield_number", "drag_coefficient", "drag_law_names", "explicit_step_limit",
@@ -38,6 +36,6 @@ def __getattr__(name: str):
     raise AttributeError(f"module 'sediment' has no attribute '{name}'")
 
 
-def __dir__() -> list[str]:
-    """The module's own names and those loaded on first use, for dir() and completion."""
-    return sorted(set(globals()) | set(__all__))
+def __dir__():
+    """What a user calls (the names loaded on first use) and the version, for dir() and completion."""
+    return sorted(__all__ + ["__version__"])

@@ -26,18 +26,19 @@ def benchmark_script(name: str) -> ModuleType:
 
 @pytest.fixture(scope="session")
 def installed(tmp_path_factory) -> Path:
-    """The package installed by the README's own pip command into a venv (returns the venv), with a
-    Jupyter kernel of its own, 'sediment-venv', as a user would add one."""
+    """The package installed by the README's own pip command into a venv (returns the venv), from a
+    copy of what a checkout holds for it. setuptools must leave build/ (CMake's) alone."""
     source = tmp_path_factory.mktemp("install") / "src"
     source.mkdir()
     for name in ("pyproject.toml", "setup.py", "README.md", "LICENSE"):
         shutil.copy(REPO / name, source / name)
     shutil.copytree(REPO / "core", source / "core")
-    shutil.copytree(REPO / "python", source / "python", ignore=shutil.ignore_patterns("_core*.so", "__pycache__"))
+    shutil.copytree(REPO / "examples", source / "examples")
+    # python/sediment/examples stays the link it is in the checkout
+    shutil.copytree(REPO / "python", source / "python", symlinks=True,
+                    ignore=shutil.ignore_patterns("_core*.so", "__pycache__"))
     command = next(line.strip() for line in (REPO / "README.md").read_text().splitlines()
                    if "pip install" in line and line.strip().startswith("/usr/bin/python3 -m venv"))
     subprocess.run(["bash", "-c", command], check=True, cwd=source, capture_output=True)
-    venv = source / ".venv"
-    subprocess.run([venv / "bin" / "python", "-m", "ipykernel", "install", "--prefix", venv, "--name", "sediment-venv"],
-                   check=True, capture_output=True)
-    return venv
+    assert not (source / "build").exists() and (source / "build-pip").is_dir()
+    return source / ".venv"

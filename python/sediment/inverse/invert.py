@@ -193,7 +193,13 @@ def sieve_data(sieve: SieveSheet | None, split: float | None, noise: float) -> S
 def invert(sheets: list[Sheet], test: LabTest, folder: Path, *, sieve: SieveSheet | None = None,
            split: float | None = None, bins: int = 24, particles: int = 20000, courant: float = 4.0, rounds: int = 4,
            draws: int = 64, seed: int = 1, budget_band: float = 0.0) -> Inversion:
-    """Recovers the PSD the sheets were read from (docs/inverse.md, the method).
+    """Recovers a sample's particle-size distribution from a laboratory's sheets of readings.
+
+    The readings are simulated: DEM runs of the test in its cylinder, with the instruments reading
+    the simulated column at the sheets' times. The masses of size bins whose simulated readings (and
+    the sieves' percent passing, when given) match the sheets' are found by a constrained least
+    squares; further runs with the fitted PSD update the hindrance, and draws of the data's noise
+    give the band. The method and its limits are described in docs/inverse.md.
 
     Parameters
     ----------
@@ -211,13 +217,21 @@ def invert(sheets: list[Sheet], test: LabTest, folder: Path, *, sieve: SieveShee
     bins : int
         Size bins between the finest and the coarsest reading's cut.
     particles, courant : int, float
-        Resolution of the forward runs (`sediment sample`'s defaults).
+        Resolution of the forward runs: simulated parcels, and the Courant number of their time steps.
     rounds : int
         Forward runs at most.
     draws : int
         Draws of the PSDs the data allow, for the band (their central 95 %) and the texture.
+    seed : int
+        Seed of the draws.
     budget_band : float
         Points of percent finer the physics' uncertainty adds (an error budget's physical total).
+
+    Returns
+    -------
+    Inversion
+        The PSD of the whole sample with its band, what pins each diameter, the standard reduction,
+        the fit and its verdict.
     """
     if not sheets:
         raise ValueError("no sheet of readings to invert (a sieve sheet alone gives no sedimentation data)")
