@@ -31,6 +31,7 @@ from __future__ import annotations
 
 import argparse
 import os
+import re
 import shutil
 import statistics
 import subprocess
@@ -195,6 +196,32 @@ def scene_list(text: str) -> list[str]:
     return names
 
 
+def machine_and_build(lmp: Path | None = None, under_valgrind: bool = False) -> str:
+    """What a figure was measured on: the CPU and its vector extensions, the LAMMPS release and the
+    compiler of the build (lmp -h), and the vector copy of the block step that ran (the fix's log line;
+    under valgrind, whose CPU has no AVX-512, the copy valgrind's run takes)."""
+    exe = str(lmp or lmp_executable())
+    cpu, flags = "unknown CPU", set()
+    with open("/proc/cpuinfo") as f:
+        for line in f:
+            key, _, value = line.partition(":")
+            if key.strip() == "model name" and cpu == "unknown CPU":
+                cpu = value.strip()
+            elif key.strip() == "flags" and not flags:
+                flags = set(value.split())
+    extensions = ", ".join(x for x in ("avx2", "fma", "avx512f") if x in flags) or "none of avx2, fma, avx512f"
+    about = subprocess.run([exe, "-h"], capture_output=True, text=True).stdout.splitlines()
+    release = next((l.split(" - ", 1)[1].strip() for l in about if l.startswith("Large-scale")), "unknown release")
+    compiler = next((l.split(":", 1)[1].strip() for l in about if l.startswith("Compiler:")), "unknown compiler")
+    probe = ([exe] if not under_valgrind else ["valgrind", "--tool=none", exe]) + [
+        "-in", str(HERE / "in.cost"), "-log", "none", "-var", "scene", "nonlinear", "-var", "n", "64", "-var",
+        "steps", "2"]
+    printed = subprocess.run(probe, capture_output=True, text=True).stdout
+    copy = re.search(r"stepped in blocks, (\w+) vectors", printed)
+    return (f"machine: {cpu} ({extensions}); build: {exe}, LAMMPS {release}, compiler (lmp -h) {compiler}; block step in "
+            f"{copy.group(1) if copy else 'unknown'} vectors")
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--particles", type=count, default=20000)
@@ -216,6 +243,9 @@ def main() -> None:
     # The references run where they can (EXPLICIT_LIMIT; --sweep takes the peer's cost at dt/tau = 1 past it).
     references = ("plain", "peer") if args.counts or args.sweep or args.dt <= EXPLICIT_LIMIT * TAU else ()
     scenes = {s: SCENES[s] for s in SCENES if s in args.scenes or s in references}
+    print(machine_and_build(under_valgrind=args.counts))
+    if args.baseline:
+        print("baseline " + machine_and_build(args.baseline, under_valgrind=args.counts).split("; ", 1)[1])
     if args.counts:
         report_counts(scenes, args)
         return

@@ -73,7 +73,7 @@ constexpr double zhang_li_high = 150.0;
 // Schiller-Naumann's Cd Re given power = Re^0.687 (used below the switch only): a batch takes the
 // powers from exp_many and log_many, one sphere from std::pow.
 constexpr double schiller_naumann_exponent = 0.687;
-inline DragCurve schiller_naumann_curve(double re, double power)
+[[gnu::always_inline]] inline DragCurve schiller_naumann_curve(double re, double power)
 {
   if (re <= schiller_naumann_switch) {
     const double p = 0.15 * power;
@@ -108,25 +108,25 @@ constexpr Range high[4] = {
     {4.4e4, {-1.91838447528945, 0.637, -0.0636, 0.0}},
     {1e300, {-4.3392290555769892, 1.5809, -0.1546, 0.0}},
 };
-inline const Range &range_of(double re)
+[[gnu::always_inline]] inline const Range &range_of(double re)
 {
   return re < high[0].upper ? high[0] : re < high[1].upper ? high[1] : re < high[2].upper ? high[2] : high[3];
 }
-inline double clamp_log(double log_re) { return log_re < -700.0 ? -700.0 : log_re; }
+[[gnu::always_inline]] inline double clamp_log(double log_re) { return log_re < -700.0 ? -700.0 : log_re; }
 // The lowest piece (Re < low_to_mid, where a settling grain's Reynolds number mostly is) on its own,
 // for a batch that lies wholly in it: no look-up of the ranges above.
-inline double low_argument(double log_re)
+[[gnu::always_inline]] inline double low_argument(double log_re)
 {
   const double w = log_re * (1.0 / ln10);
   return log_low_coeff + (0.82 - 0.05 * w) * log_re;
 }
-inline DragCurve low_curve(double log_re, double power)
+[[gnu::always_inline]] inline DragCurve low_curve(double log_re, double power)
 {
   const double w = log_re * (1.0 / ln10);
   return {24.0 * (1.0 + power), 24.0 * power * (0.82 - 0.1 * w)};
 }
 // The argument whose exponential the piece of Re needs.
-inline double argument(double re, double log_re)
+[[gnu::always_inline]] inline double argument(double re, double log_re)
 {
   const double w = log_re * (1.0 / ln10);
   if (re < low_to_mid) return low_argument(log_re);
@@ -135,7 +135,7 @@ inline double argument(double re, double log_re)
   return log_re + ln10 * (r.c[0] + w * (r.c[1] + w * (r.c[2] + w * r.c[3])));
 }
 // Cd Re and Re d(Cd Re)/dRe from Re, ln Re and the exponential of argument().
-inline DragCurve curve(double re, double log_re, double power)
+[[gnu::always_inline]] inline DragCurve curve(double re, double log_re, double power)
 {
   const double w = log_re * (1.0 / ln10);
   if (re < low_to_mid) return low_curve(log_re, power);
@@ -169,7 +169,7 @@ struct Constants {
 };
 constexpr Constants fitted{0.0101, 8.05};
 // H and Re dH/dRe.
-inline DragCurve yield_curve(double re, Constants constants)
+[[gnu::always_inline]] inline DragCurve yield_curve(double re, Constants constants)
 {
   const double x = constants.yield_weight * re;
   const double inverse = 1.0 / (1.0 + x);
@@ -178,8 +178,9 @@ inline DragCurve yield_curve(double re, Constants constants)
 }
 }    // namespace bingham_law
 
-// Inline: the integrator's per-atom loops evaluate it with the law fixed for the whole run.
-inline DragCurve drag_curve(DragLaw law, double re)
+// Always inline: the integrator's per-atom loops evaluate it with the law fixed for the whole run, in
+// the vectors of their instruction set (GCC 12 kept it out of line, a call per sphere into SSE code).
+[[gnu::always_inline]] inline DragCurve drag_curve(DragLaw law, double re)
 {
   switch (law) {
     case DragLaw::Stokes:
@@ -227,7 +228,7 @@ struct DragScale {
 };
 // The voidage around a sphere from the local solid fraction, capped at max_fraction (where grains stop
 // on a floor without contacts their grid fraction exceeds any packing, even 1).
-inline double voidage_of(double fraction, double max_fraction) { return 1.0 - std::clamp(fraction, 0.0, max_fraction); }
+[[gnu::always_inline]] inline double voidage_of(double fraction, double max_fraction) { return 1.0 - std::clamp(fraction, 0.0, max_fraction); }
 
 // Di Felice (1994) exponent chi(Re) = 3.7 - 0.65 exp(-(1.5 - log10 Re)^2 / 2) and Re d chi / d Re.
 struct Exponent {
@@ -235,7 +236,7 @@ struct Exponent {
   double re_slope;
 };
 // chi from t = 1.5 - log10 Re and gauss = exp(-t^2 / 2).
-inline Exponent di_felice_exponent(double t, double gauss)
+[[gnu::always_inline]] inline Exponent di_felice_exponent(double t, double gauss)
 {
   const double bump = 0.65 * gauss;
   return {3.7 - bump, -bump * t / ln10};    // Re d/dRe of -bump = -bump t / ln 10
@@ -255,7 +256,7 @@ struct ExponentFit {
 constexpr ExponentFit rowe_exponent{4.7, 0.41 / 0.175, 0.175, 0.75};
 constexpr ExponentFit garside_exponent{5.1, 2.7, 0.1, 0.9};
 // n and Re dn/dRe from k = K (scale Re^power).
-inline Exponent richardson_zaki_exponent(const ExponentFit &fit, double k)
+[[gnu::always_inline]] inline Exponent richardson_zaki_exponent(const ExponentFit &fit, double k)
 {
   const double inverse = 1.0 / (1.0 + k);
   return {(fit.low + fit.high * k) * inverse, (fit.high - fit.low) * fit.power * k * inverse * inverse};
