@@ -88,7 +88,7 @@ test-lammps-current: build
 	@! grep -E "missing" $(CURRENT)/check-packages.txt
 	@echo "check-packages: $$(head -1 $(CURRENT)/check-packages.txt), none missing"
 
-# Debian 12's LAMMPS, 29 Sep 2021 (Debian 20220106), built from its source package with SEDIMENT in the
+# Debian 12's LAMMPS, 29 Sep 2021 (Debian 12, 20220106), built from its source package with SEDIMENT in the
 # tree (its CMake sets C++11; the package's module raises the lammps target to C++17; about 5 min to
 # build at -j2 the first time): on its lmp, the style checks (every style's pinned regression and
 # restart replay, 1 and 2 ranks) and the comparison of rank counts. Every other deck test runs on

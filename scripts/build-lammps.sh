@@ -4,7 +4,7 @@
 # tree (the in-tree route), for testing the package on the releases the README names:
 #   scripts/build-lammps.sh RELEASE DEST
 # RELEASE: current   the current release (Debian sid's source package; 4 Jul 2026 when written)
-#          2022      Debian 12's release, 29 Sep 2021 (Debian 20220106): the source package of the
+#          2022      29 Sep 2021 (Debian 12, 20220106): the source package of the
 #                    installed liblammps-dev (bookworm's newest without it), whose tree sets C++11
 # DEST/lammps: the source tree (src, cmake, doc) with SEDIMENT installed (lammps-pkg/install-in-tree.sh);
 # DEST/build: liblammps.so and lmp with GRANULAR, PLUGIN and SEDIMENT, MPI, no FFT library.

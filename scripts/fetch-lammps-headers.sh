@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # SPDX-License-Identifier: GPL-2.0-or-later
-# Unpack the LAMMPS headers that exactly match Debian's liblammps (29 Sep 2021 update 2) into DEST.
+# Unpack the LAMMPS headers that exactly match Debian's liblammps, 29 Sep 2021 (Debian 12, 20220106), into DEST.
 # liblammps-dev ships only part of the headers and none of the embedded fmt 7 library, so we take them
 # from the Debian source package of the same version. Nothing of LAMMPS is committed to the project.
 set -euo pipefail
