@@ -148,7 +148,7 @@ double DragModel::slope_at(double d, double speed, DragCurve g, DragCurve g_yiel
   if (!split_yield_) {
     double dforce = eta_d * g.g;
     // (tau_y + eta s / d) G' dRe'/ds with dRe'/ds = Re' (2 tau_y + eta s / d) / (s (tau_y + eta s / d))
-    if (speed > 0.0) dforce += g.re_dg * (2.0 * fluid_.yield_stress + eta_d * speed) / speed;
+    if (speed > 0.0) dforce += g.re_dg * (2.0 * fluid_.yield_stress + fluid_.viscosity * speed / d) / speed;
     return scale.area * half_area * dforce;
   }
   // d/ds of (eta s / d) G + tau_y H at Re_w: dRe_w/ds = Re_w (2 w tau_y + eta s / d) / (s (w tau_y + eta s / d))
