@@ -451,9 +451,10 @@ template <bool yield>
   for (int n = 0; n < size_; ++n)    // as advance_all found it (kept there, it cost the smooth laws a store)
     end_speed[n] = advance(Phi{decay_[0][n], phi1_[0][n], phi2_[0][n]}, speed_[n], c_[n], dt).speed;
   if constexpr (yield) {
+    const double weight = model.yield_weight();
     for (int n = 0; n < size_; ++n) {
       const double s0 = speed_[n], s1 = end_speed[n];
-      const double re_end = reynolds_per_speed_[n] * s1 * s1 / (s1 + model.yield_weight() * yield_speed_[n]);
+      const double re_end = reynolds_per_speed_[n] * s1 * s1 / (s1 + weight * yield_speed_[n]);
       low[n] = std::min(reynolds_[n], re_end) * (1.0 - margin);
       high[n] = std::max(reynolds_[n], re_end) * (1.0 + margin);
       meets_point_[n] = (!(s0 > 0.0)) | (s1 < 0.0);

@@ -98,13 +98,18 @@ def settle(sphere: Sphere, law: str = "bingham", steps: int = 2000) -> Settling:
     return Settling(sphere, law, speed, regime, out.results["speed"])
 
 
+def net_weight(sphere: Sphere) -> float:
+    """The sphere's weight less its buoyancy in the suspension [N]."""
+    return (sphere.rho_p - sphere.rho_f) * GRAVITY * math.pi / 6 * sphere.d ** 3
+
+
 def law_speeds(spheres: list[Sphere], law: str, **constants: float) -> np.ndarray:
     """Terminal speeds [m/s] of the spheres under a law, from the physics core (0 for a sphere held at
     rest); `constants`: yield_weight and yield_rise for law bingham."""
     out = np.empty(len(spheres))
     for i, s in enumerate(spheres):
         model = _core.DragModel(law, s.rho_f, s.eta_B, s.tau_y, **constants)
-        out[i] = model.steady_speed(s.d, (s.rho_p - s.rho_f) * GRAVITY * math.pi / 6 * s.d ** 3)[0]
+        out[i] = model.steady_speed(s.d, net_weight(s))[0]
     return out
 
 
@@ -153,7 +158,7 @@ def fit_bingham(spheres: list[Sphere]) -> dict[str, float]:
     """Law bingham's yield_weight and yield_rise fitted on the spheres (see FIT_LOSS_SCALE)."""
     from scipy.optimize import least_squares
 
-    weights = np.array([(s.rho_p - s.rho_f) * GRAVITY * math.pi / 6 * s.d ** 3 for s in spheres])
+    weights = np.array([net_weight(s) for s in spheres])
 
     def residuals(x: np.ndarray) -> np.ndarray:
         forces = [_core.DragModel("bingham", s.rho_f, s.eta_B, s.tau_y, yield_weight=x[0], yield_rise=x[1])
