@@ -4,7 +4,8 @@
 The physics lives in one C++ core (sediment._core), shared with the LAMMPS styles. The package is
 grouped by role: `sediment.lab` (PSDs, instruments, readouts, calibrations), `sediment.sim` (running
 LAMMPS, scenes, layer files), `sediment.studies` (validation and accuracy studies) and
-`sediment.cli` (the `sediment` command); `sediment.constants` and `sediment.results` serve them all.
+`sediment.cli` (the `sediment` command); `sediment.constants`, `sediment.results` and
+`sediment.folders` (who may write what in a folder of results) serve them all.
 
 The names below are loaded when first used, so that the parts that need no compiled code (running
 decks, reading layer files) import before the extension is built.

@@ -6,15 +6,11 @@ leaves the previous file or none, never a partial one.
 """
 from __future__ import annotations
 
-import ctypes
-import fcntl
 import os
-import shutil
 import tempfile
-from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Callable, Iterator, Protocol, Sequence
+from typing import Callable, Protocol, Sequence
 
 
 @dataclass
@@ -92,76 +88,3 @@ def write_atomic(path: Path, write: Callable[[Path], None]) -> Path:
 def write_text(path: Path, text: str) -> Path:
     """Writes `text` to `path` atomically (see `write_atomic`)."""
     return write_atomic(path, lambda tmp: tmp.write_text(text))
-
-
-SAVED = ".sediment-saved"    # the files of the last result saved in a folder, one per line
-
-
-def hold_one(folder: Path, written: list[Path]) -> list[Path]:
-    """Makes `folder` hold one result: the files an earlier save there listed and this one did not
-    write (another instrument's table, say) are removed, and this save's files are listed. Returns
-    `written`."""
-    folder = Path(folder)
-    listed = folder / SAVED
-    names = {Path(p).name for p in written}
-    if listed.is_file():
-        for name in listed.read_text().split("\n"):
-            if name and name not in names and "/" not in name:
-                (folder / name).unlink(missing_ok=True)
-    write_text(listed, "".join(f"{n}\n" for n in sorted(names)))
-    return written
-
-
-@contextmanager
-def exclusive(path: Path, busy: str) -> Iterator[None]:
-    """Holds an exclusive lock on the file `path` (created, holding this process's id) for the block;
-    RuntimeError naming the holder and `busy` (what to do) if another process has it."""
-    with open(path, "a+") as handle:
-        try:
-            fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
-        except BlockingIOError:
-            handle.seek(0)
-            raise RuntimeError(f"another sediment command (pid {handle.read().strip() or '?'}) is using "
-                               f"{path.parent}; {busy}") from None
-        handle.seek(0)
-        handle.truncate()
-        handle.write(str(os.getpid()))
-        handle.flush()
-        yield
-
-
-@contextmanager
-def staged_folder(out: Path) -> Iterator[Path]:
-    """A new folder beside `out` to write a whole result into. When the block ends normally it takes
-    the place of `out` in one step (the old folder then removed); if the block fails or is
-    interrupted it is removed and `out` is as it was. Folders of a process that died are cleared."""
-    out = Path(out)
-    out.parent.mkdir(parents=True, exist_ok=True)
-    for stale in [*out.parent.glob(f".{out.name}.new-*"), *out.parent.glob(f".{out.name}.old-*")]:
-        pid = stale.name.rsplit("-", 1)[1]
-        if pid.isdigit() and not Path(f"/proc/{pid}").exists():
-            shutil.rmtree(stale, ignore_errors=True)
-    stage = out.parent / f".{out.name}.new-{os.getpid()}"
-    shutil.rmtree(stage, ignore_errors=True)
-    stage.mkdir()
-    try:
-        yield stage
-        if not out.exists():
-            os.rename(stage, out)
-        elif not _exchange(stage, out):    # a file system without RENAME_EXCHANGE: two renames
-            old = out.parent / f".{out.name}.old-{os.getpid()}"
-            os.rename(out, old)
-            os.rename(stage, out)
-            shutil.rmtree(old, ignore_errors=True)
-    finally:
-        shutil.rmtree(stage, ignore_errors=True)    # the old folder after an exchange, or the unfinished new one
-
-
-def _exchange(a: Path, b: Path) -> bool:
-    """Swaps two paths atomically (Linux renameat2 with RENAME_EXCHANGE); False where that is not available."""
-    libc = ctypes.CDLL(None, use_errno=True)
-    renameat2 = getattr(libc, "renameat2", None)
-    if renameat2 is None:
-        return False
-    at_fdcwd, rename_exchange = -100, 2
-    return renameat2(at_fdcwd, os.fsencode(a), at_fdcwd, os.fsencode(b), rename_exchange) == 0

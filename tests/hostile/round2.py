@@ -172,7 +172,7 @@ def main() -> int:
     run.send_signal(signal.SIGINT)
     run.communicate()
     deck = sample(root / "stalelock", PSD, *SHORT)
-    (deck.parent / ".sediment-run.lock").write_text("99999")
+    (deck.parent / ".sediment.lock").write_text("99999")
     done = sediment("run", deck, "--quiet")
     case("a lock file left by a dead process does not block", done.returncode == 0, done.stderr)
     ro = root / "readonly"
@@ -256,7 +256,8 @@ def main() -> int:
     sediment("readout", deck.parent / "layers.h5", "--out", mine, "--instrument", "hydrometer")
     case("readout into a folder with the user's files keeps them", (mine / "notes.txt").read_text() == "mine"
          and not (mine / "pipette.csv").exists(), done.stderr)
-    (mine / ".sediment-saved").write_text("../copied/layers.h5\nnotes.txt\n")
+    (mine / ".sediment-files.json").write_text('{"format": 1, "sets": {"readout": {"files": '
+                                               '{"../copied/layers.h5": [1, 1, 1], "notes.txt": [1, 1, 1]}}}}')
     sediment("readout", deck.parent / "layers.h5", "--out", mine, "--instrument", "hydrometer")
     case("a forged list of saved files deletes nothing outside the folder", (deck.parent / "layers.h5").is_file(), "")
     bad = sum(1 for _, good, _ in results if not good)

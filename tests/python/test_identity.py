@@ -145,37 +145,43 @@ def _small_plan(out: Path, psd: Path = PSD) -> subprocess.CompletedProcess:
                     "--replicas", 1, "--no-models")
 
 
-def test_5_the_planner_replaces_its_folder_whole_or_not_at_all(tmp_path):
+def test_5_the_planner_replaces_its_own_files_whole_or_not_at_all(tmp_path):
     out = tmp_path / "plan"
     done = _small_plan(out)
     assert done.returncode == 0, done.stderr
-    before = {p.relative_to(out): digest(p) for p in out.rglob("*") if p.is_file()}
+    (out / "notes.txt").write_text("mine")    # a file of the user's: every plan leaves it
+    before = {p.relative_to(out): digest(p) for p in out.rglob("*") if p.is_file() and p.name != ".sediment.lock"}
     # a rerun for another PSD, interrupted: the earlier plan as it was, nothing left beside it
     plan = subprocess.Popen(SEDIMENT + ["plan", str(SAMPLE1), "--out", str(out), "--particles", "2000,1000",
                                         "--courant", "4", "--t-end", "7200", "--replicas", "1", "--no-models"],
                             stderr=subprocess.PIPE, text=True)
     # as soon as its first run has a folder (a run's layers.h5.partial lives a fraction of a second,
     # between two looks when the machine is busy; the folder stays until the plan is swapped in)
-    wait_for(lambda: [run for run in tmp_path.glob(".plan.new-*/runs/*") if run.is_dir()])
+    wait_for(lambda: [run for run in out.glob(".sediment-stage-*/runs/*") if run.is_dir()])
     plan.send_signal(signal.SIGINT)
-    plan.communicate(timeout=30)
+    _, err = plan.communicate(timeout=30)
     assert plan.returncode == 130
-    assert {p.relative_to(out): digest(p) for p in out.rglob("*") if p.is_file()} == before
-    assert not list(tmp_path.glob(".plan.*new*"))
+    assert {p.relative_to(out): digest(p) for p in out.rglob("*") if p.is_file() and p.name != ".sediment.lock"} == before
+    assert not list(out.glob(".sediment-stage-*")) and f"{out} is as it was" in err
     # sample --plan of another PSD's report: refused, naming it
     other = sediment("sample", SAMPLE1, "--plan", out / "report.json", "--out", tmp_path / "s")
     assert other.returncode == 2 and "was made for another test: the PSD" in other.stderr
     # a refused rerun deletes nothing: a run's result in decision/
     (out / "decision" / "layers.h5").write_bytes(b"a result")
     refused = _small_plan(out)
-    assert refused.returncode == 2 and "holds the results of a run" in refused.stderr
+    assert refused.returncode == 2 and f"{out / 'decision' / 'layers.h5'} (not written by sediment plan)" in refused.stderr
     assert (out / "runs").is_dir() and (out / "decision" / "layers.h5").read_bytes() == b"a result"
+    # that result moved away, the rerun replaces the plan's own files and keeps the user's
+    (out / "decision" / "layers.h5").unlink()
+    again = _small_plan(out)
+    assert again.returncode == 0, again.stderr
+    assert (out / "notes.txt").read_text() == "mine" and (out / "report.json").is_file()
     # a folder it did not write
     mine = tmp_path / "mine"
     mine.mkdir()
     (mine / "report.json").write_text("my own")
     refused = _small_plan(mine)
-    assert refused.returncode == 2 and "sediment plan did not write" in refused.stderr
+    assert refused.returncode == 2 and "report.json (not written by sediment plan)" in refused.stderr
     assert (mine / "report.json").read_text() == "my own"
 
 

@@ -147,18 +147,22 @@ def test_the_report_of_a_test_is_reproducible_with_a_seed(tmp_path):
     assert (tmp_path / "a" / "decision" / "in.sedimentation").is_file()
 
 
-def test_a_rerun_replaces_its_own_runs_and_spares_other_folders(tmp_path):
+def test_a_rerun_replaces_its_own_files_and_spares_everyone_elses(tmp_path):
     out = tmp_path / "plan"
     args = ("--deck", SUSPENSION, "--observe", "speed", "--var", "cells", "1")
-    _plan(out, *args)
-    stale = out / "runs" / "stale.txt"
-    stale.write_text("from the previous plan")
-    _plan(out, *args)
-    assert not stale.exists()
+    first = _plan(out, *args)
+    (out / "notes.txt").write_text("mine")
+    assert _plan(out, *args)["decision"]["settings"] == first["decision"]["settings"]
+    assert (out / "notes.txt").read_text() == "mine"
+    # a file put into the plan's own decision folder: the rerun would delete it, so it is refused
+    (out / "decision" / "results.csv").write_text("precious")
+    assert cli.main(["plan", *map(str, args), "--out", str(out)]) == 2
+    assert (out / "decision" / "results.csv").read_text() == "precious"
+    # a folder the plan never wrote into is no concern of it
     mine = tmp_path / "mine"
     (mine / "runs").mkdir(parents=True)
     (mine / "runs" / "results.csv").write_text("precious")
-    assert cli.main(["plan", *map(str, args), "--out", str(mine)]) == 2
+    _plan(mine, *args)
     assert (mine / "runs" / "results.csv").read_text() == "precious"
 
 
@@ -214,14 +218,14 @@ def test_an_interrupted_plan_stops_every_run_and_says_so(tmp_path, stop):
                              "40000,20000", "--courant", "1,2", "--t-end", "7200"], stderr=subprocess.PIPE, text=True,
                             preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_IGN))
     def busy() -> list[Path]:    # the plan works in a new folder beside --out until it is done
-        return [f for f in tmp_path.glob(".plan.new-*/runs/*") if f.is_dir() and processes_in(f)]
+        return [f for f in out.glob(".sediment-stage-*/runs/*") if f.is_dir() and processes_in(f)]
 
     wait_for(lambda: len(busy()) == 2)      # two trials at once (--jobs 2)
     plan.send_signal(getattr(signal, stop))
     _, err = plan.communicate(timeout=20)     # not after the runs end (about 40 s each)
     assert plan.returncode == 130 and "Traceback" not in err and f"interrupted by {stop}" in err
     wait_for(lambda: not busy(), seconds=10)
-    assert not (out / "report.json").exists() and not list(tmp_path.glob(".plan.new-*"))
+    assert not (out / "report.json").exists() and not list(out.glob(".sediment-stage-*"))
 
 
 def _narrow_psd(tmp_path: Path) -> Path:
@@ -282,7 +286,7 @@ def test_a_reduced_scene_outside_the_psd_is_refused(tmp_path, capsys):
     mine.mkdir(parents=True)
     (mine / "notes.txt").write_text("kept")
     assert cli.main(["plan", str(SAMPLE5), "--screen-only", "--measure-contacts", "--out", str(mine.parent)]) == 2
-    assert "was not written by sediment plan" in capsys.readouterr().err
+    assert "notes.txt (not written by sediment plan)" in capsys.readouterr().err
     assert (mine / "notes.txt").read_text() == "kept"
 
 

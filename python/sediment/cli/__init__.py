@@ -1,7 +1,9 @@
 # SPDX-License-Identifier: GPL-2.0-or-later
 """The `sediment` command line: one module per command, each with ``add_parser(commands)``,
 ``run(args)`` and ``EXAMPLES`` (shown under its --help); results are printed with their ``table()``
-and written with their ``save(folder)``. Every --help works before the C++ core is built."""
+and written with their ``save(folder)``. A command with ``--out`` writes into a stage that is
+published as one set when it returns (`sediment.folders`). Every --help works before the C++ core is
+built."""
 from __future__ import annotations
 
 import argparse
@@ -10,6 +12,7 @@ import os
 import signal
 import sys
 import threading
+from pathlib import Path
 
 from .. import __version__
 from ..sim.run import RunInterrupted
@@ -67,14 +70,29 @@ def main(argv: list[str] | None = None) -> int:
     previous = {}
     if threading.current_thread() is threading.main_thread():    # where Python lets a handler be set
         previous = {sig: signal.signal(sig, _interrupt) for sig in (signal.SIGINT, signal.SIGTERM)}
+    outputs = None
     try:
-        return args.func(args)
+        if getattr(args, "out", None) is None:
+            return args.func(args)
+        from ..folders import OutputSet
+
+        with OutputSet(args.out, result_set(args), inputs_of(args)) as outputs:
+            args.final_out, args.out, args.outputs = args.out, outputs.stage, outputs
+            args.publish = lambda: _publish(outputs)
+            status = args.func(args)
+            args.publish()
+        return status
     except RunInterrupted as exc:    # says what the run left
         print(f"sediment {args.command}: {exc}", file=sys.stderr)
         return 130
     except KeyboardInterrupt as exc:
-        print(f"sediment {args.command}: interrupted by {exc or 'SIGINT'}; files being written were left as "
-              "*.partial or not written", file=sys.stderr)
+        if outputs is None:
+            left = "files being written were left as *.partial or not written"
+        elif outputs.published:
+            left = f"after its results were written into {args.final_out}"
+        else:
+            left = f"{args.final_out} is as it was: nothing of this {outputs.name} was written"
+        print(f"sediment {args.command}: interrupted by {exc or 'SIGINT'}; {left}", file=sys.stderr)
         return 130
     except (ValueError, OSError, RuntimeError) as exc:    # SheetError is a ValueError; OSError: missing, read-only or full files
         print(f"sediment {args.command}: error: {exc}", file=sys.stderr)
@@ -83,6 +101,32 @@ def main(argv: list[str] | None = None) -> int:
         sys.stdout = stdout
         for sig, handler in previous.items():
             signal.signal(sig, handler)
+
+
+def _publish(outputs) -> None:
+    """Publishes a command's set (once: a command may do it before its last words) and says so."""
+    if outputs.published:
+        return
+    written = outputs.publish()
+    print(f"wrote {outputs.folder}: " + ", ".join(p.name + ("/" if p.is_dir() else "") for p in written))
+    for name in outputs.removed_sets:
+        print(f"removed the results of sediment {name} in {outputs.folder}: they were made from files this "
+              f"{outputs.name} removed")
+
+
+def result_set(args: argparse.Namespace) -> str:
+    """The name of the set of files a command writes: the command, and its study or test."""
+    return " ".join([args.command] + [getattr(args, k) for k in ("study", "test") if getattr(args, k, None)])
+
+
+def inputs_of(args: argparse.Namespace) -> list[Path]:
+    """The files a command's options name (its output folder aside): its results may not replace them."""
+    found = []
+    for name, value in vars(args).items():
+        for item in value if isinstance(value, list) else [value]:
+            if isinstance(item, Path) and name != "out":
+                found.append(item)
+    return found
 
 
 def _interrupt(signum: int, _frame: object) -> None:

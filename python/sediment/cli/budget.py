@@ -55,6 +55,5 @@ def run(args: argparse.Namespace) -> int:
                               jobs=args.jobs, name=path.stem)
         print(budget.table().text(), end="")
         budgets.append(budget)
-    for path in save(budgets, args.out):
-        print(f"wrote {path}")
+    save(budgets, args.out)
     return 0

@@ -45,5 +45,5 @@ def run(args: argparse.Namespace) -> int:
         result = calibrate.friction_from_tilt(args.lift, args.length)
     print(result.table().text(), end="")
     if args.out is not None:
-        print("wrote " + ", ".join(str(p) for p in result.save(args.out)))
+        result.save(args.out)
     return 0

@@ -25,5 +25,5 @@ def run(args: argparse.Namespace) -> int:
 
     result = case_a_study(args.out / "runs")
     print(result.table().text(), end="")
-    print("wrote " + ", ".join(str(p) for p in result.save(args.out)))
+    result.save(args.out)
     return 0

@@ -73,7 +73,6 @@ def run(args: argparse.Namespace) -> int:
     """Reads the sheets, inverts, prints the PSD and the verdict, writes the report."""
     from ..inverse import LabTest
     from ..lab.sheet import read_sheet
-    from ..sim.run import folder_lock
 
     if (args.design is None) == (not args.sheets):
         raise ValueError("give the sheets of a sample, or --design PSD to plan a test (not both)")
@@ -97,8 +96,7 @@ def run(args: argparse.Namespace) -> int:
     if args.zero_correction and any(len(getattr(s, "blank", ())) for s in sheets):
         raise ValueError("--zero-correction and a sheet with a blank column: the composite correction is given twice; "
                          "keep one")
-    with folder_lock(args.out, "invert"):    # its forward runs and report: one inversion per folder at a time
-        return _design(args, test) if args.design is not None else _invert(args, test, sheets)
+    return _design(args, test) if args.design is not None else _invert(args, test, sheets)
 
 
 def _refuse_repeats(sheets: list) -> None:
@@ -127,12 +125,11 @@ def _invert(args: argparse.Namespace, test, sheets) -> int:
     sieve = next((s for s in sheets if s.instrument == "sieve"), None)
     result = invert(readings, test, args.out / "runs", sieve=sieve, split=None if args.split is None else args.split * 1e-3,
                     bins=args.bins, particles=args.particles, seed=args.seed, budget_band=band)
-    written = result.save(args.out)    # before printing: a reader that leaves (`| head`) loses nothing
+    result.save(args.out)
+    args.publish()    # before the verdict, which comes last
     notes, result.notes = result.notes, []
     print(result.table().text(), end="")
     print(result.texture().table().text(), end="")
-    for path in written:
-        print(f"wrote {path}")
     print("\n".join(notes))           # the verdict last
     return 0 if result.consistent else 3
 
@@ -165,6 +162,6 @@ def _design(args: argparse.Namespace, test) -> int:
            title=f"designs of a test of {args.design.stem}")
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8)
-    for path in (write_text(args.out / "design.csv", table.csv()), figures.save(fig, args.out / "design.png")):
-        print(f"wrote {path}")
+    write_text(args.out / "design.csv", table.csv())
+    figures.save(fig, args.out / "design.png")
     return 0

@@ -80,5 +80,5 @@ def run(args: argparse.Namespace) -> int:
         result = funnel.funnel_study(runs=args.runs, jobs=args.jobs, dt=args.dt, settings=dict(args.set))
     print(result.table().text(), end="")
     if args.out is not None:
-        print("wrote " + ", ".join(str(p) for p in result.save(args.out)))
+        result.save(args.out)
     return 0

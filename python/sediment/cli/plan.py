@@ -122,7 +122,7 @@ def run(args: argparse.Namespace) -> int:
     plan = plan_effects(scene, args.out, tolerance, args.jobs, args.seed if args.deck is None else 1,
                         args.measure_all, name=name)
     print(plan.text(), end="")
-    print(f"wrote {args.out}/effects.csv, trials.csv, report.json, plan.png; the chosen scene: {args.out / 'decision'}")
+    print(f"the chosen scene: {args.final_out / 'decision'}")
     if args.deck is None and args.measure_contacts:
         _measure_contacts(test, args, tolerance)
     return 0
@@ -147,8 +147,6 @@ def _measure_contacts(test, args: argparse.Namespace, tolerance: float) -> None:
     print(f"measuring contacts: grains above {cut * 1e6:.3g} um in a periodic box of {setups[0].width * 1e3:.3g} x "
           f"{setups[0].width * 1e3:.3g} x {setups[0].height * 1e3:.3g} mm, without and with lubrication "
           f"({min(args.jobs, 2)} at once) ...", flush=True)
-    for stale in ("contacts.csv", "contacts.json"):    # a failed rerun must not leave the last one's answer
-        (args.out / stale).unlink(missing_ok=True)
     # One name per measurement: its run folder and its rows in contacts.csv/json.
     kinds = ["contacts_lubrication" if setup.lubrication else "contacts" for setup in setups]
     running: set = set()
@@ -188,10 +186,8 @@ def _measure_contacts(test, args: argparse.Namespace, tolerance: float) -> None:
         print(f"{kind}: readings move by up to {m.change:.3g} pp (tolerance {tolerance:g}): {verdict}")
         lines = table.csv().splitlines(keepends=True)
         header, rows = lines[0], rows + [f"{kind},{line}" for line in lines[1:]]
-    args.out.mkdir(parents=True, exist_ok=True)
     write_text(args.out / "contacts.csv", "scene," + header + "".join(rows))
     write_text(args.out / "contacts.json", json.dumps(summary, indent=2) + "\n")
-    print(f"wrote {args.out}/contacts.csv, contacts.json")
 
 
 def _print_screens(screens) -> None:

@@ -121,8 +121,7 @@ def run(args: argparse.Namespace) -> int:
                             ", ".join(f"{r.instrument} +-{r.band:.3g} pp" for r in report.readings))
     elif args.band_sample is not None:
         raise ValueError("--band-sample names a sample of --band BUDGET: give both")
-    for path in report.save(args.out):
-        print(f"wrote {path}")
+    report.save(args.out)
     print(report.table().text(), end="")
     return 0
 

@@ -100,7 +100,7 @@ def cylinder_of(args: argparse.Namespace):
 def run(args: argparse.Namespace) -> int:
     """Plans the scene, prints it and writes its data file, deck and PSD tables."""
     from ..lab.psd import read_psd
-    from ..sim.scene import describe, plan, write
+    from ..sim.scene import describe, plan, runs_replaced, write
 
     psd = read_psd(args.psd)
     if args.plan is not None:
@@ -142,9 +142,9 @@ def run(args: argparse.Namespace) -> int:
                  layers=args.layers, t_end=args.t_end, courant=args.courant, seed=args.seed)
     scene.water_record = record
     print(describe(scene))
-    for path in write(scene, args.out, force=args.force):
-        print(f"wrote {path}")
-    print(f"next: sediment run {args.out / 'in.sedimentation'}")
+    write(scene, args.out)
+    args.outputs.remove_also(runs_replaced(args.final_out, args.out / "in.sedimentation", force=args.force))
+    print(f"next: sediment run {args.final_out / 'in.sedimentation'}")
     return 0
 
 

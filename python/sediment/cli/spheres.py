@@ -30,5 +30,5 @@ def run(args: argparse.Namespace) -> int:
 
     result = study(args.csv, laws=args.law)
     print(result.table().text(), end="")
-    print("wrote " + ", ".join(str(p) for p in result.save(args.out)))
+    result.save(args.out)
     return 0

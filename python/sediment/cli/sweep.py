@@ -49,7 +49,6 @@ def run(args: argparse.Namespace) -> int:
     integrators = args.integrator.split(",") if args.integrator else None
     result = sweep.run_sweep(args.deck, args.dt, args.observe, integrators, args.parameter, references,
                              dict(args.var or []), args.np, args.out / "runs", args.tau, args.rayleigh)
-    paths = result.save(args.out, args.tolerance, args.title)
+    result.save(args.out, args.tolerance, args.title)
     print(result.table(args.tolerance).text(), end="")
-    print("wrote " + ", ".join(str(p) for p in paths))
     return 0

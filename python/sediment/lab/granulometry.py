@@ -11,7 +11,7 @@ import numpy as np
 
 from .. import figures
 from ..constants import D422_CYLINDER_AREA
-from ..results import Table, hold_one, write_atomic, write_text
+from ..results import Table, write_atomic, write_text
 from .psd import PSD
 from .readout import SCHEDULES, BuoyancySphere, Column, Hydrometer, Pipette, Readings
 
@@ -128,7 +128,7 @@ class Granulometry:
         written = [path for r in self.readings for path in r.save(folder)]
         if self.references():
             written.append(write_text(folder / "errors.csv", self.table().csv()))
-        return hold_one(folder, written + _plot(self, folder))
+        return written + _plot(self, folder)
 
 
 def granulometry(column: Column, instruments: list[str], psd: PSD | None = None, simulated: PSD | None = None,

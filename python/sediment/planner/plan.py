@@ -29,9 +29,9 @@ from pathlib import Path
 import numpy as np
 
 from .. import figures
-from ..results import Table, exclusive, staged_folder, write_text
+from ..results import Table, write_text
 from ..sim.run import stop_all
-from .scenes import Knob, Outcome, check_plan_folder, prepare
+from .scenes import Knob, Outcome, prepare
 from .screening import INCLUDE, MEASURE, Screen
 
 VERIFY_ATTEMPTS = 3
@@ -329,7 +329,7 @@ def plan_effects(scene, out: Path, tolerance: float, jobs: int = 2, seed: int = 
     scene : SampleScene or DeckScene
         The knobs and how to run them.
     out : Path
-        Output folder.
+        Output folder, new or empty (`sediment plan` gives it a stage it publishes as one set).
     tolerance : float
         Largest error allowed (pp of percent finer for a test, relative for a deck).
     jobs : int
@@ -350,21 +350,13 @@ def plan_effects(scene, out: Path, tolerance: float, jobs: int = 2, seed: int = 
         raise ValueError(f"the tolerance must be > 0, not {tolerance:g}")
     if jobs < 1:
         raise ValueError("jobs must be >= 1")
-    out = Path(out)
-    check_plan_folder(out)
-    out.parent.mkdir(parents=True, exist_ok=True)
-    # Everything is written into a new folder that replaces --out whole at the end: an interrupted or
-    # failed plan leaves the earlier one as it was.
-    with exclusive(out.parent / f".{out.name}.lock", f"wait for it, or plan into another --out"), \
-            staged_folder(out) as stage:
-        plan = _plan(scene, prepare(stage), tolerance, jobs, seed, measure_all, progress, name)
-    return plan
+    return _plan(scene, prepare(Path(out)), tolerance, jobs, seed, measure_all, progress, name)
 
 
-def _plan(scene, stage: Path, tolerance: float, jobs: int, seed: int, measure_all: bool, progress: bool,
+def _plan(scene, out: Path, tolerance: float, jobs: int, seed: int, measure_all: bool, progress: bool,
           name: str) -> Plan:
-    """plan_effects, into the new folder `stage`."""
-    runs, decided = prepare(stage / "runs"), prepare(stage / "decision")
+    """plan_effects, into the empty folder `out`."""
+    runs, decided = prepare(out / "runs"), prepare(out / "decision")
     seeds = itertools.count(seed)      # every run its own placement: errors include each run's sampling
     reference = Trial("reference", {k.name: k.values[0] for k in scene.knobs}, next(seeds))
     replicas = [reference] + [Trial(f"reference-{k + 1}", dict(reference.settings), next(seeds))
@@ -439,7 +431,7 @@ def _plan(scene, stage: Path, tolerance: float, jobs: int, seed: int, measure_al
     plan = Plan(name, scene.unit, tolerance, scene.knobs, scene.screens, reference, trials, verified, decision, fixed,
                 candidates, scene.describe(decision.settings), scene.options_record(), replicas, uncertainty, models,
                 converged)
-    plan.save(stage)
+    plan.save(out)
     return plan
 
 

@@ -14,7 +14,6 @@ from __future__ import annotations
 
 import math
 import re
-import shutil
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -26,7 +25,6 @@ from ..sim.run import run_batch
 from ..constants import DRAGS, HINDRANCES
 from .screening import INCLUDE, MEASURE, OMIT, Screen, SedimentationTest, screen, verdict_of
 
-MARKER = ".sediment-plan"    # in a folder of trial runs: the planner owns it and may empty it
 
 
 @dataclass(frozen=True)
@@ -55,42 +53,13 @@ class Outcome:
     printed: dict[str, float] = field(default_factory=dict)    # SCREEN numbers a deck printed
 
 
-def check_plan_folder(out: Path) -> None:
-    """Refuses, before anything is written, an --out the planner may not replace: one it did not write
-    (no marker), and one where a run has since left its results beside a deck (a layer file or log in
-    it, its runs/ or its decision/)."""
-    out = Path(out)
-    if not out.exists() or (out.is_dir() and not any(out.iterdir())):
-        return
-    if not out.is_dir():
-        raise ValueError(f"{out} exists and is not a folder: choose another --out")
-    if not ((out / MARKER).is_file() or (out / "runs" / MARKER).is_file()):
-        names = sorted(p.name for p in out.iterdir())[:5]
-        raise ValueError(f"{out} holds files sediment plan did not write ({', '.join(names)}): choose another --out")
-    for folder in (out, out / "runs", out / "decision"):
-        _refuse_run_results(folder)
-
-
-def _refuse_run_results(folder: Path) -> None:
-    """Refuses a folder where a run has left its results beside a deck (a layer file or log)."""
-    results = sorted(p.name for p in folder.glob("*") if p.suffix == ".h5" or p.name.startswith("log.lammps"))
-    if results:
-        raise ValueError(f"{folder} holds the results of a run ({', '.join(results)}): move them or choose "
-                         "another --out")
-
-
 def prepare(folder: Path) -> Path:
-    """A folder the planner writes (its runs, its decision, a contact measurement), emptied if the
-    planner left it. Refused rather than emptied: a folder the planner did not write, and one where a
-    run has since left its results (a layer file or log beside the deck)."""
+    """A new or empty folder for the planner's runs, its decision or a contact measurement (created);
+    ValueError naming it if it holds anything."""
     folder = Path(folder)
-    if folder.exists() and any(folder.iterdir()):
-        if not (folder / MARKER).is_file():
-            raise ValueError(f"{folder} exists and was not written by sediment plan: choose another --out")
-        _refuse_run_results(folder)
-        shutil.rmtree(folder)
+    if folder.exists() and any(not p.name.startswith(".sediment") for p in folder.iterdir()):
+        raise ValueError(f"{folder} is not empty: the planner writes into a new or empty folder")
     folder.mkdir(parents=True, exist_ok=True)
-    (folder / MARKER).write_text("written by sediment plan; replaced whole by the next plan in this folder\n")
     return folder
 
 

@@ -24,7 +24,8 @@ from typing import Callable
 
 import numpy as np
 
-from ..results import exclusive, write_text
+from ..folders import folder_lock
+from ..results import write_text
 from .paths import lmp_executable, mpirun_prefix
 
 
@@ -145,15 +146,8 @@ def _signals_stop():
             signal.signal(sig, old)
 
 
-LOCK = ".sediment-run.lock"
 RECORD = ".sediment-run.json"    # the folder's latest run: its identity, deck, variables and state
 RUN_OUTPUTS = ("restart.a.bin", "restart.b.bin", "log.lammps", "log.failed.lammps", RECORD)
-
-
-def folder_lock(folder: Path, what: str = "run"):
-    """One `sediment run` or `sample` at a time per folder: a second one would write the same files."""
-    folder.mkdir(parents=True, exist_ok=True)
-    return exclusive(folder / LOCK, f"wait for it, or {what} in another folder")
 
 
 # Commands whose first literal argument (after an ID for molecule) is a file the deck reads.
@@ -326,7 +320,7 @@ def run_deck(deck: Path, ranks: int = 1, variables: dict[str, str] | None = None
                          f"--np {cores}; add --oversubscribe to run it anyway")
     variables = {k: str(v) for k, v in (variables or {}).items()}
     folder = deck.parent
-    with folder_lock(folder):
+    with folder_lock(folder, "run"):
         if not resume:
             launch = dict(variables, sediment_run_id=run_id(deck, variables))
             if force:

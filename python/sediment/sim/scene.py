@@ -446,6 +446,9 @@ def _periodic_delta(delta: np.ndarray, box: list[float]) -> np.ndarray:
     return delta - box * np.rint(delta / box)
 
 
+SAMPLE_FILES = ("sample.data", "in.sedimentation", "input_psd.csv", "simulated_psd.csv", "classes.csv")
+
+
 def write(scene: Scene, out: Path, layer_file: str = "layers.h5", force: bool = False) -> list[Path]:
     """Writes the scene: data file, deck and PSD tables, together (under the folder's lock, staged and
     then moved into place).
@@ -469,34 +472,40 @@ def write(scene: Scene, out: Path, layer_file: str = "layers.h5", force: bool = 
     """
     import shutil
 
-    from .run import RUN_OUTPUTS, folder_lock, inputs_id
+    from ..folders import folder_lock
 
     if out.exists() and not out.is_dir():
         raise ValueError(f"{out} exists and is not a folder")
-    names = ["sample.data", "in.sedimentation", "input_psd.csv", "simulated_psd.csv", "classes.csv"]
     with folder_lock(out, "sample"):
         stage = out / f".sample.{os.getpid()}"
         shutil.rmtree(stage, ignore_errors=True)
         stage.mkdir()
         try:
-            _write_files(scene, [stage / n for n in names], layer_file)
-            # A run here read the deck and data file now in place: new ones would leave its frames
-            # beside tables of another test.
-            results = [p.name for p in (out / layer_file, out / (layer_file + ".partial"),
-                                        *(out / n for n in RUN_OUTPUTS)) if p.exists()]
-            deck = out / names[1]
-            if results and (not deck.is_file() or inputs_id(deck) != inputs_id(stage / names[1])):
-                if not force:
-                    raise ValueError(f"{out} holds a run of another scene ({', '.join(results)}): its frames would "
-                                     "stand beside tables of this one; sample into another --out, or give --force "
-                                     "to delete that run's files")
-                for name in results:
-                    (out / name).unlink()
-            for name in names:
+            _write_files(scene, [stage / n for n in SAMPLE_FILES], layer_file)
+            for name in runs_replaced(out, stage / "in.sedimentation", layer_file, force):
+                (out / name).unlink()
+            for name in SAMPLE_FILES:
                 os.replace(stage / name, out / name)
         finally:
             shutil.rmtree(stage, ignore_errors=True)
-    return [out / n for n in names]
+    return [out / n for n in SAMPLE_FILES]
+
+
+def runs_replaced(out: Path, deck: Path, layer_file: str = "layers.h5", force: bool = False) -> list[str]:
+    """The files of a run in `out` (layer file, restart files, logs) that a new `deck` of another scene
+    makes stale, to delete with `force`; ValueError naming them without it. A run read the deck and
+    data file in place: new ones would leave its frames beside the tables of another test."""
+    from .run import RUN_OUTPUTS, inputs_id
+
+    results = [p.name for p in (out / layer_file, out / (layer_file + ".partial"), *(out / n for n in RUN_OUTPUTS))
+               if p.exists()]
+    here = out / "in.sedimentation"
+    if not results or (here.is_file() and inputs_id(here) == inputs_id(deck)):
+        return []
+    if not force:
+        raise ValueError(f"{out} holds a run of another scene ({', '.join(results)}): its frames would stand beside "
+                         "tables of this one; sample into another --out, or give --force to delete that run's files")
+    return results
 
 
 def _write_files(scene: Scene, paths: list[Path], layer_file: str) -> None:
