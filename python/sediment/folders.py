@@ -57,7 +57,7 @@ def folder_lock(folder: Path, what: str):
     if folder.exists() and not folder.is_dir():
         raise ValueError(f"{folder} exists and is not a folder")
     folder.mkdir(parents=True, exist_ok=True)
-    return exclusive(folder / LOCK, f"wait for it, or {what} into another folder")
+    return exclusive(folder / LOCK, f"wait for it, or {what} in another folder")
 
 
 class OutputSet:
@@ -87,7 +87,7 @@ class OutputSet:
         self._foreign: list[str] = []
         self.removed_sets: list[str] = []    # other sets publish() removed with the files they were made from
         self._created = [p for p in (self.folder, *self.folder.parents) if not p.exists()]
-        self._lock = folder_lock(self.folder, f"sediment {name}")
+        self._lock = folder_lock(self.folder, "write")
 
     def __enter__(self) -> OutputSet:
         self._lock.__enter__()
