@@ -2,8 +2,8 @@
 # SEDIMENT: the two commands of the README, and their steps.
 #   make demo   installs what is missing, builds, runs the main example and says where its output is
 #   make test   installs what is missing, builds, runs every test (also under the sanitizers, the deck
-#               tests on LAMMPS built from source with SEDIMENT in its tree, Debian 12's release and the
-#               current one, and the documentation site)
+#               tests on LAMMPS built from source with SEDIMENT in its tree and as a plugin, Debian 12's
+#               release and the current one, and the documentation site)
 #   make docs   the documentation site in build/docs (Sphinx, warnings as errors)
 BUILD   ?= build
 PYTHON  := /usr/bin/python3
