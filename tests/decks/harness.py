@@ -42,7 +42,8 @@ def _run_with_plugin(plugin: Path, deck: Path, variables, np_ranks: int, cwd: Pa
     """The deck run through a wrapper that loads the plugin first. The wrapper sits in a folder of
     its own; the run's working folder, and so every relative name in the deck, stays the caller's.
     The -var variables are global and reach the included deck; a restart file the deck reads is read
-    after the load, so the styles it names are the plugin's."""
+    after the load, so the styles it names are the plugin's. Not for a deck that issues `clear`:
+    29 Sep 2021 unloads every plugin there, and the rest of the deck would run the tree's styles."""
     if not plugin.is_file():
         raise FileNotFoundError(f"SEDIMENT_PLUGIN={plugin}: no such file")
     with tempfile.TemporaryDirectory(prefix="sediment-plugin-") as tmp:
