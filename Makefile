@@ -2,8 +2,8 @@
 # SEDIMENT: the two commands of the README, and their steps.
 #   make demo   installs what is missing, builds, runs the main example and says where its output is
 #   make test   installs what is missing, builds, runs every test (also under the sanitizers, the deck
-#               tests on LAMMPS built from source with SEDIMENT in its tree, Debian 12's release and the
-#               current one, and the documentation site)
+#               tests on LAMMPS built from source with SEDIMENT in its tree and as a plugin, Debian 12's
+#               release and the current one, and the documentation site)
 #   make docs   the documentation site in build/docs (Sphinx, warnings as errors)
 BUILD   ?= build
 PYTHON  := /usr/bin/python3
@@ -88,12 +88,14 @@ test-lammps-current: build
 	@! grep -E "missing" $(CURRENT)/check-packages.txt
 	@echo "check-packages: $$(head -1 $(CURRENT)/check-packages.txt), none missing"
 
-# Debian 12's LAMMPS, 29 Sep 2021 (Debian 12, 20220106), built from its source package with SEDIMENT in the
-# tree (its CMake sets C++11; the package's module raises the lammps target to C++17; about 5 min to
-# build at -j2 the first time): on its lmp, the style checks (every style's pinned regression and
-# restart replay, 1 and 2 ranks) and the comparison of rank counts. Every other deck test runs on
-# the same release through test-cpp's lmp_sediment (Debian's liblammps). Nothing is built in
-# LAMMPS_2022_SEDIMENT: it is this project configured to register the deck tests on that lmp; the
+# LAMMPS 29 Sep 2021 (Debian 12's release), built from its source package with SEDIMENT in the tree
+# (its CMake sets C++11; the package's module raises the lammps target to C++17; about 5 min to build
+# at -j2 the first time). The in-tree route on its lmp: the style checks (every style's pinned
+# regression and restart replay, 1 and 2 ranks) and the comparison of rank counts. The plugin route
+# on the same lmp: this project's sedimentplugin.so, built against that tree's headers in
+# LAMMPS_2022_SEDIMENT (the plugin and the core only: nothing else is built there), loaded by
+# `plugin load` before each deck, runs the style checks on 2 ranks and lists its styles. Every other
+# deck test runs on the same release through test-cpp's lmp_sediment (Debian's liblammps). The
 # decks' checks use the Python module of $(BUILD).
 LAMMPS_2022 ?= $(LAMMPS_CACHE)/lammps-2022
 LAMMPS_2022_SEDIMENT ?= $(BUILD)/lammps-2022-sediment
@@ -103,7 +105,9 @@ test-lammps-2022: build
 	      -DLAMMPS_SOURCE_DIR=$(abspath $(LAMMPS_2022))/lammps/src \
 	      -DLAMMPS_LIBRARY=$(abspath $(LAMMPS_2022))/build/liblammps.so \
 	      -DSEDIMENT_DECK_LMP=$(abspath $(LAMMPS_2022))/build/lmp >/dev/null
-	cd $(LAMMPS_2022_SEDIMENT) && ctest -j $(JOBS) -L deck -R '^deck\.(style_|mpi_consistency)' --output-on-failure
+	cmake --build $(LAMMPS_2022_SEDIMENT) -j $(JOBS) --target sedimentplugin
+	cd $(LAMMPS_2022_SEDIMENT) && ctest -j $(JOBS) -R '^(deck\.(style_|mpi_consistency)|route\.plugin\.)' \
+	  --output-on-failure
 
 # The documentation site (Sphinx from Debian's packages, warnings as errors): the README and docs/,
 # the style pages, the notebook as a tutorial and the Python API from its docstrings.

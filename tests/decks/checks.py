@@ -1151,18 +1151,22 @@ PLUGIN_STYLES = {("fix", "fluid"), ("fix", "fluid/buoyancy"), ("fix", "fluid/dra
 
 @check(ranks=None)
 def plugin_styles(np_ranks: int):
-    """With LAMMPS_PLUGIN_PATH naming the folder of sedimentplugin.so, the lmp loads it at start and
-    every SEDIMENT style comes from it (`plugin list`)."""
+    """Every SEDIMENT style comes from sedimentplugin.so (`plugin list`), loaded by `plugin load` (with
+    SEDIMENT_PLUGIN naming it: the harness's wrapper deck) or at start (with LAMMPS_PLUGIN_PATH naming
+    its folder, on releases that load from there)."""
     import re
 
-    if not os.environ.get("LAMMPS_PLUGIN_PATH"):
-        raise RuntimeError("plugin_styles needs LAMMPS_PLUGIN_PATH (the folder of sedimentplugin.so)")
+    source = os.environ.get("SEDIMENT_PLUGIN") or os.environ.get("LAMMPS_PLUGIN_PATH")
+    if not source:
+        raise RuntimeError("plugin_styles needs SEDIMENT_PLUGIN (sedimentplugin.so, loaded by `plugin load`) or "
+                           "LAMMPS_PLUGIN_PATH (its folder, loaded at start)")
     with tempfile.TemporaryDirectory() as tmp:
         deck = Path(tmp) / "plugins.lmp"
         deck.write_text("plugin list\n")
         out = run_deck(deck, {}, np_ranks, cwd=Path(tmp))
     listed = set(re.findall(r"^\s*\d+: (\w+) style plugin (\S+)$", out.text, re.MULTILINE))
-    report(f"plugin: {len(listed)} styles loaded from {os.environ['LAMMPS_PLUGIN_PATH']}: "
+    how = "plugin load" if os.environ.get("SEDIMENT_PLUGIN") else "LAMMPS_PLUGIN_PATH"
+    report(f"plugin: {len(listed)} styles loaded from {source} ({how}): "
            f"{', '.join(sorted(f'{k} {n}' for k, n in listed))}")
     assert listed == PLUGIN_STYLES, listed ^ PLUGIN_STYLES
 

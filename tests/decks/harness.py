@@ -3,10 +3,18 @@
 
 Decks print "SAMPLE v1 v2 ..." rows and "RESULT key value key value ..." lines; checks compare
 them with analytic references from the physics core (sediment._core).
+
+With SEDIMENT_PLUGIN naming a sedimentplugin.so, each deck runs on the lmp of SEDIMENT_LMP with that
+plugin loaded first, as a user of the plugin route writes it: a wrapper deck holds `plugin load
+PLUGIN` and then `include DECK`. The same on every release with the PLUGIN package (29 Sep 2021 loads
+no plugin from LAMMPS_PLUGIN_PATH at start). The run must show that the plugin loaded: the route
+tests' lmps have SEDIMENT in their trees too, which would otherwise run the decks all the same.
 """
 from __future__ import annotations
 
+import os
 import sys
+import tempfile
 from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
@@ -19,10 +27,33 @@ def run_deck(deck: str | Path, variables: dict[str, object] | None = None, np_ra
     deck = Path(deck)
     if not deck.is_absolute():
         deck = HERE / deck
-    out = run_batch(deck, variables, np_ranks, cwd=cwd or HERE, timeout=timeout, check=False)
+    plugin = os.environ.get("SEDIMENT_PLUGIN")
+    if plugin:
+        out = _run_with_plugin(Path(plugin).resolve(), deck.resolve(), variables, np_ranks, cwd or HERE, timeout)
+    else:
+        out = run_batch(deck, variables, np_ranks, cwd=cwd or HERE, timeout=timeout, check=False)
     if (out.returncode != 0) != expect_failure:
         sys.stderr.write(out.text[-4000:])
         raise AssertionError(f"{deck.name} exited with {out.returncode} (variables {variables})")
+    return out
+
+
+def _run_with_plugin(plugin: Path, deck: Path, variables, np_ranks: int, cwd: Path, timeout: float):
+    """The deck run through a wrapper that loads the plugin first. The wrapper sits in a folder of
+    its own; the run's working folder, and so every relative name in the deck, stays the caller's.
+    The -var variables are global and reach the included deck; a restart file the deck reads is read
+    after the load, so the styles it names are the plugin's. Not for a deck that issues `clear`:
+    29 Sep 2021 unloads every plugin there, and the rest of the deck would run the tree's styles."""
+    if not plugin.is_file():
+        raise FileNotFoundError(f"SEDIMENT_PLUGIN={plugin}: no such file")
+    with tempfile.TemporaryDirectory(prefix="sediment-plugin-") as tmp:
+        wrapper = Path(tmp) / f"plugin_{deck.name}"
+        wrapper.write_text(f'plugin load "{plugin}"\ninclude "{deck}"\n')
+        out = run_batch(wrapper, variables, np_ranks, cwd=cwd, timeout=timeout, check=False)
+    # LAMMPS only logs a load that failed and goes on: with the tree's own SEDIMENT the deck would pass.
+    if "Loading plugin: " not in out.text or "Open of file" in out.text:
+        sys.stderr.write(out.text[-4000:])
+        raise AssertionError(f"{plugin} did not load (see LAMMPS's output above)")
     return out
 
 
