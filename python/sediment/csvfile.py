@@ -93,6 +93,8 @@ def read_csv(path: str | Path, what: str = "CSV") -> CsvFile:
     _check_header(path, header_line, header)
     rows = []
     for n, row in parsed[1:]:
+        if not any(cell.strip() for cell in row):    # a spreadsheet's empty row (",,,"): a blank line
+            continue
         # empty cells past the header's last column (a row saved with trailing commas) say nothing
         while len(row) > len(header) and not row[-1].strip():
             row = row[:-1]

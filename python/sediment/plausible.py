@@ -28,7 +28,8 @@ class Range:
         if self.low <= value <= self.high:
             return None
         unit = f" {self.unit}" if self.unit else ""
-        message = f"{value:g}{unit} is not within {self.low:g}-{self.high:g}{unit} ({self.why})"
+        span = f"{self.low:g} to {self.high:g}" if self.low < 0 else f"{self.low:g}-{self.high:g}"
+        message = f"{value:g}{unit} is not within {span}{unit}: {self.why}"
         # every slip that would explain the value: where two do, the user knows which unit they used
         meant = [(name, convert(value)) for name, convert in self.slips]
         return "".join([message] + [f"; written in {name}? that is {v:.6g}{unit}: give {v:.6g}" for name, v in meant
@@ -58,7 +59,8 @@ RANGES: dict[str, Range] = {
     "fluid_density": Range("kg/m3", 500.0, 3000.0, "a liquid: a light oil's 500 to a heavy mud's 3000", (G_PER_CM3,)),
     "paste_density": Range("kg/m3", 1000.0, 3000.0, "a paste: water's 1000 to a dense backfill's 3000", (G_PER_CM3,)),
     "concentration": Range("g/L", 0.5, 500.0, "solids in a sedimentation test: tens of g/L", (("kg/L or g/cm3", _times(1e3)),)),
-    "temperature": Range("C", 0.0, 40.0, "the water correlations' range", (("F", _fahrenheit),)),
+    "temperature": Range("C", 0.0, 40.0, "the water correlations' range", (("F", _fahrenheit),
+                                                                          ("K", lambda value: value - 273.15))),
     "water_viscosity": Range("Pa s", 2e-4, 0.02, "water and its solutions: 0.65-1.8 mPa s from 40 to 0 C",
                              (("mPa s (cP)", _times(1e-3)),)),
     "viscosity": Range("Pa s", 1e-5, 1000.0, "a gas's 1e-5 to a thick paste's hundreds", (("mPa s (cP)", _times(1e-3)),)),

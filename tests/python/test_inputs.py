@@ -51,12 +51,13 @@ def _refusal(capsys, argv: list[str]) -> str:
     (["sample", PSD, "--mass", "60"], "written in g? that is 0.06 kg"),
     (["sample", PSD, "--t-end", "24"], "written in h? that is 86400 s"),
     (["sample", PSD, "--temperature", "68"], "written in F? that is 20 C"),
+    (["readout", "--psd", PSD, "--stokes-preview", "--temperature", "293"], "written in K? that is 19.85 C"),
     (["budget", PSD, "--mass", "60"], "written in g? that is 0.06 kg"),
     (["readout", "--psd", PSD, "--stokes-preview", "--viscosity", "1"], "written in mPa s (cP)? that is 0.001 Pa s"),
     (["readout", "--psd", PSD, "--stokes-preview", "--concentration", "0.05"], "that is 50 g/L"),
     (["readout", "--psd", PSD, "--stokes-preview", "--pipette-depth", "10"], "written in cm? that is 0.1 m"),
     (["readout", "--psd", PSD, "--stokes-preview", "--hydrometer", "0.14", "67", "0.006", "0.07", "0.105", "0.023"],
-     "--hydrometer VB 67 m3 is not within 1e-05-0.0003 m3 (a hydrometer's bulb (152H: 67 cm3)); written in cm3 (mL)?"),
+     "--hydrometer VB 67 m3 is not within 1e-05-0.0003 m3: a hydrometer's bulb (152H: 67 cm3); written in cm3 (mL)?"),
     (["terminal", "--diameter", "50", "--particle-density", "2650"], "written in um? that is 5e-05 m"),
     (["terminal", "--diameter", "5e-5", "--particle-density", "2650", "--fluid-density", "1.0"], "that is 1000 kg/m3"),
     (["terminal", "--diameter", "5e-5", "--particle-density", "2650", "--youngs-modulus", "200"], "written in GPa?"),
@@ -123,7 +124,7 @@ def test_every_example_file_is_read():
     HYDROMETER.replace("\n", ",\n").encode(),                              # a trailing empty column
     "time_min,reading,temperature_C\n1,45,20,\n2,40,20,,\n".encode(),      # empty cells past the header
     HYDROMETER.replace("\n", "\r\n").encode(),
-    ("# 152H, cylinder 3\n\n" + HYDROMETER + "\n").encode(),
+    ("# 152H, cylinder 3\n\n" + HYDROMETER + "\n,,\n").encode(),                # comments, blank and empty rows
 ])
 def test_what_a_spreadsheet_writes_is_read_where_it_is_unambiguous(tmp_path, data):
     path = tmp_path / "sheet.csv"
@@ -161,11 +162,11 @@ def test_what_cannot_be_read_is_refused_in_one_line_naming_the_file_and_line(tmp
 
 
 @pytest.mark.parametrize("rows, message", [
-    ("1,45,20\n2,40,20\n86400,5,20\n", "line 4: time_min 86400 min is not within 0.05-10080 min (a sedimentation test "
-                                       "is read from seconds after the start to a week); written in s? that is 1440 min"),
-    ("1,45,68\n2,40,68\n", "line 2: temperature_C 68 C is not within 0-40 C (the water correlations' range); written in "
+    ("1,45,20\n2,40,20\n86400,5,20\n", "line 4: time_min 86400 min is not within 0.05-10080 min: a sedimentation test "
+                                       "is read from seconds after the start to a week; written in s? that is 1440 min"),
+    ("1,45,68\n2,40,68\n", "line 2: temperature_C 68 C is not within 0-40 C: the water correlations' range; written in "
                            "F? that is 20 C: give 20"),
-    ("1,45,20\n2,450,20\n", "line 3: reading 450 g/L is not within -5-60 g/L (a 152H's scale runs from -5 to 60 g/L)"),
+    ("1,45,20\n2,450,20\n", "line 3: reading 450 g/L is not within -5 to 60 g/L: a 152H's scale runs from -5 to 60 g/L"),
 ])
 def test_a_sheet_value_out_of_range_names_its_line_and_slip(tmp_path, rows, message):
     path = tmp_path / "sheet.csv"
@@ -177,8 +178,8 @@ def test_a_sheet_value_out_of_range_names_its_line_and_slip(tmp_path, rows, mess
 
 @pytest.mark.parametrize("text, message", [
     ("time_min,depth_cm,mass_g\n1,0.1,1.2\n", "line 2: depth_cm 0.1 cm is not within 1-200 cm"),
-    ("time_min,depth_cm,mass_g\n1,10,1200\n", "line 2: mass_g 1200 g is not within 0-7.5 g (the solids of a 25 mL "
-                                              "sample of at most 300 g/L); written in mg? that is 1.2 g"),
+    ("time_min,depth_cm,mass_g\n1,10,1200\n", "line 2: mass_g 1200 g is not within 0-7.5 g: the solids of a 25 mL "
+                                              "sample of at most 300 g/L; written in mg? that is 1.2 g"),
     ("time_min,apparent_mass_g\n1,0.0115\n", "written in kg? that is 11.5 g"),
 ])
 def test_pipette_and_sphere_sheets_name_their_slips(tmp_path, text, message):
