@@ -82,7 +82,7 @@ def read_csv(path: str | Path, what: str = "CSV") -> CsvFile:
             kept.append((number_, line))
     if not kept:
         raise CsvError(f"{path}: empty {what} (no header, no rows)")
-    parsed = [(n, next(csv.reader([line]))) for n, line in kept]
+    parsed = [(n, next(csv.reader([line], skipinitialspace=True))) for n, line in kept]    # "a, b": the space is no part of b
     header_line, header = parsed[0]
     _check_delimiter(path, header_line, header)
     # a spreadsheet's trailing empty column: no name in the header and nothing in any row

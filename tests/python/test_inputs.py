@@ -219,9 +219,10 @@ def test_the_same_sheet_twice_is_refused_however_it_was_saved(tmp_path, capsys):
     sheet = tmp_path / "h.csv"
     sheet.write_text(HYDROMETER)
     (tmp_path / "u16.csv").write_bytes(HYDROMETER.encode("utf-16"))    # the same readings saved as Unicode text
-    for other in (sheet, tmp_path / "u16.csv"):
-        line = _refusal(capsys, ["invert", str(sheet), str(other), "--mass", "0.06", "--out", str(tmp_path / "o")])
-        assert f"{other} and {sheet} hold the same readings" in line
+    line = _refusal(capsys, ["invert", str(sheet), str(tmp_path / "u16.csv"), "--mass", "0.06", "--out", str(tmp_path / "o")])
+    assert f"{tmp_path / 'u16.csv'} and {sheet} hold the same readings" in line
+    line = _refusal(capsys, ["invert", str(sheet), str(tmp_path / "." / "h.csv"), "--mass", "0.06", "--out", str(tmp_path / "o")])
+    assert f"{sheet} is given twice" in line
 
 
 def test_a_sheet_of_two_instruments_is_refused_naming_both(tmp_path):

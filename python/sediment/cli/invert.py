@@ -108,6 +108,9 @@ def _refuse_repeats(sheets: list) -> None:
     for sheet in sheets:
         arrays = (sheet.opening, sheet.passing) if sheet.instrument == "sieve" else (sheet.time, sheet.reading, sheet.depth)
         key = (sheet.instrument, *(tuple(np.round(a, 9)) for a in arrays))
+        if key in seen and seen[key].resolve() == sheet.path.resolve():
+            named = f" (as {seen[key]} and {sheet.path})" if seen[key] != sheet.path else ""
+            raise ValueError(f"{sheet.path} is given twice{named}: give each sheet once")
         if key in seen:
             raise ValueError(f"{sheet.path} and {seen[key]} hold the same readings: give each sheet once")
         seen[key] = sheet.path
