@@ -49,7 +49,7 @@ def number(text: str, name: str, where: str) -> float:
     except ValueError:
         hint = ""
         if "," in text and float_or_none(text.replace(",", ".")) is not None:
-            hint = f": a decimal comma? write {text.replace(',', '.')}"
+            hint = f": a decimal comma? write {text.replace(',', '.')} (and no thousands separator)"
         elif _invisible(text):
             hint = f": it holds {_invisible(text)}"
         raise CsvError(f"{where}: {name} '{text}' is not a number{hint}") from None
@@ -73,7 +73,11 @@ def read_csv(path: str | Path, what: str = "CSV") -> CsvFile:
         raise CsvError(f"{path} is a folder, not a {what}")
     if not path.is_file():
         raise CsvError(f"{path}: no such {what}")
-    lines = _decode(path, path.read_bytes(), what).splitlines()
+    text = _decode(path, path.read_bytes(), what)
+    if "\x00" in text:    # csv cannot read past one, and no table holds one
+        raise CsvError(f"{path}, line {text[:text.index(chr(0))].count(chr(10)) + 1}: a NUL character: not a text "
+                       f"{what}; save it as CSV UTF-8")
+    lines = text.splitlines()
     comments, kept = [], []
     for number_, line in enumerate(lines, start=1):
         if line.lstrip().startswith("#"):
