@@ -31,15 +31,11 @@ class CsvFile:
         """The file and line, as messages begin."""
         return f"{self.path}, line {line}"
 
-    def texts(self, name: str) -> list[tuple[int, str]]:
-        """Each row's text under a column, with its line."""
-        k = self.header.index(name)
-        return [(line, row[k].strip()) for line, row in self.rows]
-
     def numbers(self, name: str, blank: bool = False) -> list[float]:
         """A column's values as finite numbers (NaN for a blank cell where `blank` allows one)."""
-        return [math.nan if blank and text == "" else number(text, name, self.where(line))
-                for line, text in self.texts(name)]
+        k = self.header.index(name)
+        return [math.nan if blank and not row[k].strip() else number(row[k].strip(), name, self.where(line))
+                for line, row in self.rows]
 
 
 def number(text: str, name: str, where: str) -> float:
@@ -48,7 +44,7 @@ def number(text: str, name: str, where: str) -> float:
         value = float(text)
     except ValueError:
         hint = ""
-        if "," in text and float_or_none(text.replace(",", ".")) is not None:
+        if "," in text and _is_number(text.replace(",", ".")):
             hint = f": a decimal comma? write {text.replace(',', '.')} (and no thousands separator)"
         elif _invisible(text):
             hint = f": it holds {_invisible(text)}"
@@ -58,12 +54,12 @@ def number(text: str, name: str, where: str) -> float:
     return value
 
 
-def float_or_none(text: str) -> float | None:
-    """The number a text is, or None."""
+def _is_number(text: str) -> bool:
     try:
-        return float(text)
+        float(text)
     except ValueError:
-        return None
+        return False
+    return True
 
 
 def read_csv(path: str | Path, what: str = "CSV") -> CsvFile:
@@ -72,7 +68,7 @@ def read_csv(path: str | Path, what: str = "CSV") -> CsvFile:
     if path.is_dir():
         raise CsvError(f"{path} is a folder, not a {what}")
     if not path.is_file():
-        raise CsvError(f"{path}: no such {what}")
+        raise CsvError(f"{path}: no such file (the {what} named)")
     text = _decode(path, path.read_bytes(), what)
     if "\x00" in text:    # csv cannot read past one, and no table holds one
         raise CsvError(f"{path}, line {text[:text.index(chr(0))].count(chr(10)) + 1}: a NUL character: not a text "

@@ -95,7 +95,7 @@ def _typed_options():
             if isinstance(action, argparse._SubParsersAction):
                 for name, sub in action.choices.items():
                     yield from walk(sub, words + [name])
-            elif action.option_strings and (action.type in (types.positive, types.nonnegative, types.finite,
+            elif action.option_strings and (action.type in (types.positive, types.finite,
                                                             types.count, float, int)
                                             or getattr(action.type, "__name__", "") in RANGES):
                 yield words, action.option_strings[-1], action.type

@@ -211,7 +211,7 @@ def test_every_csv_input_goes_through_one_reader(tmp_path):
     spheres.write_text("suspension,rho_f,eta_B,tau_y,d,rho_p,v_ter_measured\n1,1280,0.0131,30.5,19,6513,0.65\n")
     with pytest.raises(ValueError, match="line 2: d 19 m .* written in mm\\? that is 0.019 m"):
         read_spheres(spheres)
-    with pytest.raises(CsvError, match="no such PSD file"):
+    with pytest.raises(CsvError, match="none.csv: no such file \\(the PSD file named\\)"):
         read_csv(tmp_path / "none.csv", "PSD file")
 
 

@@ -25,14 +25,6 @@ def positive(text: str) -> float:
     return value
 
 
-def nonnegative(text: str) -> float:
-    """A finite number >= 0."""
-    value = finite(text)
-    if value < 0:
-        raise argparse.ArgumentTypeError(f"must be >= 0, got {text}")
-    return value
-
-
 def quantity(name: str):
     """A finite number within the plausible range of a quantity of `sediment.plausible` (the type of
     the option that takes it), refused with the unit slip that most likely explains it."""

@@ -102,16 +102,16 @@ def read_psd(path: str | Path) -> PSD:
         values = np.array([table.numbers("diameter_um"), table.numbers("percent_finer")]).T
     except CsvError as exc:
         raise PSDError(f"{exc} (every row needs two numbers: diameter in um, percent finer)") from None
-    smallest = float(np.nanmin(values[:, 0])) if np.isfinite(values[:, 0]).any() else float("nan")
+    smallest = float(values[:, 0].min())
     if 0 < smallest < MIN_DIAMETER_UM:
         raise PSDError(f"{path}: the diameter_um column starts at {smallest:g} um, below {MIN_DIAMETER_UM} um "
                        "(10 nm): write micrometres, not metres or millimetres")
-    largest = float(np.nanmax(values[:, 0])) if np.isfinite(values[:, 0]).any() else float("nan")
+    largest = float(values[:, 0].max())
     if largest < MAX_DIAMETER_LOW_UM:
         raise PSDError(f"{path}: the largest diameter is {largest:g} um; a sedimentation test's PSD reaches tens of "
                        "um: if these are millimetres (sieve sizes), write micrometres (x 1000)")
-    if np.nanmax(values[:, 1]) <= 1.0:
-        raise PSDError(f"{path}: percent finer tops out at {np.nanmax(values[:, 1]):g}: write percent (0-100), "
+    if values[:, 1].max() <= 1.0:
+        raise PSDError(f"{path}: percent finer tops out at {values[:, 1].max():g}: write percent (0-100), "
                        "not fractions (0-1)")
     return PSD(values[:, 0] * 1e-6, values[:, 1], name=str(path))
 
