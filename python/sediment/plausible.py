@@ -70,6 +70,7 @@ RANGES: dict[str, Range] = {
     "cylinder_area": Range("m2", 5e-4, 0.05, "a sedimentation cylinder of 2.5-25 cm across; D422's is 27.8 cm2",
                            (("cm2", _times(1e-4)), ("mm2", _times(1e-6)))),
     "suspension_height": Range("m", 0.05, 2.0, "a settling column of 5 cm to 2 m; D422's 1000 mL is 0.36 m", (CM, MM)),
+    "suspension_volume": Range("L", 0.2, 5.0, "a sedimentation cylinder holds 0.5-2 L (D422's: 1 L)"),
     "column_width": Range("m", 1e-6, 0.3, "a simulated column's side: a few grains to the cylinder's width", (MM, UM)),
     "instrument_depth": Range("m", 0.005, 2.0, "a depth below the suspension's surface in a settling column", (CM, MM)),
     "surface": Range("m", -10.0, 10.0, "the free surface's coordinate in the layer file: within metres of its origin",

@@ -48,6 +48,8 @@ def _refusal(capsys, argv: list[str]) -> str:
     (["invert", "h.csv", "--mass", "0.06", "--split", "2000"], "written in um? that is 2 mm"),
     (["invert", "h.csv", "--mass", "0.06", "--cylinder-area", "27.8"], "written in cm2? that is 0.00278 m2"),
     (["invert", "h.csv", "--mass", "0.06", "--height", "36"], "written in cm? that is 0.36 m"),
+    (["invert", "h.csv", "--mass", "0.06", "--cylinder-area", "0.0278"], "--cylinder-area 0.0278 m2 x --height 0.36 m: "
+                                                                         "10.008 L is not within 0.2-5 L"),
     (["sample", PSD, "--mass", "60"], "written in g? that is 0.06 kg"),
     (["sample", PSD, "--t-end", "24"], "written in h? that is 86400 s"),
     (["sample", PSD, "--temperature", "68"], "written in F? that is 20 C"),

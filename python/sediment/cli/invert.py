@@ -73,12 +73,15 @@ def run(args: argparse.Namespace) -> int:
     """Reads the sheets, inverts, prints the PSD and the verdict, writes the report."""
     from ..inverse import LabTest
     from ..lab.sheet import read_sheet
-    from ..plausible import sphere_density
+    from ..plausible import check, sphere_density
 
     if (args.design is None) == (not args.sheets):
         raise ValueError("give the sheets of a sample, or --design PSD to plan a test (not both)")
     if args.design is None and args.mass is None:
         raise ValueError("--mass is required: the dry mass of the hydrometer's specimen [kg] (0.05 for 50 g)")
+    # each within its range, the two may still make a cylinder no laboratory has (27.8 cm2 typed as 0.0278)
+    check(args.cylinder_area * args.height * 1e3, "suspension_volume",
+          f"--cylinder-area {args.cylinder_area:g} m2 x --height {args.height:g} m:")
     sphere = sphere_density(args.sphere_mass, args.sphere_diameter)
     if sphere is not None:
         raise ValueError(sphere)
