@@ -232,3 +232,10 @@ def test_a_sheet_of_two_instruments_is_refused_naming_both(tmp_path):
     path.write_text("time_min,reading,temperature_C,apparent_mass_g\n1,45,20,11.5\n2,40,20,11.6\n")
     with pytest.raises(SheetError, match="the columns of hydrometer and buoyancy sheets: give each instrument"):
         read_sheet(path)
+
+
+def test_the_docs_list_every_range_as_it_is():
+    table = (REPO / "docs" / "inputs.md").read_text()
+    for name, bounds in RANGES.items():
+        span = f"{bounds.low:g} to {bounds.high:g}" if bounds.low < 0 else f"{bounds.low:g}-{bounds.high:g}"
+        assert f"| {name} | {bounds.unit or '-'} | {span} |" in table, name
