@@ -95,6 +95,8 @@ def read_csv(path: str | Path, what: str = "CSV") -> CsvFile:
     for n, row in parsed[1:]:
         if not any(cell.strip() for cell in row):    # a spreadsheet's empty row (",,,"): a blank line
             continue
+        if [cell.strip() for cell in row] == header:
+            raise CsvError(f"{path}, line {n}: the header again (two tables in one file?): give one table per file")
         # empty cells past the header's last column (a row saved with trailing commas) say nothing
         while len(row) > len(header) and not row[-1].strip():
             row = row[:-1]

@@ -154,6 +154,7 @@ def test_what_a_spreadsheet_writes_is_read_where_it_is_unambiguous(tmp_path, dat
     ("time_min,reading,temperature_C\n1,45\n2,40,20\n".encode(), "sheet.csv, line 2: 2 values where the header has 3"),
     ("time_min,reading,temperature_C\n1,45,20\n2,nan,20\n".encode(), "line 3: reading is nan, not a finite number"),
     (b"", "empty sheet"),
+    ((HYDROMETER + HYDROMETER).encode(), "sheet.csv, line 4: the header again (two tables in one file?)"),
 ])
 def test_what_cannot_be_read_is_refused_in_one_line_naming_the_file_and_line(tmp_path, data, message):
     path = tmp_path / "sheet.csv"
