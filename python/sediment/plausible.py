@@ -111,8 +111,10 @@ RANGES: dict[str, Range] = {
     "gravity": Range("m/s2", 0.1, 100.0, "gravity: the Moon's 1.6 to a centrifuge's 10 g", (("cm/s2", _times(1e-2)),)),
     "youngs_modulus": Range("Pa", 1e4, 1.2e12, "a soft rubber's 10 kPa to diamond's 1.2 TPa",
                             (("GPa", _times(1e9)), ("MPa", _times(1e6)))),
-    "poisson_ratio": Range("", -1.0, 0.5, "the bounds of an isotropic solid", (PERCENT,)),
-    "restitution": Range("", 0.0, 1.0, "0 (no rebound) to 1 (elastic)", (PERCENT,)),
+    "poisson_ratio": Range("", -0.99, 0.5, "an isotropic solid's, above -1 (where its shear modulus is infinite) "
+                           "and at most 0.5", (PERCENT,)),
+    "restitution": Range("", 0.05, 0.95, "the restitutions the tsuji damping is solved for; steel on steel is "
+                         "about 0.6", (PERCENT,)),
     "settling_speed": Range("m/s", 1e-7, 30.0, "a sphere's settling speed", (("mm/s", _times(1e-3)), ("cm/s", _times(1e-2)))),
     # the columns of a sheet (the units the sheet's header names)
     "time_min": Range("min", 0.05, 10080.0, "a sedimentation test is read from seconds after the start to a week",
