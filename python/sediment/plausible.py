@@ -124,7 +124,7 @@ RANGES: dict[str, Range] = {
     "reading": Range("g/L", -5.0, 60.0, "a 152H's scale runs from -5 to 60 g/L"),
     "depth_cm": Range("cm", 1.0, 200.0, "a pipette's depth in a settling column", (("m", _times(100.0)), ("mm", _times(0.1)))),
     "apparent_mass_g": Range("g", 0.1, 5000.0, "what a balance shows for a buoyancy sphere in a suspension",
-                             (("kg", _times(1e3)),)),
+                             (("kg", _times(1e3)), ("mg", _times(1e-3)))),
 }
 
 

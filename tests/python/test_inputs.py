@@ -184,6 +184,7 @@ def test_a_sheet_value_out_of_range_names_its_line_and_slip(tmp_path, rows, mess
     ("time_min,depth_cm,mass_g\n1,10,1200\n", "line 2: mass_g 1200 g is not within 0-7.5 g: the solids of a 25 mL "
                                               "sample of at most 300 g/L; written in mg? that is 1.2 g"),
     ("time_min,apparent_mass_g\n1,0.0115\n", "written in kg? that is 11.5 g"),
+    ("time_min,apparent_mass_g\n1,11500\n", "written in mg? that is 11.5 g"),
 ])
 def test_pipette_and_sphere_sheets_name_their_slips(tmp_path, text, message):
     path = tmp_path / "sheet.csv"
