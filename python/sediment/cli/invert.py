@@ -36,28 +36,37 @@ def add_parser(commands) -> argparse.ArgumentParser:
                         "times and sample masses by how well each recovers it (OUT/design.csv, design.png)")
     parser.add_argument("--masses", type=quantity_list("specimen_mass"), default=[0.030, 0.045, 0.060, 0.080],
                         help="with --design: sample masses to compare [kg] (default 0.03,0.045,0.06,0.08)")
-    parser.add_argument("--mass", type=quantity("specimen_mass"), help="dry mass of the hydrometer's specimen [kg] (required with "
+    parser.add_argument("--mass", type=quantity("specimen_mass"),
+                        help="dry mass of the hydrometer's specimen [kg] (required with "
                         "sheets; the part passing --split where one is given)")
     parser.add_argument("--split", type=quantity("split"), metavar="OPENING_MM",
                         help="the hydrometer's specimen is the part of the sample passing this sieve (D422: 2.0); the "
                         "sieve sheet gives the percent passing it")
-    parser.add_argument("--particle-density", type=quantity("particle_density"), default=SOIL_PARTICLE_DENSITY, help="[kg/m3] (default 2650)")
-    parser.add_argument("--cylinder-area", type=quantity("cylinder_area"), default=D422_CYLINDER_AREA, help="[m2] (default D422's)")
-    parser.add_argument("--height", type=quantity("suspension_height"), default=D422_CYLINDER_HEIGHT, help="suspension height [m]")
+    parser.add_argument("--particle-density", type=quantity("particle_density"),
+                        default=SOIL_PARTICLE_DENSITY, help="[kg/m3] (default 2650)")
+    parser.add_argument("--cylinder-area", type=quantity("cylinder_area"),
+                        default=D422_CYLINDER_AREA, help="[m2] (default D422's)")
+    parser.add_argument("--height", type=quantity("suspension_height"),
+                        default=D422_CYLINDER_HEIGHT, help="suspension height [m]")
     parser.add_argument("--zero-correction", type=quantity("correction"), default=0.0,
                         help="152H composite correction [g/L], subtracted from each reading (dispersant, zero)")
-    parser.add_argument("--meniscus", type=quantity("meniscus"), default=0.0, help="152H meniscus correction [g/L], for the depth")
-    parser.add_argument("--sphere-depth", type=quantity("instrument_depth"), help="buoyancy sphere centre depth [m] (default 0.3 H)")
+    parser.add_argument("--meniscus", type=quantity("meniscus"),
+                        default=0.0, help="152H meniscus correction [g/L], for the depth")
+    parser.add_argument("--sphere-depth", type=quantity("instrument_depth"),
+                        help="buoyancy sphere centre depth [m] (default 0.3 H)")
     parser.add_argument("--sphere-diameter", type=quantity("sphere_diameter"), default=0.025, help="[m]")
     parser.add_argument("--sphere-mass", type=quantity("sphere_mass"), default=0.020, help="[kg]")
     parser.add_argument("--pipette-volume", type=quantity("pipette_volume"), default=25e-6, help="[m3] (default 25 mL)")
     parser.add_argument("--hydrometer-noise", type=quantity("hydrometer_noise"), default=0.25,
                         help="standard uncertainty of a 152H reading [g/L] (default 0.25: read to 0.5 g/L)")
-    parser.add_argument("--balance-noise", type=quantity("balance_noise"), default=1e-3, help="of a sphere's apparent mass [g]")
-    parser.add_argument("--pipette-noise", type=quantity("pipette_noise"), default=1e-4, help="of a pipette sample's mass [g]")
+    parser.add_argument("--balance-noise", type=quantity("balance_noise"),
+                        default=1e-3, help="of a sphere's apparent mass [g]")
+    parser.add_argument("--pipette-noise", type=quantity("pipette_noise"),
+                        default=1e-4, help="of a pipette sample's mass [g]")
     parser.add_argument("--sieve-noise", type=quantity("sieve_noise"), default=0.5,
                         help="standard uncertainty of a sieve's percent passing [points] (default 0.5)")
-    parser.add_argument("--thermometer", type=quantity("thermometer"), default=0.5, help="of the temperature record [C]")
+    parser.add_argument("--thermometer", type=quantity("thermometer"),
+                        default=0.5, help="of the temperature record [C]")
     parser.add_argument("--budget", type=Path, help="budget.json of `sediment budget` for this test: its physical "
                         "total widens the band")
     parser.add_argument("--budget-sample", metavar="NAME", help="the sample of a budget.json that holds several")

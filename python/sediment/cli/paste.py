@@ -29,7 +29,8 @@ def add_parser(commands) -> argparse.ArgumentParser:
         study.add_argument("--out", type=Path, default=Path("out/paste"), help="output folder")
         if name == "balls":
             study.add_argument("--law", default="bingham", choices=BINGHAM_LAWS, help="the paste's drag law")
-            study.add_argument("--viscosity", type=quantity("viscosity"), help="the paste's plastic viscosity [Pa s] (default: "
+            study.add_argument("--viscosity", type=quantity("viscosity"),
+                               help="the paste's plastic viscosity [Pa s] (default: "
                                "the law's calibration, 0.279 for bingham and Zhang & Li's 0.7 for theirs; see the "
                                "viscosity study)")
     calibration = studies.add_parser("viscosity", help="the paste's plastic viscosity with which a law puts "

@@ -83,8 +83,8 @@ def add_parser(commands) -> argparse.ArgumentParser:
 def run(args: argparse.Namespace) -> int:
     """Screens (and unless --screen-only measures and decides), prints the tables, writes the report."""
     from ..planner.plan import pin, plan_effects
-    from ..plausible import check
     from ..planner.scenes import DeckScene, SampleScene
+    from ..plausible import check
 
     if (args.psd is None) == (args.deck is None):
         raise ValueError("give either a PSD table (a sedimentation test) or --deck DECK")

@@ -32,11 +32,15 @@ def add_parser(commands) -> argparse.ArgumentParser:
                         "beside the layer file)")
     parser.add_argument("--stokes-preview", action="store_true",
                         help="without a layer file: read an analytic Stokes column of --psd")
-    parser.add_argument("--height", type=quantity("suspension_height"), default=D422_CYLINDER_HEIGHT, help="preview column height [m]")
+    parser.add_argument("--height", type=quantity("suspension_height"),
+                        default=D422_CYLINDER_HEIGHT, help="preview column height [m]")
     parser.add_argument("--concentration", type=quantity("concentration"), default=50.0, help="preview solids [g/L]")
-    parser.add_argument("--particle-density", type=quantity("particle_density"), default=SOIL_PARTICLE_DENSITY, help="preview [kg/m3]")
-    parser.add_argument("--surface", type=quantity("surface"), help="free-surface coordinate [m] (default: top of the layers)")
-    parser.add_argument("--sphere-depth", type=quantity("instrument_depth"), help="buoyancy sphere centre depth [m] (default 0.3 H)")
+    parser.add_argument("--particle-density", type=quantity("particle_density"),
+                        default=SOIL_PARTICLE_DENSITY, help="preview [kg/m3]")
+    parser.add_argument("--surface", type=quantity("surface"),
+                        help="free-surface coordinate [m] (default: top of the layers)")
+    parser.add_argument("--sphere-depth", type=quantity("instrument_depth"),
+                        help="buoyancy sphere centre depth [m] (default 0.3 H)")
     parser.add_argument("--pipette-depth", type=quantity("instrument_depth"), default=0.10, help="[m]")
     parser.add_argument("--pipette-volume", type=quantity("pipette_volume"), default=25e-6, help="[m3]")
     parser.add_argument("--hydrometer", type=positive, nargs=6,
@@ -46,7 +50,8 @@ def add_parser(commands) -> argparse.ArgumentParser:
     parser.add_argument("--temperature", type=temperature, help="the water temperature the laboratory recorded [C], "
                         "0-40: the reduction takes the water's viscosity and density at it (default: the layer "
                         "file's fluid)")
-    parser.add_argument("--viscosity", type=quantity("water_viscosity"), help="viscosity for Stokes' law [Pa s] (default: the "
+    parser.add_argument("--viscosity", type=quantity("water_viscosity"),
+                        help="viscosity for Stokes' law [Pa s] (default: the "
                         "layer file's fluid)")
     parser.add_argument("--cylinder-area", type=quantity("cylinder_area"), default=D422_CYLINDER_AREA,
                         help="for the hydrometer's level rise [m2]")

@@ -54,11 +54,14 @@ def add_test_options(parser: argparse.ArgumentParser) -> None:
                         help="3D periodic column, or Bravo et al.'s 2D slab of the cylinder's axial section")
     parser.add_argument("--cylinder", default="d422", choices=["d422", "bravo"],
                         help="ASTM D422 (27.8 cm2, 0.36 m) or Bravo et al. (B 0.0635 m, H 0.457 m)")
-    parser.add_argument("--height", type=quantity("suspension_height"), help="suspension height [m] (default: the cylinder's)")
-    parser.add_argument("--width", type=quantity("column_width"), help="column side or slab width [m] (default: 2 largest "
+    parser.add_argument("--height", type=quantity("suspension_height"),
+                        help="suspension height [m] (default: the cylinder's)")
+    parser.add_argument("--width", type=quantity("column_width"),
+                        help="column side or slab width [m] (default: 2 largest "
                         "diameters; the slab spans the cylinder)")
     parser.add_argument("--mass", type=quantity("specimen_mass"), default=0.060, help="dry sample mass [kg]")
-    parser.add_argument("--particle-density", type=quantity("particle_density"), default=SOIL_PARTICLE_DENSITY, help="[kg/m3]")
+    parser.add_argument("--particle-density", type=quantity("particle_density"),
+                        default=SOIL_PARTICLE_DENSITY, help="[kg/m3]")
     parser.add_argument("--temperature", type=temperature, default=LAB_TEMPERATURE,
                         help="water temperature [C], 0-40: its density and viscosity (default 20; 1 C moves the "
                         "viscosity by about 2.5 %%)")

@@ -24,7 +24,8 @@ def add_parser(commands) -> argparse.ArgumentParser:
     parser.add_argument("--diameter", type=quantity("sphere_size"), required=True, help="sphere diameter [m]")
     parser.add_argument("--particle-density", type=quantity("solid_density"), required=True, help="[kg/m3]")
     parser.add_argument("--fluid-density", type=quantity("fluid_density"), help="[kg/m3] (default water at 20 C)")
-    parser.add_argument("--viscosity", type=quantity("viscosity"), help="viscosity, or plastic viscosity of a Bingham fluid "
+    parser.add_argument("--viscosity", type=quantity("viscosity"),
+                        help="viscosity, or plastic viscosity of a Bingham fluid "
                         "[Pa s] (default water at 20 C)")
     parser.add_argument("--temperature", type=temperature, help="water at this temperature [C], 0-40, instead of "
                         "--fluid-density and --viscosity")

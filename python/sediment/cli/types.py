@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import math
+from typing import Callable
 
 
 def finite(text: str) -> float:
@@ -25,7 +26,7 @@ def positive(text: str) -> float:
     return value
 
 
-def quantity(name: str):
+def quantity(name: str) -> Callable[[str], float]:
     """A finite number within the plausible range of a quantity of `sediment.plausible` (the type of
     the option that takes it), refused with the unit slip that most likely explains it."""
     from ..plausible import refusal
@@ -41,7 +42,7 @@ def quantity(name: str):
     return parse
 
 
-def quantity_list(name: str):
+def quantity_list(name: str) -> Callable[[str], list[float]]:
     """Comma-separated numbers, each within the plausible range of the quantity `name`."""
     one = quantity(name)
 
