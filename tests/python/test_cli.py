@@ -11,6 +11,7 @@ import pytest
 
 from sediment import cli
 from sediment.cli import types
+from sediment.plausible import RANGES
 from sediment.studies.single_sphere import case_a_sweep
 
 REPO = Path(__file__).resolve().parents[2]
@@ -94,8 +95,9 @@ def _typed_options():
             if isinstance(action, argparse._SubParsersAction):
                 for name, sub in action.choices.items():
                     yield from walk(sub, words + [name])
-            elif action.option_strings and action.type in (types.positive, types.nonnegative, types.finite,
-                                                           types.count, float, int):
+            elif action.option_strings and (action.type in (types.positive, types.finite,
+                                                            types.count, float, int)
+                                            or getattr(action.type, "__name__", "") in RANGES):
                 yield words, action.option_strings[-1], action.type
     return list(walk(cli.build_parser(), []))
 
@@ -105,7 +107,8 @@ def test_every_numeric_option_refuses_malformed_values(bad, capsys):
     options = _typed_options()
     assert len(options) > 40 and not [o for o in options if o[2] is float]
     for words, option, kind in options:
-        if kind in (types.finite, int) and bad == "-1":
+        signed = kind in (types.finite, int) or getattr(kind, "__name__", "") in RANGES and RANGES[kind.__name__].low < 0
+        if signed and bad == "-1":
             continue    # a signed value (a coordinate, a seed): -1 is valid
         with pytest.raises(SystemExit) as exit_info:
             cli.main(words + [option, bad])

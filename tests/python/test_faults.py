@@ -226,9 +226,9 @@ def test_a_signal_while_the_run_is_launched_stops_it(tmp_path, monkeypatch):
 
 @pytest.mark.parametrize("args, message", [
     (["run", "in.sedimentation", "--np", "1000"], "more ranks than the"),
-    (["sample", PSD, "--particle-density", "998.2"], "do not settle in water"),
-    (["sample", PSD, "--mass", "1e3"], "would fill"),
-    (["sample", PSD, "--height", "1e-6"], "not tall enough"),
+    (["sample", PSD, "--particle-density", "998.2"], "grains settle in water only if denser than it"),
+    (["sample", PSD, "--mass", "1e3"], "1000 kg is not within 0.01-0.2 kg"),
+    (["sample", PSD, "--height", "1e-6"], "1e-06 m is not within 0.05-2 m"),
     (["sample", PSD, "--particles", "1e12"], "at most 1e+09"),
     (["sample", REPO / "examples", "--out", "x"], "is a folder"),
 ])
@@ -253,8 +253,8 @@ def test_readout_refuses_partial_and_implausible_readings(tmp_path):
     assert sediment("run", deck, "--quiet").returncode == 0
     layers = deck.parent / "layers.h5"
     cases = [(["--surface", "-1"], "leaves no layer below it"),
-             (["--cylinder-area", "1e-9"], "no wider than the hydrometer's bulb"),
-             (["--pipette-volume", "1"], "does not fit")]
+             (["--cylinder-area", "1e-9"], "1e-09 m2 is not within 0.0005-0.05 m2"),
+             (["--pipette-volume", "1"], "1 m3 is not within 1e-05-5e-05 m3")]
     for options, message in cases:
         done = sediment("readout", layers, "--out", tmp_path / "out", *options)
         assert done.returncode == 2 and message in done.stderr, (options, done.stderr)

@@ -198,7 +198,7 @@ def test_bad_input_is_refused_with_the_reason(tmp_path, capsys):
     assert "--particles is an option of a sedimentation test, not of a deck" in capsys.readouterr().err
     assert cli.main(["plan", str(SAMPLE5), "--observe", "speed"]) == 2
     assert "--observe is an option of a deck" in capsys.readouterr().err
-    assert cli.main(["plan", str(SAMPLE5), "--screen-only", "--mass", "0.265"]) == 2
+    assert cli.main(["plan", str(SAMPLE5), "--screen-only", "--mass", "0.19"]) == 2
     assert "the hydrometer cannot read this test" in capsys.readouterr().err
     assert not (tmp_path / "o").exists()
 

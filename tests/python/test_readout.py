@@ -109,7 +109,7 @@ def test_psd_validation(tmp_path):
                           ("diameter_um,percent_finer\n10,0\n20,abc\n", "two numbers"),
                           ("diameter_um,percent_finer\n10,0\n20,0.4\n70,1\n", "not fractions"),
                           ("diameter_um,percent_finer\n0.075,0\n0.6,40\n2,100\n", "millimetres"),
-                          ("diameter_um,percent_finer\n2,5,0\n20,100\n", "line 2: a row has 3 values"),
+                          ("diameter_um,percent_finer\n2,5,0\n20,100\n", "line 2: 3 values where the header has 2 columns"),
                           ("diameter_um,percent_finer,note\n10,0,a\n20,100,b\n", "two columns")]:
         with pytest.raises(PSDError, match=message):
             read_psd(table(text))

@@ -187,7 +187,7 @@ def test_sample_rejects_what_it_cannot_build(tmp_path, capsys):
     psd = PSDS / "sample5.csv"
     assert cli.main(["sample", str(psd), "--particles", "10", "--out", str(tmp_path)]) == 2
     assert "10 particles cannot sample 40 size classes" in capsys.readouterr().err
-    assert cli.main(["sample", str(psd), "--width", "1", "--out", str(tmp_path)]) == 2
+    assert cli.main(["sample", str(psd), "--width", "0.2", "--out", str(tmp_path)]) == 2
     assert "does not fit the cylinder" in capsys.readouterr().err
     falling = tmp_path / "falling.csv"
     falling.write_text("diameter_um,percent_finer\n2,10\n5,5\n")

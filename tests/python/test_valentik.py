@@ -30,10 +30,10 @@ def test_a_sphere_held_by_the_yield_stress_stays_at_rest():
 @pytest.mark.parametrize("text, message", [
     ("suspension,rho_f,eta_B,tau_y,d,rho_p\n1,1280,0.0131,30.5,0.019,6513\n", "missing column"),
     ("suspension,rho_f,eta_B,tau_y,d,rho_p,v_ter_measured\n1,1280,x,30.5,0.019,6513,0.65\n", "not a number"),
-    ("suspension,rho_f,eta_B,tau_y,d,rho_p,v_ter_measured\n1,1280,-0.01,30.5,0.019,6513,0.65\n", "eta_B must be > 0"),
+    ("suspension,rho_f,eta_B,tau_y,d,rho_p,v_ter_measured\n1,1280,-0.01,30.5,0.019,6513,0.65\n", "line 2: eta_B -0.01 Pa s is not within"),
     ("suspension,rho_f,eta_B,tau_y,d,rho_p,v_ter_measured\n1,1280,0.01,30.5,0.019,1000,0.65\n", "does not sink"),
     ("suspension,rho_f,eta_B,tau_y,d,rho_p,v_ter_measured\n", "no spheres"),
-    ("", "missing column"),
+    ("", "empty spheres CSV"),
 ])
 def test_malformed_csv_is_refused_with_the_reason(tmp_path, text, message):
     path = tmp_path / "spheres.csv"

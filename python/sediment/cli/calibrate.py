@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from .types import positive
+from .types import positive, quantity
 
 
 EXAMPLES = [
@@ -19,9 +19,9 @@ def add_parser(commands) -> argparse.ArgumentParser:
     parser = commands.add_parser("calibrate", help="paste and contact parameters from a slump, drop or tilt test")
     tests = parser.add_subparsers(dest="test", required=True)
     slump = tests.add_parser("slump", help="yield stress from a cylindrical slump test (Pashias & Boger 1996)")
-    slump.add_argument("--slump", type=positive, nargs="+", required=True, help="measured slumps [m]")
-    slump.add_argument("--height", type=positive, required=True, help="cylinder height [m]")
-    slump.add_argument("--density", type=positive, required=True, help="paste density [kg/m3]")
+    slump.add_argument("--slump", type=quantity("slump_length"), nargs="+", required=True, help="measured slumps [m]")
+    slump.add_argument("--height", type=quantity("slump_length"), required=True, help="cylinder height [m]")
+    slump.add_argument("--density", type=quantity("paste_density"), required=True, help="paste density [kg/m3]")
     drop = tests.add_parser("restitution", help="coefficient of restitution from drop and rebound heights")
     drop.add_argument("--drop", type=positive, nargs="+", required=True, help="fall heights (any length unit)")
     drop.add_argument("--rebound", type=positive, nargs="+", required=True, help="rebound heights (same unit)")

@@ -6,7 +6,7 @@ import argparse
 from pathlib import Path
 
 from ..constants import D422_CYLINDER_AREA, D422_CYLINDER_HEIGHT, SOIL_PARTICLE_DENSITY
-from .types import count, finite, positive, positive_list
+from .types import count, quantity, quantity_list
 
 
 EXAMPLES = [
@@ -34,30 +34,39 @@ def add_parser(commands) -> argparse.ArgumentParser:
     parser.add_argument("--design", type=Path, metavar="PSD",
                         help="instead of sheets: the PSD a sample is expected to have; compares instruments, reading "
                         "times and sample masses by how well each recovers it (OUT/design.csv, design.png)")
-    parser.add_argument("--masses", type=positive_list, default=[0.030, 0.045, 0.060, 0.080],
+    parser.add_argument("--masses", type=quantity_list("specimen_mass"), default=[0.030, 0.045, 0.060, 0.080],
                         help="with --design: sample masses to compare [kg] (default 0.03,0.045,0.06,0.08)")
-    parser.add_argument("--mass", type=positive, help="dry mass of the hydrometer's specimen [kg] (required with "
+    parser.add_argument("--mass", type=quantity("specimen_mass"),
+                        help="dry mass of the hydrometer's specimen [kg] (required with "
                         "sheets; the part passing --split where one is given)")
-    parser.add_argument("--split", type=positive, metavar="OPENING_MM",
+    parser.add_argument("--split", type=quantity("split"), metavar="OPENING_MM",
                         help="the hydrometer's specimen is the part of the sample passing this sieve (D422: 2.0); the "
                         "sieve sheet gives the percent passing it")
-    parser.add_argument("--particle-density", type=positive, default=SOIL_PARTICLE_DENSITY, help="[kg/m3] (default 2650)")
-    parser.add_argument("--cylinder-area", type=positive, default=D422_CYLINDER_AREA, help="[m2] (default D422's)")
-    parser.add_argument("--height", type=positive, default=D422_CYLINDER_HEIGHT, help="suspension height [m]")
-    parser.add_argument("--zero-correction", type=finite, default=0.0,
+    parser.add_argument("--particle-density", type=quantity("particle_density"),
+                        default=SOIL_PARTICLE_DENSITY, help="[kg/m3] (default 2650)")
+    parser.add_argument("--cylinder-area", type=quantity("cylinder_area"),
+                        default=D422_CYLINDER_AREA, help="[m2] (default D422's)")
+    parser.add_argument("--height", type=quantity("suspension_height"),
+                        default=D422_CYLINDER_HEIGHT, help="suspension height [m]")
+    parser.add_argument("--zero-correction", type=quantity("correction"), default=0.0,
                         help="152H composite correction [g/L], subtracted from each reading (dispersant, zero)")
-    parser.add_argument("--meniscus", type=finite, default=0.0, help="152H meniscus correction [g/L], for the depth")
-    parser.add_argument("--sphere-depth", type=positive, help="buoyancy sphere centre depth [m] (default 0.3 H)")
-    parser.add_argument("--sphere-diameter", type=positive, default=0.025, help="[m]")
-    parser.add_argument("--sphere-mass", type=positive, default=0.020, help="[kg]")
-    parser.add_argument("--pipette-volume", type=positive, default=25e-6, help="[m3] (default 25 mL)")
-    parser.add_argument("--hydrometer-noise", type=positive, default=0.25,
+    parser.add_argument("--meniscus", type=quantity("meniscus"),
+                        default=0.0, help="152H meniscus correction [g/L], for the depth")
+    parser.add_argument("--sphere-depth", type=quantity("instrument_depth"),
+                        help="buoyancy sphere centre depth [m] (default 0.3 H)")
+    parser.add_argument("--sphere-diameter", type=quantity("sphere_diameter"), default=0.025, help="[m]")
+    parser.add_argument("--sphere-mass", type=quantity("sphere_mass"), default=0.020, help="[kg]")
+    parser.add_argument("--pipette-volume", type=quantity("pipette_volume"), default=25e-6, help="[m3] (default 25 mL)")
+    parser.add_argument("--hydrometer-noise", type=quantity("hydrometer_noise"), default=0.25,
                         help="standard uncertainty of a 152H reading [g/L] (default 0.25: read to 0.5 g/L)")
-    parser.add_argument("--balance-noise", type=positive, default=1e-3, help="of a sphere's apparent mass [g]")
-    parser.add_argument("--pipette-noise", type=positive, default=1e-4, help="of a pipette sample's mass [g]")
-    parser.add_argument("--sieve-noise", type=positive, default=0.5,
+    parser.add_argument("--balance-noise", type=quantity("balance_noise"),
+                        default=1e-3, help="of a sphere's apparent mass [g]")
+    parser.add_argument("--pipette-noise", type=quantity("pipette_noise"),
+                        default=1e-4, help="of a pipette sample's mass [g]")
+    parser.add_argument("--sieve-noise", type=quantity("sieve_noise"), default=0.5,
                         help="standard uncertainty of a sieve's percent passing [points] (default 0.5)")
-    parser.add_argument("--thermometer", type=positive, default=0.5, help="of the temperature record [C]")
+    parser.add_argument("--thermometer", type=quantity("thermometer"),
+                        default=0.5, help="of the temperature record [C]")
     parser.add_argument("--budget", type=Path, help="budget.json of `sediment budget` for this test: its physical "
                         "total widens the band")
     parser.add_argument("--budget-sample", metavar="NAME", help="the sample of a budget.json that holds several")
@@ -73,14 +82,18 @@ def run(args: argparse.Namespace) -> int:
     """Reads the sheets, inverts, prints the PSD and the verdict, writes the report."""
     from ..inverse import LabTest
     from ..lab.sheet import read_sheet
+    from ..plausible import check, sphere_density
 
     if (args.design is None) == (not args.sheets):
         raise ValueError("give the sheets of a sample, or --design PSD to plan a test (not both)")
     if args.design is None and args.mass is None:
         raise ValueError("--mass is required: the dry mass of the hydrometer's specimen [kg] (0.05 for 50 g)")
-    if args.particle_density <= 1000.0:
-        raise ValueError(f"--particle-density {args.particle_density:g} kg/m3: grains must be denser than water to "
-                         "settle (a soil's is about 2650; give kg/m3, not g/cm3)")
+    # each within its range, the two may still make a cylinder no laboratory has (27.8 cm2 typed as 0.0278)
+    check(args.cylinder_area * args.height * 1e3, "suspension_volume",
+          f"--cylinder-area {args.cylinder_area:g} m2 x --height {args.height:g} m:")
+    sphere = sphere_density(args.sphere_mass, args.sphere_diameter)
+    if sphere is not None:
+        raise ValueError(sphere)
     noise = {"hydrometer": args.hydrometer_noise, "buoyancy": args.balance_noise,
              "pipette": args.pipette_noise / (args.pipette_volume * 1e3), "sieve": args.sieve_noise}
     test = LabTest(0.060 if args.mass is None else args.mass, args.particle_density, args.cylinder_area, args.height, zero_correction=args.zero_correction,
@@ -107,6 +120,9 @@ def _refuse_repeats(sheets: list) -> None:
     for sheet in sheets:
         arrays = (sheet.opening, sheet.passing) if sheet.instrument == "sieve" else (sheet.time, sheet.reading, sheet.depth)
         key = (sheet.instrument, *(tuple(np.round(a, 9)) for a in arrays))
+        if key in seen and seen[key].resolve() == sheet.path.resolve():
+            named = f" (as {seen[key]} and {sheet.path})" if seen[key] != sheet.path else ""
+            raise ValueError(f"{sheet.path} is given twice{named}: give each sheet once")
         if key in seen:
             raise ValueError(f"{sheet.path} and {seen[key]} hold the same readings: give each sheet once")
         seen[key] = sheet.path

@@ -6,7 +6,7 @@ import argparse
 from pathlib import Path
 
 from ..constants import BINGHAM_LAWS
-from .types import count, nonnegative, positive, setting
+from .types import count, quantity, setting
 
 
 EXAMPLES = [
@@ -21,7 +21,7 @@ def add_parser(commands) -> argparse.ArgumentParser:
                                  "balls, the funnel")
     studies = parser.add_subparsers(dest="study", required=True)
     target = studies.add_parser("restitution", help="the 'damping tsuji' input giving a restitution (drop deck)")
-    target.add_argument("--target", type=positive, default=0.612)
+    target.add_argument("--target", type=quantity("restitution"), default=0.612)
     for name, text in (("drop-test", "rebounds of the five drops of case F with steel.lmp"),
                        ("balls", "8, 12.6 and 16 mm balls from six fall heights, with and without partial "
                                  "submergence: settling distances")):
@@ -29,7 +29,8 @@ def add_parser(commands) -> argparse.ArgumentParser:
         study.add_argument("--out", type=Path, default=Path("out/paste"), help="output folder")
         if name == "balls":
             study.add_argument("--law", default="bingham", choices=BINGHAM_LAWS, help="the paste's drag law")
-            study.add_argument("--viscosity", type=positive, help="the paste's plastic viscosity [Pa s] (default: "
+            study.add_argument("--viscosity", type=quantity("viscosity"),
+                               help="the paste's plastic viscosity [Pa s] (default: "
                                "the law's calibration, 0.279 for bingham and Zhang & Li's 0.7 for theirs; see the "
                                "viscosity study)")
     calibration = studies.add_parser("viscosity", help="the paste's plastic viscosity with which a law puts "
@@ -37,15 +38,15 @@ def add_parser(commands) -> argparse.ArgumentParser:
     calibration.add_argument("--law", default="bingham", choices=BINGHAM_LAWS, help="the paste's drag law")
     calibration.add_argument("--out", type=Path, help="also write viscosity_calibration.csv into this folder")
     energy = studies.add_parser("energy", help="energy balance of one ball entering the paste")
-    energy.add_argument("--diameter", type=positive, default=0.0126, help="[m]")
-    energy.add_argument("--fall", type=nonnegative, default=0.255, help="fall height above the paste [m]")
-    energy.add_argument("--dt", type=positive, default=1e-5, help="[s]")
+    energy.add_argument("--diameter", type=quantity("ball_diameter"), default=0.0126, help="[m]")
+    energy.add_argument("--fall", type=quantity("fall_height"), default=0.255, help="fall height above the paste [m]")
+    energy.add_argument("--dt", type=quantity("time_step"), default=1e-5, help="[s]")
     energy.add_argument("--law", default="bingham", choices=BINGHAM_LAWS, help="the paste's drag law")
     energy.add_argument("--out", type=Path, help="also write energy_balance.csv into this folder")
     pour = studies.add_parser("funnel", help="68 balls poured from a funnel, several random packings")
     pour.add_argument("--runs", type=count, default=15)
     pour.add_argument("--jobs", type=count, default=2, help="runs at a time")
-    pour.add_argument("--dt", type=positive, default=1e-6, help="[s]")
+    pour.add_argument("--dt", type=quantity("time_step"), default=1e-6, help="[s]")
     pour.add_argument("--set", type=setting, action="append", default=[], metavar="NAME=VALUE",
                       help="a variable of examples/paste/in.funnel (or of the steel.lmp and mould.lmp it includes), "
                       "for a variant: stem=0.05, fall=0.15, effect_submergence=no, tsuji=0.2, ...; repeatable")

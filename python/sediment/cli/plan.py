@@ -6,7 +6,7 @@ import argparse
 from pathlib import Path
 
 from .sample import add_test_options, cylinder_of, suspension_of
-from .types import count, positive, positive_list, setting
+from .types import count, positive, positive_list, quantity, setting
 
 
 def _counts(text: str) -> list[int]:
@@ -65,7 +65,7 @@ def add_parser(commands) -> argparse.ArgumentParser:
                       help="also measure what contacts, and contacts with lubrication, change: a reduced real-grain "
                       "scene (the grains above --contact-cut in a periodic box) run both ways, written to "
                       "OUT/contacts.csv and contacts.json (minutes; docs/effects.md section 5)")
-    test.add_argument("--contact-cut", type=positive, metavar="UM",
+    test.add_argument("--contact-cut", type=quantity("contact_cut"), metavar="UM",
                       help="smallest grain of the reduced scene [um] (default a third of the largest: smaller "
                       "grains meet larger ones with an interception efficiency below 9 %%)")
     deck = parser.add_argument_group("deck")
@@ -84,6 +84,7 @@ def run(args: argparse.Namespace) -> int:
     """Screens (and unless --screen-only measures and decides), prints the tables, writes the report."""
     from ..planner.plan import pin, plan_effects
     from ..planner.scenes import DeckScene, SampleScene
+    from ..plausible import check
 
     if (args.psd is None) == (args.deck is None):
         raise ValueError("give either a PSD table (a sedimentation test) or --deck DECK")
@@ -92,6 +93,8 @@ def run(args: argparse.Namespace) -> int:
     if ignored:
         raise ValueError(f"--{ignored[0].replace('_', '-')} is an option of a {'sedimentation test' if other == 'test' else 'deck'}"
                          f", not of {'a deck' if other == 'test' else 'a sedimentation test'}")
+    if args.tolerance is not None:    # its unit depends on the scene
+        check(args.tolerance, "relative_tolerance" if args.deck is not None else "test_tolerance", "--tolerance")
     if args.deck is not None:
         tolerance = args.tolerance or 0.01
         scene = DeckScene(args.deck, args.observe or [], dict(args.ladder or []), tolerance, dict(args.var or []),

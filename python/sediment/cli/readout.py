@@ -9,7 +9,7 @@ from pathlib import Path
 import numpy as np
 
 from ..constants import D422_CYLINDER_AREA, D422_CYLINDER_HEIGHT, SCHEDULES, SOIL_PARTICLE_DENSITY
-from .types import finite, positive, temperature
+from .types import positive, quantity, temperature
 
 
 EXAMPLES = [
@@ -32,13 +32,17 @@ def add_parser(commands) -> argparse.ArgumentParser:
                         "beside the layer file)")
     parser.add_argument("--stokes-preview", action="store_true",
                         help="without a layer file: read an analytic Stokes column of --psd")
-    parser.add_argument("--height", type=positive, default=D422_CYLINDER_HEIGHT, help="preview column height [m]")
-    parser.add_argument("--concentration", type=positive, default=50.0, help="preview solids [g/L]")
-    parser.add_argument("--particle-density", type=positive, default=SOIL_PARTICLE_DENSITY, help="preview [kg/m3]")
-    parser.add_argument("--surface", type=finite, help="free-surface coordinate [m] (default: top of the layers)")
-    parser.add_argument("--sphere-depth", type=positive, help="buoyancy sphere centre depth [m] (default 0.3 H)")
-    parser.add_argument("--pipette-depth", type=positive, default=0.10, help="[m]")
-    parser.add_argument("--pipette-volume", type=positive, default=25e-6, help="[m3]")
+    parser.add_argument("--height", type=quantity("suspension_height"),
+                        default=D422_CYLINDER_HEIGHT, help="preview column height [m]")
+    parser.add_argument("--concentration", type=quantity("concentration"), default=50.0, help="preview solids [g/L]")
+    parser.add_argument("--particle-density", type=quantity("particle_density"),
+                        default=SOIL_PARTICLE_DENSITY, help="preview [kg/m3]")
+    parser.add_argument("--surface", type=quantity("surface"),
+                        help="free-surface coordinate [m] (default: top of the layers)")
+    parser.add_argument("--sphere-depth", type=quantity("instrument_depth"),
+                        help="buoyancy sphere centre depth [m] (default 0.3 H)")
+    parser.add_argument("--pipette-depth", type=quantity("instrument_depth"), default=0.10, help="[m]")
+    parser.add_argument("--pipette-volume", type=quantity("pipette_volume"), default=25e-6, help="[m3]")
     parser.add_argument("--hydrometer", type=positive, nargs=6,
                         metavar=("L2", "VB", "STEM_D", "MASS", "L1_R0", "L1_R50"),
                         help="a measured hydrometer instead of the nominal 152H: bulb length [m], bulb volume "
@@ -46,9 +50,10 @@ def add_parser(commands) -> argparse.ArgumentParser:
     parser.add_argument("--temperature", type=temperature, help="the water temperature the laboratory recorded [C], "
                         "0-40: the reduction takes the water's viscosity and density at it (default: the layer "
                         "file's fluid)")
-    parser.add_argument("--viscosity", type=positive, help="viscosity for Stokes' law [Pa s] (default: the "
+    parser.add_argument("--viscosity", type=quantity("water_viscosity"),
+                        help="viscosity for Stokes' law [Pa s] (default: the "
                         "layer file's fluid)")
-    parser.add_argument("--cylinder-area", type=positive, default=D422_CYLINDER_AREA,
+    parser.add_argument("--cylinder-area", type=quantity("cylinder_area"), default=D422_CYLINDER_AREA,
                         help="for the hydrometer's level rise [m2]")
     parser.add_argument("--band", type=Path, metavar="BUDGET",
                         help="budget.json of `sediment budget` for this test: each reading gets the band (low, high) "
@@ -105,7 +110,7 @@ def run(args: argparse.Namespace) -> int:
         column = settling_column(psd, args.height, times, args.concentration, suspension)
         title = f"{args.psd.name}: Stokes settling preview (no DEM)"
     instruments = ["hydrometer", "buoyancy", "pipette"] if args.instrument == "all" else [args.instrument]
-    hydrometer = Hydrometer.measured(*args.hydrometer) if args.hydrometer else None
+    hydrometer = Hydrometer.measured(*_measured(args.hydrometer)) if args.hydrometer else None
     report = granulometry(column, instruments, psd, simulated, title, schedule=args.schedule,
                           sphere_depth=args.sphere_depth, pipette_depth=args.pipette_depth,
                           pipette_volume=args.pipette_volume, cylinder_area=args.cylinder_area,
@@ -124,6 +129,15 @@ def run(args: argparse.Namespace) -> int:
     report.save(args.out)
     print(report.table().text(), end="")
     return 0
+
+
+def _measured(values: list[float]) -> list[float]:
+    """The six values of --hydrometer, each within its quantity's plausible range."""
+    from ..plausible import check
+
+    quantities = ("bulb_length", "bulb_volume", "stem_diameter", "hydrometer_mass", "scale_mark", "scale_mark")
+    names = ("L2", "VB", "STEM_D", "MASS", "L1_R0", "L1_R50")
+    return [check(v, q, f"--hydrometer {n}") for v, q, n in zip(values, quantities, names)]
 
 
 def check_inputs(path: Path, identity: str) -> None:

@@ -6,7 +6,7 @@ import argparse
 from pathlib import Path
 
 from ..constants import DRAGS, HINDRANCES, LAB_TEMPERATURE, SOIL_PARTICLE_DENSITY
-from .types import count, positive, temperature
+from .types import count, positive, quantity, temperature
 
 
 EXAMPLES = [
@@ -54,11 +54,14 @@ def add_test_options(parser: argparse.ArgumentParser) -> None:
                         help="3D periodic column, or Bravo et al.'s 2D slab of the cylinder's axial section")
     parser.add_argument("--cylinder", default="d422", choices=["d422", "bravo"],
                         help="ASTM D422 (27.8 cm2, 0.36 m) or Bravo et al. (B 0.0635 m, H 0.457 m)")
-    parser.add_argument("--height", type=positive, help="suspension height [m] (default: the cylinder's)")
-    parser.add_argument("--width", type=positive, help="column side or slab width [m] (default: 2 largest "
+    parser.add_argument("--height", type=quantity("suspension_height"),
+                        help="suspension height [m] (default: the cylinder's)")
+    parser.add_argument("--width", type=quantity("column_width"),
+                        help="column side or slab width [m] (default: 2 largest "
                         "diameters; the slab spans the cylinder)")
-    parser.add_argument("--mass", type=positive, default=0.060, help="dry sample mass [kg]")
-    parser.add_argument("--particle-density", type=positive, default=SOIL_PARTICLE_DENSITY, help="[kg/m3]")
+    parser.add_argument("--mass", type=quantity("specimen_mass"), default=0.060, help="dry sample mass [kg]")
+    parser.add_argument("--particle-density", type=quantity("particle_density"),
+                        default=SOIL_PARTICLE_DENSITY, help="[kg/m3]")
     parser.add_argument("--temperature", type=temperature, default=LAB_TEMPERATURE,
                         help="water temperature [C], 0-40: its density and viscosity (default 20; 1 C moves the "
                         "viscosity by about 2.5 %%)")
@@ -67,7 +70,7 @@ def add_test_options(parser: argparse.ArgumentParser) -> None:
                         "sheet serves): the run's water follows it, linear between rows, instead of --temperature")
     parser.add_argument("--classes", type=count, default=40, help="log-spaced size classes (eq. 15)")
     parser.add_argument("--layers", type=count, default=400, help="layers of the concentration grid")
-    parser.add_argument("--t-end", type=positive, default=86400.0, help="simulated time [s] (default 24 h)")
+    parser.add_argument("--t-end", type=quantity("t_end"), default=86400.0, help="simulated time [s] (default 24 h)")
     parser.add_argument("--seed", type=int, default=1, help="placement seed")
 
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from .types import count, positive, positive_list
+from .types import count, positive_list, quantity
 
 
 EXAMPLES = [
@@ -31,9 +31,11 @@ def add_parser(commands) -> argparse.ArgumentParser:
     parser.add_argument("--reference", action="append", metavar="NAME=EXPR",
                         help="analytic reference: a number, or an expression of x for a series "
                         "(numpy exp, log, sqrt, ...); default: the finest run")
-    parser.add_argument("--tolerance", type=positive, default=0.01, help="relative error to meet (default 1 %%)")
-    parser.add_argument("--tau", type=positive, help="drag relaxation time [s]: marks the explicit limit 2 tau")
-    parser.add_argument("--rayleigh", type=positive, help="Rayleigh time [s]: marks the 20 %% rule")
+    parser.add_argument("--tolerance", type=quantity("relative_tolerance"),
+                        default=0.01, help="relative error to meet (default 1 %%)")
+    parser.add_argument("--tau", type=quantity("time_scale"),
+                        help="drag relaxation time [s]: marks the explicit limit 2 tau")
+    parser.add_argument("--rayleigh", type=quantity("time_scale"), help="Rayleigh time [s]: marks the 20 %% rule")
     parser.add_argument("--var", nargs=2, action="append", metavar=("NAME", "VALUE"), help="LAMMPS -var for every run")
     parser.add_argument("--np", type=count, default=1, help="MPI ranks per run")
     parser.add_argument("--title", default="", help="figure title")

@@ -7,7 +7,7 @@ import argparse
 import math
 
 from ..constants import DRAG_LAWS, GRAVITY, WATER_20C_DENSITY, WATER_20C_VISCOSITY
-from .types import finite, nonnegative, positive, temperature
+from .types import quantity, temperature
 
 
 EXAMPLES = [
@@ -21,21 +21,22 @@ def add_parser(commands) -> argparse.ArgumentParser:
                                  description="Example: sediment terminal --law standard --diameter 70e-6 "
                                  "--particle-density 2650 --temperature 18")
     parser.add_argument("--law", default="stokes", choices=DRAG_LAWS)
-    parser.add_argument("--diameter", type=positive, required=True, help="sphere diameter [m]")
-    parser.add_argument("--particle-density", type=positive, required=True, help="[kg/m3]")
-    parser.add_argument("--fluid-density", type=positive, help="[kg/m3] (default water at 20 C)")
-    parser.add_argument("--viscosity", type=positive, help="viscosity, or plastic viscosity of a Bingham fluid "
+    parser.add_argument("--diameter", type=quantity("sphere_size"), required=True, help="sphere diameter [m]")
+    parser.add_argument("--particle-density", type=quantity("solid_density"), required=True, help="[kg/m3]")
+    parser.add_argument("--fluid-density", type=quantity("fluid_density"), help="[kg/m3] (default water at 20 C)")
+    parser.add_argument("--viscosity", type=quantity("viscosity"),
+                        help="viscosity, or plastic viscosity of a Bingham fluid "
                         "[Pa s] (default water at 20 C)")
     parser.add_argument("--temperature", type=temperature, help="water at this temperature [C], 0-40, instead of "
                         "--fluid-density and --viscosity")
     parser.add_argument("--hindrance", default="none", help="with --solid-fraction: the speed in a uniform "
                         "suspension under this hindrance (richardson-zaki, garside, difelice)")
-    parser.add_argument("--solid-fraction", type=nonnegative, default=0.0,
+    parser.add_argument("--solid-fraction", type=quantity("solid_fraction"), default=0.0,
                         help="solid volume fraction of the suspension around the sphere (default 0, clear fluid)")
-    parser.add_argument("--yield-stress", type=nonnegative, default=0.0, help="Bingham yield stress [Pa]")
-    parser.add_argument("--gravity", type=positive, default=GRAVITY, help="[m/s2]")
-    parser.add_argument("--youngs-modulus", type=positive, help="[Pa]: also print the Rayleigh time")
-    parser.add_argument("--poisson-ratio", type=finite, default=0.3, help="for the Rayleigh time")
+    parser.add_argument("--yield-stress", type=quantity("yield_stress"), default=0.0, help="Bingham yield stress [Pa]")
+    parser.add_argument("--gravity", type=quantity("gravity"), default=GRAVITY, help="[m/s2]")
+    parser.add_argument("--youngs-modulus", type=quantity("youngs_modulus"), help="[Pa]: also print the Rayleigh time")
+    parser.add_argument("--poisson-ratio", type=quantity("poisson_ratio"), default=0.3, help="for the Rayleigh time")
     return parser
 
 
@@ -49,8 +50,6 @@ def run(args: argparse.Namespace) -> int:
         args.fluid_density, args.viscosity = _core.water_density(args.temperature), _core.water_viscosity(args.temperature)
     args.fluid_density = WATER_20C_DENSITY if args.fluid_density is None else args.fluid_density
     args.viscosity = WATER_20C_VISCOSITY if args.viscosity is None else args.viscosity
-    if not 0.0 <= args.solid_fraction < 0.64:
-        raise ValueError(f"--solid-fraction must be in [0, 0.64), got {args.solid_fraction:g}")
     if (args.hindrance != "none") != (args.solid_fraction > 0):
         raise ValueError("--hindrance and --solid-fraction go together")
     fluid = (args.fluid_density, args.viscosity, args.yield_stress)

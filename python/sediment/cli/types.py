@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import math
+from typing import Callable
 
 
 def finite(text: str) -> float:
@@ -25,20 +26,34 @@ def positive(text: str) -> float:
     return value
 
 
-def nonnegative(text: str) -> float:
-    """A finite number >= 0."""
-    value = finite(text)
-    if value < 0:
-        raise argparse.ArgumentTypeError(f"must be >= 0, got {text}")
-    return value
+def quantity(name: str) -> Callable[[str], float]:
+    """A finite number within the plausible range of a quantity of `sediment.plausible` (the type of
+    the option that takes it), refused with the unit slip that most likely explains it."""
+    from ..plausible import refusal
+
+    def parse(text: str) -> float:
+        value = finite(text)
+        reason = refusal(value, name)
+        if reason is not None:
+            raise argparse.ArgumentTypeError(reason)
+        return value
+
+    parse.__name__ = name    # argparse names the type in its messages
+    return parse
 
 
-def temperature(text: str) -> float:
-    """A water temperature within the range of the water correlations, 0-40 C."""
-    value = finite(text)
-    if not 0.0 <= value <= 40.0:
-        raise argparse.ArgumentTypeError(f"must be within 0-40 C (the range of the water correlations), got {text}")
-    return value
+def quantity_list(name: str) -> Callable[[str], list[float]]:
+    """Comma-separated numbers, each within the plausible range of the quantity `name`."""
+    one = quantity(name)
+
+    def parse(text: str) -> list[float]:
+        return [one(word) for word in text.split(",")]
+
+    parse.__name__ = name
+    return parse
+
+
+temperature = quantity("temperature")    # water, 0-40 C: the range of the water correlations
 
 
 MAX_COUNT = 10**9    # particles, ranks, layers, runs: beyond this no run fits this machine's memory

@@ -3,11 +3,12 @@
 classes (docs/sedimentation-tests.md section 1, Bravo et al. eq. 15)."""
 from __future__ import annotations
 
-import csv
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
+
+from ..csvfile import CsvError, read_csv
 
 
 class PSDError(ValueError):
@@ -83,48 +84,34 @@ def read_psd(path: str | Path) -> PSD:
     PSDError
         The file is missing, empty or malformed, with the line and the reason.
     """
-    path = Path(path)
-    if path.is_dir():
-        raise PSDError(f"{path} is a folder, not a PSD file")
-    if not path.is_file():
-        raise PSDError(f"{path}: no such PSD file")
     try:
-        with open(path, newline="", encoding="utf-8-sig") as f:    # utf-8-sig: a spreadsheet's byte-order mark
-            lines = [row for row in csv.reader(f) if row]
-    except UnicodeDecodeError:
-        raise PSDError(f"{path}: not a text (CSV) file") from None
-    refused = next((",".join(row) for row in lines if row[0].lstrip().startswith(f"# {NOT_FITTING}")), None)
+        table = read_csv(path, "PSD file")
+    except CsvError as exc:
+        raise PSDError(str(exc)) from None
+    path = table.path
+    refused = next((line.strip() for line in table.comments if line.lstrip().startswith(f"# {NOT_FITTING}")), None)
     if refused:
         raise PSDError(f"{path}: written by an inversion whose fit does not explain its sheets ('{refused[2:60]}...'): "
                        "it is no PSD of the sample")
-    rows = [row for row in lines if not row[0].lstrip().startswith("#")]
-    if not rows:
-        raise PSDError(f"{path}: empty PSD file (expected a header diameter_um,percent_finer and rows)")
-    header, body = [h.strip() for h in rows[0]], rows[1:]
-    width = 2 if header == ["diameter_um", "percent_finer"] else len(INVERSE_COLUMNS)
-    if header != ["diameter_um", "percent_finer"] and header != list(INVERSE_COLUMNS):
+    if table.header != ["diameter_um", "percent_finer"] and table.header != list(INVERSE_COLUMNS):
         raise PSDError(f"{path}: header must be 'diameter_um,percent_finer' (two columns, or the columns of `sediment "
-                       f"invert`'s psd.csv), not '{','.join(header)}'")
-    if not body:
+                       f"invert`'s psd.csv), not '{','.join(table.header)}'")
+    if not table.rows:
         raise PSDError(f"{path}: no rows below the header")
-    wide = next((k for k, row in enumerate(body, start=2) if len([c for c in row if c.strip()]) != width), None)
-    if wide is not None:
-        raise PSDError(f"{path}, line {wide}: a row has {len(body[wide - 2])} values; every row needs exactly {width} "
-                       "(diameter in um, percent finer" + (")" if width == 2 else ", and the inverse's band)"))
     try:
-        values = np.array([[float(row[0]), float(row[1])] for row in body])
-    except (ValueError, IndexError):
-        raise PSDError(f"{path}: every row needs two numbers (diameter in um, percent finer)") from None
-    smallest = float(np.nanmin(values[:, 0])) if np.isfinite(values[:, 0]).any() else float("nan")
+        values = np.array([table.numbers("diameter_um"), table.numbers("percent_finer")]).T
+    except CsvError as exc:
+        raise PSDError(f"{exc} (every row needs two numbers: diameter in um, percent finer)") from None
+    smallest = float(values[:, 0].min())
     if 0 < smallest < MIN_DIAMETER_UM:
         raise PSDError(f"{path}: the diameter_um column starts at {smallest:g} um, below {MIN_DIAMETER_UM} um "
                        "(10 nm): write micrometres, not metres or millimetres")
-    largest = float(np.nanmax(values[:, 0])) if np.isfinite(values[:, 0]).any() else float("nan")
+    largest = float(values[:, 0].max())
     if largest < MAX_DIAMETER_LOW_UM:
         raise PSDError(f"{path}: the largest diameter is {largest:g} um; a sedimentation test's PSD reaches tens of "
                        "um: if these are millimetres (sieve sizes), write micrometres (x 1000)")
-    if np.nanmax(values[:, 1]) <= 1.0:
-        raise PSDError(f"{path}: percent finer tops out at {np.nanmax(values[:, 1]):g}: write percent (0-100), "
+    if values[:, 1].max() <= 1.0:
+        raise PSDError(f"{path}: percent finer tops out at {values[:, 1].max():g}: write percent (0-100), "
                        "not fractions (0-1)")
     return PSD(values[:, 0] * 1e-6, values[:, 1], name=str(path))
 

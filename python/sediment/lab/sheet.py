@@ -16,13 +16,14 @@ sample in suspension reads.
 """
 from __future__ import annotations
 
-import csv
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
+from ..csvfile import CsvError, CsvFile, read_csv
+from ..plausible import RANGES, Range, pipette_mass
 from .readout import BuoyancySphere, Hydrometer, Suspension, gs_correction
 
 KINDS = {
@@ -76,8 +77,8 @@ class SieveSheet:
 
 def read_sheet(path: str | Path, pipette_volume: float = 25e-6) -> Sheet | SieveSheet:
     """Reads and checks one sheet (its kind from its header); a pipette's masses become g/L of the sample."""
-    path = Path(path)
-    header, rows = _table(path)
+    table = _table(path)
+    path, header = table.path, table.header
     kinds = [k for k, columns in KINDS.items() if set(columns) <= set(header)]
     if not kinds:
         expected = "; ".join(",".join(c) for c in KINDS.values())
@@ -91,57 +92,58 @@ def read_sheet(path: str | Path, pipette_volume: float = 25e-6) -> Sheet | Sieve
         known = ", ".join(KINDS[kind] + OPTIONAL[kind])
         raise SheetError(f"{path}: column(s) {', '.join(unknown)} are not of a {kind} sheet (its columns: {known}): "
                          "rename or remove them, as a misspelt column would be left out silently")
-    if not rows:
+    if not table.rows:
         raise SheetError(f"{path}: no readings below the header")
-    values: dict[str, list[float]] = {name: [] for name in header}
-    for number, row in enumerate(rows, start=2):
-        for name, text in zip(header, row):
-            text = text.strip()
-            if text == "" and name in ("temperature_C", "blank"):
-                values[name].append(math.nan)
-                continue
-            try:
-                values[name].append(float(text))
-            except ValueError:
-                raise SheetError(f"{path}, row {number}: {name} '{text}' is not a number") from None
-            if not math.isfinite(values[name][-1]):
-                raise SheetError(f"{path}, row {number}: {name} is not finite")
+    values = {name: np.array(_numbers(table, name, blank=name in ("temperature_C", "blank"))) for name in header}
+    lines = [line for line, _ in table.rows]
     if kind == "sieve":
-        return _sieve_sheet(path, np.array(values["opening_mm"]), np.array(values["percent_passing"]))
-    time = np.array(values["time_min"]) * 60.0
+        return _sieve_sheet(path, values["opening_mm"], values["percent_passing"])
+    _plausible(path, lines, values, "time_min", "time_min")
+    time = values["time_min"] * 60.0
     if time[0] <= 0 or np.any(np.diff(time) <= 0):
         raise SheetError(f"{path}: the times must be > 0 and increase from row to row")
-    temperature = np.array(values.get("temperature_C", [math.nan] * len(time)))
+    values.setdefault("temperature_C", np.full(len(time), math.nan))
+    temperature = values["temperature_C"]
     recorded = np.isfinite(temperature)
     if kind == "hydrometer" and not recorded.all():
-        missing = ", ".join(str(k + 2) for k in np.flatnonzero(~recorded))
-        raise SheetError(f"{path}: no temperature in row(s) {missing}: a hydrometer's reading needs the temperature "
+        missing = ", ".join(str(lines[k]) for k in np.flatnonzero(~recorded))
+        raise SheetError(f"{path}: no temperature on line(s) {missing}: a hydrometer's reading needs the temperature "
                          "it was taken at")
-    if np.any(recorded & ((temperature < 0) | (temperature > 40))):
-        raise SheetError(f"{path}: temperatures outside 0-40 C, the range of the water correlations")
+    _plausible(path, lines, values, "temperature_C", "temperature")
     depth, blank = np.empty(0), np.empty(0)
     if kind == "hydrometer":
-        reading = np.array(values["reading"])
+        reading = values["reading"]
         if np.all((reading > 0.95) & (reading < 1.15)):
             raise SheetError(f"{path}: the readings ({reading.min():g}-{reading.max():g}) look like specific gravities "
                              "(a 151H, g/cm3): the sheet takes a 152H's readings in g/L")
+        _plausible(path, lines, values, "reading", "reading")
         if "blank" in values:
-            blank = np.array(values["blank"])
+            blank = values["blank"]
             if not np.isfinite(blank).all():
-                missing = ", ".join(str(k + 2) for k in np.flatnonzero(~np.isfinite(blank)))
-                raise SheetError(f"{path}: no blank in row(s) {missing}: give the composite correction beside every "
+                missing = ", ".join(str(lines[k]) for k in np.flatnonzero(~np.isfinite(blank)))
+                raise SheetError(f"{path}: no blank on line(s) {missing}: give the composite correction beside every "
                                  "reading, or drop the column and give --zero-correction")
+            _plausible(path, lines, values, "blank", "correction")
     elif kind == "pipette":
-        depth = np.array(values["depth_cm"]) / 100.0
-        mass = np.array(values["mass_g"])
-        if np.any(depth <= 0) or np.any(mass < 0):
-            raise SheetError(f"{path}: depths must be > 0 and masses >= 0")
-        reading = mass / (pipette_volume * 1e3)      # g per litre of the sample
+        _plausible(path, lines, values, "depth_cm", "depth_cm")
+        _plausible(path, lines, values, "mass_g", pipette_mass(pipette_volume))
+        depth = values["depth_cm"] / 100.0
+        reading = values["mass_g"] / (pipette_volume * 1e3)      # g per litre of the sample
     else:
-        reading = np.array(values["apparent_mass_g"])
-        if np.any(reading <= 0):
-            raise SheetError(f"{path}: apparent masses must be > 0")
+        _plausible(path, lines, values, "apparent_mass_g", "apparent_mass_g")
+        reading = values["apparent_mass_g"]
     return Sheet(kind, path, time, reading, temperature, depth, blank)
+
+
+def _plausible(path: Path, lines: list[int], values: dict[str, np.ndarray], column: str,
+               quantity: str | Range) -> None:
+    """Refuses the first value of a column outside its quantity's plausible range (blank cells aside),
+    naming the line and the likely unit slip."""
+    bounds = RANGES[quantity] if isinstance(quantity, str) else quantity
+    for line, value in zip(lines, values[column]):
+        reason = bounds.refusal(value) if math.isfinite(value) else None
+        if reason is not None:
+            raise SheetError(f"{path}, line {line}: {column} {reason}")
 
 
 def _sieve_sheet(path: Path, opening_mm: np.ndarray, passing: np.ndarray) -> SieveSheet:
@@ -172,54 +174,43 @@ def _sieve_sheet(path: Path, opening_mm: np.ndarray, passing: np.ndarray) -> Sie
     return SieveSheet(path, opening, passing)
 
 
-def _table(path: Path) -> tuple[list[str], list[list[str]]]:
-    """A CSV's header and rows (blank lines and # comments left out), each row as long as the header."""
+def _table(path: str | Path) -> CsvFile:
+    """A sheet's table (sediment.csvfile: one reader for every CSV given), its errors as SheetErrors."""
     try:
-        with path.open(newline="", encoding="utf-8-sig") as handle:
-            rows = [row for row in csv.reader(handle) if row and not row[0].lstrip().startswith("#")]
-    except UnicodeDecodeError as exc:
-        raise SheetError(f"{path}: not a text CSV ({exc.reason})") from None
-    if not rows:
-        raise SheetError(f"{path}: empty sheet")
-    if len(rows[0]) == 1 and ";" in rows[0][0]:
-        raise SheetError(f"{path}: the columns are separated by ';' (a spreadsheet's export with decimal commas): save "
-                         "it as CSV with ',' between columns and '.' as the decimal point")
-    # a spreadsheet's trailing empty column: left out where the header names none
-    while len(rows[0]) > 1 and not rows[0][-1].strip() and all(len(r) == len(rows[0]) and not r[-1].strip() for r in rows):
-        rows = [r[:-1] for r in rows]
-    header = [h.strip() for h in rows[0]]
-    for number, row in enumerate(rows[1:], start=2):
-        if len(row) != len(header):
-            raise SheetError(f"{path}, row {number}: {len(row)} fields, the header has {len(header)}")
-    return header, rows[1:]
+        return read_csv(path, "sheet")
+    except CsvError as exc:
+        raise SheetError(str(exc)) from None
+
+
+def _numbers(table: CsvFile, name: str, blank: bool = False) -> list[float]:
+    """A column's numbers, its errors as SheetErrors."""
+    try:
+        return table.numbers(name, blank)
+    except CsvError as exc:
+        raise SheetError(str(exc)) from None
 
 
 def read_temperature_record(path: str | Path) -> tuple[tuple[float, float], ...]:
     """The water's temperature over a test, (time [s], temperature [C]) pairs, from any CSV with the
     columns time_min and temperature_C (a sheet of readings serves; rows without a temperature are
     left out)."""
-    path = Path(path)
-    header, rows = _table(path)
-    if not {"time_min", "temperature_C"} <= set(header):
+    table = _table(path)
+    path = table.path
+    if not {"time_min", "temperature_C"} <= set(table.header):
         raise SheetError(f"{path}: a temperature record needs the columns time_min and temperature_C (header: "
-                         f"{','.join(header)})")
-    at, column = header.index("time_min"), header.index("temperature_C")
-    record = []
-    for number, row in enumerate(rows, start=2):
-        if row[column].strip() == "":
-            continue
-        try:
-            time, celsius = float(row[at]) * 60.0, float(row[column])
-        except ValueError:
-            raise SheetError(f"{path}, row {number}: time or temperature is not a number") from None
-        if not (math.isfinite(time) and 0.0 <= celsius <= 40.0):
-            raise SheetError(f"{path}, row {number}: a temperature within 0-40 C at a finite time is needed")
-        record.append((time, celsius))
+                         f"{','.join(table.header)})")
+    lines = [line for line, _ in table.rows]
+    values = {"time_min": np.array(_numbers(table, "time_min")),
+              "temperature_C": np.array(_numbers(table, "temperature_C", blank=True))}
+    _plausible(path, lines, values, "time_min", "record_time_min")
+    _plausible(path, lines, values, "temperature_C", "temperature")
+    record = tuple((float(t) * 60.0, float(c)) for t, c in zip(values["time_min"], values["temperature_C"])
+                   if math.isfinite(c))
     if not record:
         raise SheetError(f"{path}: no temperatures recorded")
     if record[0][0] < 0 or any(b[0] <= a[0] for a, b in zip(record[:-1], record[1:])):
         raise SheetError(f"{path}: the times must be >= 0 and increase from row to row")
-    return tuple(record)
+    return record
 
 
 def check_sheet(sheet: Sheet, whole: float, resolution: float) -> None:

@@ -8,7 +8,6 @@ terminal velocity with the law's analytic one (a check of the code) and with the
 """
 from __future__ import annotations
 
-import csv
 import math
 from dataclasses import dataclass
 from pathlib import Path
@@ -18,6 +17,8 @@ import numpy as np
 from .. import _core, figures
 from ..results import Table, write_text
 from ..constants import GRAVITY
+from ..csvfile import number, read_csv
+from ..plausible import refusal
 from ..sim.paths import REPO_DIR
 from ..sim.run import run_batch
 
@@ -59,32 +60,33 @@ class Settling:
         return self.analytic / self.sphere.measured - 1.0
 
 
+# each column's quantity in sediment.plausible, for the range and the unit slip of a value
+QUANTITIES = {"rho_f": "fluid_density", "eta_B": "viscosity", "tau_y": "yield_stress", "d": "ball_diameter",
+              "rho_p": "solid_density", "v_ter_measured": "settling_speed"}
+
+
 def read_spheres(path: Path) -> list[Sphere]:
-    """Reads the spheres of a Valentik & Whitmore CSV, refusing malformed rows with the line."""
-    path = Path(path)
-    if not path.is_file():
-        raise FileNotFoundError(f"{path}: no such file")
-    with open(path, newline="") as f:
-        reader = csv.DictReader(f)
-        missing = [c for c in COLUMNS if c not in (reader.fieldnames or [])]
-        if missing:
-            raise ValueError(f"{path}: missing column(s) {', '.join(missing)} (expected {', '.join(COLUMNS)})")
-        spheres = []
-        for line, row in enumerate(reader, start=2):
-            try:
-                values = {c: float(row[c]) for c in COLUMNS[1:]}
-            except (TypeError, ValueError):
-                raise ValueError(f"{path}, line {line}: a value is not a number: {row}") from None
-            bad = [c for c, v in values.items() if not (math.isfinite(v) and (v > 0 or (c == "tau_y" and v == 0)))]
-            if bad:
-                raise ValueError(f"{path}, line {line}: {', '.join(bad)} must be > 0")
-            if values["rho_p"] <= values["rho_f"]:
-                raise ValueError(f"{path}, line {line}: the sphere (rho_p {values['rho_p']}) does not sink "
-                                 f"in the suspension (rho_f {values['rho_f']})")
-            spheres.append(Sphere(row["suspension"], values["rho_f"], values["eta_B"], values["tau_y"], values["d"],
-                                  values["rho_p"], values["v_ter_measured"]))
+    """Reads the spheres of a Valentik & Whitmore CSV, refusing implausible or malformed rows with the line."""
+    table = read_csv(path, "spheres CSV")
+    missing = [c for c in COLUMNS if c not in table.header]
+    if missing:
+        raise ValueError(f"{table.path}: missing column(s) {', '.join(missing)} (expected {', '.join(COLUMNS)})")
+    spheres = []
+    for line, row in table.rows:
+        cells = dict(zip(table.header, row))
+        where = table.where(line)
+        values = {c: number(cells[c].strip(), c, where) for c in COLUMNS[1:]}
+        for column, quantity in QUANTITIES.items():
+            reason = refusal(values[column], quantity)
+            if reason is not None:
+                raise ValueError(f"{where}: {column} {reason}")
+        if values["rho_p"] <= values["rho_f"]:
+            raise ValueError(f"{where}: the sphere (rho_p {values['rho_p']:g}) does not sink in the suspension "
+                             f"(rho_f {values['rho_f']:g})")
+        spheres.append(Sphere(cells["suspension"].strip(), values["rho_f"], values["eta_B"], values["tau_y"], values["d"],
+                              values["rho_p"], values["v_ter_measured"]))
     if not spheres:
-        raise ValueError(f"{path}: no spheres")
+        raise ValueError(f"{table.path}: no spheres")
     return spheres
 
 
