@@ -64,18 +64,30 @@ SCENES = {"plain": "nve/sphere + gravity (reference)",
           "lubricated": "as drag + pair lubricate/fluid"}
 
 
-def loop_time(scene: str, particles: int, steps: int, lmp: Path | None = None, dt: float = 1e-4) -> float:
-    """Loop time of the scene, with `lmp` instead of the lmp_sediment in use when given."""
+def scene_run(scene: str, particles: int, steps: int, lmp: Path | None = None, dt: float = 1e-4,
+              mu: float | None = None) -> tuple[float, int]:
+    """Loop time of the scene and how many times LAMMPS rebuilt its neighbor lists in it ("Neighbor
+    list builds": each one exchanges atoms, remaps them into the box and rebuilds the ghosts), with
+    `lmp` instead of the lmp_sediment in use when given, in a fluid of viscosity `mu` (default water's)."""
     previous = os.environ.get("SEDIMENT_LMP")
     if lmp is not None:
         os.environ["SEDIMENT_LMP"] = str(lmp)
     try:
-        return run_batch(HERE / "in.cost", {"scene": scene, "n": particles, "steps": steps, "dt": dt}).loops[0][0]
+        out = run_batch(HERE / "in.cost", {"scene": scene, "n": particles, "steps": steps, "dt": dt,
+                                           "mu": MU if mu is None else mu})
+        builds = re.search(r"^Neighbor list builds = (\d+)", out.text, re.MULTILINE)
+        return out.loops[0][0], int(builds.group(1)) if builds else -1
     finally:
         if previous is None:
             os.environ.pop("SEDIMENT_LMP", None)
         else:
             os.environ["SEDIMENT_LMP"] = previous
+
+
+def loop_time(scene: str, particles: int, steps: int, lmp: Path | None = None, dt: float = 1e-4,
+              mu: float | None = None) -> float:
+    """Loop time of the scene (scene_run's)."""
+    return scene_run(scene, particles, steps, lmp, dt, mu)[0]
 
 
 # Cachegrind's model of one core: L1 data cache and, as the last level, the L2 (size, ways, line).
@@ -100,7 +112,7 @@ def valgrind_totals(text: str) -> dict[str, int]:
 
 
 def counts_per_step(scene: str, particles: int, steps: int, lmp: Path | None = None,
-                    dt: float = 1e-4) -> dict[str, float]:
+                    dt: float = 1e-4, mu: float | None = None) -> dict[str, float]:
     """Instructions, L1 and L2 data misses per particle-step in the time-step loop, and the estimate
     of cycles."""
     if shutil.which("valgrind") is None:
@@ -113,7 +125,7 @@ def counts_per_step(scene: str, particles: int, steps: int, lmp: Path | None = N
                    f"--callgrind-out-file={out}",
                    str(lmp or lmp_executable()), "-in", str(HERE / "in.cost"), "-log", "none", "-screen", "none",
                    "-var", "scene", scene, "-var", "n", str(particles), "-var", "steps", str(run_steps),
-                   "-var", "dt", repr(dt)]
+                   "-var", "dt", repr(dt), "-var", "mu", repr(MU if mu is None else mu)]
             done = subprocess.run(cmd, capture_output=True, text=True, env=dict(os.environ, OMP_NUM_THREADS="1"))
             if done.returncode != 0:
                 sys.exit(f"cost.py --counts: scene {scene} failed under callgrind:\n{done.stderr[-2000:]}")
@@ -160,17 +172,18 @@ def report_counts(scenes: dict[str, str], args: argparse.Namespace) -> None:
     """The --counts table: this build, and the baseline when given (the counts need no turns)."""
     steps = args.steps if args.steps_given else 50
     columns = ("instructions", "L1 misses", "L2 misses", "cycles (est.)")
-    print(f"{args.particles} particles x ({steps}, {3 * steps}) steps at dt {args.dt:g} s (dt/tau {args.dt / TAU:.3g}) "
+    print(f"{args.particles} particles x ({steps}, {3 * steps}) steps at dt {args.dt:g} s, viscosity {args.viscosity:g} "
+          f"Pa s (dt/tau {args.dt / tau_at(args.viscosity):.3g}) "
           "in the time-step loop under callgrind, per particle-step")
     print(f"{'scene':10s} " + " ".join(f"{c:>13s}" for c in columns) + (f" {'this/baseline':>14s}" if args.baseline
                                                                          else "") + "  what")
     cycles = {}
     for s, what in scenes.items():
-        mine = counts_per_step(s, args.particles, steps, dt=args.dt)
+        mine = counts_per_step(s, args.particles, steps, dt=args.dt, mu=args.viscosity)
         cycles[s] = mine["cycles (est.)"]
         against = ""
         if args.baseline:
-            theirs = counts_per_step(s, args.particles, steps, args.baseline, dt=args.dt)
+            theirs = counts_per_step(s, args.particles, steps, args.baseline, dt=args.dt, mu=args.viscosity)
             against = f" {mine['cycles (est.)'] / theirs['cycles (est.)']:14.3f}"
         print(f"{s:10s} " + " ".join(f"{mine[c]:13.2f}" for c in columns) + against + f"  {what}", flush=True)
     print()
@@ -233,15 +246,24 @@ def main() -> None:
     parser.add_argument("--counts", action="store_true",
                         help="instructions and cache misses under callgrind instead of the clock (see above)")
     parser.add_argument("--dt", type=float, default=1e-4,
-                        help="time step of the scenes [s] (default 1e-4: dt/tau = 0.76 for their 30 um grains)")
+                        help="time step of the scenes [s] (default 1e-4: dt/tau = 0.76 for their 30 um grains in water)")
+    parser.add_argument("--viscosity", type=float, default=MU,
+                        help="the fluid's viscosity [Pa s] (default water's, 1.002e-3); the sweep's points above dt/tau = 1 "
+                             "take it as sqrt(dt/tau) x water's (see sweep_point())")
     parser.add_argument("--sweep", action="store_true",
                         help="the cost at every dt/tau from 1e-4 to 1e4 against the peer at each (see sweep())")
+    parser.add_argument("--sweep-by", choices=("viscosity", "dt"), default="viscosity",
+                        help="how the sweep reaches dt/tau above 1: 'viscosity' (default) as a user's scene does, with faster "
+                             "relaxing grains and the same displacement per step as at dt/tau = 1; 'dt', as before issue 60's "
+                             "second round, with steps up to 1e4 tau on the same grains, which cross the neighbor skin every "
+                             "step (see sweep_point())")
     parser.add_argument("--jobs", action="store_true",
                         help="after the ratios, the main job's commands (make demo's) and the example inversion timed")
     args = parser.parse_args()
     args.steps_given = args.steps is not None
     # The references run where they can (EXPLICIT_LIMIT; --sweep takes the peer's cost at dt/tau = 1 past it).
-    references = ("plain", "peer") if args.counts or args.sweep or args.dt <= EXPLICIT_LIMIT * TAU else ()
+    references = (("plain", "peer") if args.counts or args.sweep or args.dt <= EXPLICIT_LIMIT * tau_at(args.viscosity)
+                  else ())
     scenes = {s: SCENES[s] for s in SCENES if s in args.scenes or s in references}
     print(machine_and_build(under_valgrind=args.counts))
     if args.baseline:
@@ -250,7 +272,8 @@ def main() -> None:
         report_counts(scenes, args)
         return
     if args.sweep:
-        sweep([s for s in args.scenes if s in SWEPT] or list(SWEPT), args.particles, args.steps or 1000, args.repeats)
+        sweep([s for s in args.scenes if s in SWEPT] or list(SWEPT), args.particles, args.steps or 1000, args.repeats,
+              args.sweep_by)
         if args.jobs:
             time_jobs()
         return
@@ -261,15 +284,16 @@ def main() -> None:
     for _ in range(args.repeats):
         rounds.append({})
         for s in scenes:
-            mine = loop_time(s, args.particles, args.steps, dt=args.dt)
+            mine = loop_time(s, args.particles, args.steps, dt=args.dt, mu=args.viscosity)
             rounds[-1][s] = mine
             if args.baseline:
-                theirs = loop_time(s, args.particles, args.steps, args.baseline, dt=args.dt)
+                theirs = loop_time(s, args.particles, args.steps, args.baseline, dt=args.dt, mu=args.viscosity)
                 baseline[s] = min(baseline[s], theirs)
                 pair_ratios[s].append(mine / theirs)
     times = {s: min(r[s] for r in rounds) for s in scenes}
     per = {s: t / (args.particles * args.steps) * 1e9 for s, t in times.items()}
-    print(f"{args.particles} particles x {args.steps} steps at dt {args.dt:g} s (dt/tau {args.dt / TAU:.3g}), best of "
+    print(f"{args.particles} particles x {args.steps} steps at dt {args.dt:g} s, viscosity {args.viscosity:g} Pa s "
+          f"(dt/tau {args.dt / tau_at(args.viscosity):.3g}), best of "
           f"{args.repeats}, 1 rank")
     against = f" {'baseline ns':>12s} {'this/baseline':>14s} {'median of pairs':>16s}" if args.baseline else ""
     print(f"{'scene':10s} {'ns/particle-step':>17s} {'ratio to plain':>15s}{against}  what")
@@ -280,7 +304,7 @@ def main() -> None:
         to_plain = f"{per[s] / per['plain']:15.2f}" if "plain" in per else f"{'-':>15s}"
         print(f"{s:10s} {per[s]:17.2f} {to_plain}{against}  {what}")
     if not references:
-        print(f"no plain or peer scene at dt/tau {args.dt / TAU:.3g} > {EXPLICIT_LIMIT:g} (explicit, they cannot run there); "
+        print(f"no plain or peer scene at dt/tau {args.dt / tau_at(args.viscosity):.3g} > {EXPLICIT_LIMIT:g} (explicit, they cannot run there); "
               "their cost per particle-step at dt/tau = 1, which does not depend on the step, is --sweep's reference")
     if args.baseline:
         print(f"baseline: {args.baseline}; the peer and plain scenes run the same code in both builds, so "
@@ -320,8 +344,16 @@ def time_jobs() -> None:
             print(f"  {label:80s} {time.perf_counter() - start:7.1f} s")
 
 
-# Relaxation time of the scene's grains (30 um quartz in water, Stokes): the step's regime is dt/tau.
-TAU = _core.relaxation_time("stokes", 998.2, 1.002e-3, 3e-5, 2650)
+# The water's viscosity, and the relaxation time of the scene's grains (30 um quartz, Stokes) in a fluid
+# of the water's density and viscosity mu: the step's regime is dt/tau.
+MU = 1.002e-3
+
+
+def tau_at(mu: float) -> float:
+    return _core.relaxation_time("stokes", 998.2, mu, 3e-5, 2650)
+
+
+TAU = tau_at(MU)
 # Past this dt/tau the explicit references cannot run: the peer's explicit drag is unstable, and the
 # plain scene's free fall crosses the box in a step.
 EXPLICIT_LIMIT = 2.0
@@ -329,32 +361,63 @@ SWEPT = ("drag", "nonlinear", "standard", "richardson", "hindered")
 RATIOS = (1e-4, 1e-3, 1e-2, 1e-1, 1.0, 10.0, 100.0, 1e3, 1e4)
 
 
-def sweep(scenes: list[str], particles: int, steps: int, repeats: int) -> None:
+def sweep_point(ratio: float, by: str = "viscosity") -> tuple[float, float, float]:
+    """The viscosity, the scenes' step and the peer's step of the sweep's point at dt/tau = `ratio`.
+
+    Up to dt/tau = 1 the 30 um grains settle in water at dt = ratio x tau: they move at most 0.0036
+    of their diameter per step (1.1e-7 m at dt/tau = 1, against LAMMPS's neighbor skin of 1 mm in SI
+    units), and LAMMPS never rebuilds its neighbor lists in the run.
+
+    Above, by 'viscosity' (the default), the grains relax faster, as a user's grains at such dt/tau
+    do (a 1 um clay grain in water, tau ~1e-7 s, at dt ~1e-3 s): the viscosity is sqrt(ratio) x the
+    water's, so tau falls by sqrt(ratio) and dt = ratio x tau rises by sqrt(ratio), and the terminal
+    displacement per step, g' tau dt, stays the one at dt/tau = 1. The particle Reynolds number falls
+    as 1/ratio (2.4e-6 at 1e4; the clay grain's is ~1e-6). The peer, whose explicit drag is unstable
+    past dt/tau = 2, runs in the same fluid at dt = its tau.
+
+    By 'dt' (the sweep before issue 60's second round) the same grains in water take dt = ratio x
+    tau: at 1e4 they fall 1.1 mm (36 diameters) per step, more than half the skin, and LAMMPS
+    rebuilds its lists, exchanges the atoms and remaps them into the box every step (every 10th on
+    LAMMPS 29 Sep 2021, whose neigh_modify delay is 10), which the peer at dt/tau = 1 does not: a
+    cost of the benchmark's scene, not of a user's."""
+    if ratio <= 1.0 or by == "dt":
+        dt = ratio * TAU
+        return MU, dt, dt if ratio <= EXPLICIT_LIMIT else TAU
+    mu = MU * ratio ** 0.5
+    return mu, ratio * tau_at(mu), tau_at(mu)
+
+
+def sweep(scenes: list[str], particles: int, steps: int, repeats: int, by: str = "viscosity") -> None:
     """The step's cost at each dt/tau against the peer's at the same dt: in each of `repeats` rounds
     the peer and the scenes of a ratio run one after the other, so that a drift of the machine's
     speed touches them alike; printed as the ratio of the best times and as the median of the rounds'
-    ratios. Above dt/tau = 2 the explicit peer is unstable: there it runs at dt/tau = 1 in the same
-    rounds and stands in, as its cost per particle-step does not depend on the step."""
+    ratios, with the neighbor list builds of the run (the most of the scenes', and the peer's).
+    Above dt/tau = 2 the explicit peer is unstable: there it runs at dt/tau = 1 in the same fluid
+    and rounds and stands in, as its cost per particle-step does not depend on the step. How each
+    point is reached: sweep_point()."""
     rows = []
     for ratio in RATIOS:
-        dt = ratio * TAU
-        peer_dt = dt if ratio <= EXPLICIT_LIMIT else TAU
-        rounds = []
+        mu, dt, peer_dt = sweep_point(ratio, by)
+        rounds, builds = [], {}
         for _ in range(repeats):
-            times = {"peer": loop_time("peer", particles, steps, dt=peer_dt)}
-            times.update({s: loop_time(s, particles, steps, dt=dt) for s in scenes})
+            times = {}
+            for s in ("peer", *scenes):
+                times[s], builds[s] = scene_run(s, particles, steps, dt=peer_dt if s == "peer" else dt, mu=mu)
             rounds.append({s: t / (particles * steps) * 1e9 for s, t in times.items()})
-        rows.append((ratio, {s: min(r[s] for r in rounds) for s in rounds[0]}, rounds))
-    print(f"{particles} particles x {steps} steps, {repeats} rounds, 1 rank; tau = {TAU:.3g} s; ratios to the peer "
-          "at the same dt (at dt/tau = 1 above 2, where it is unstable): of the best times, and in brackets the "
-          "median of the rounds' ratios")
-    print(f"{'dt/tau':>8s} {'peer ns':>9s} " + " ".join(f"{s:>17s}" for s in scenes))
-    for ratio, best, rounds in rows:
+        rows.append((ratio, mu, dt, {s: min(r[s] for r in rounds) for s in rounds[0]}, rounds, builds))
+    print(f"{particles} particles x {steps} steps, {repeats} rounds, 1 rank; 30 um grains, tau = {TAU:.3g} s in water; "
+          f"above dt/tau = 1 {'by the step on the same grains in water' if by == 'dt' else 'by the viscosity'} "
+          "(sweep_point()); ratios to the peer at the same dt (at dt/tau = 1 above 2, where it is unstable): of the "
+          "best times, and in brackets the median of the rounds' ratios; lists: neighbor list builds in the run, "
+          "the most of the scenes' / the peer's")
+    print(f"{'dt/tau':>8s} {'mu Pa s':>9s} {'dt s':>9s} {'lists':>9s} {'peer ns':>9s} " + " ".join(f"{s:>17s}" for s in scenes))
+    for ratio, mu, dt, best, rounds, builds in rows:
         mark = "*" if ratio > EXPLICIT_LIMIT else " "
         medians = {s: statistics.median(r[s] / r["peer"] for r in rounds) for s in scenes}
-        print(f"{ratio:8.0e} {best['peer']:8.2f}{mark} "
+        lists = f"{max(builds[s] for s in scenes)}/{builds['peer']}"
+        print(f"{ratio:8.0e} {mu:9.3g} {dt:9.3g} {lists:>9s} {best['peer']:8.2f}{mark} "
               + " ".join(f"{best[s] / best['peer']:9.2f}x ({medians[s]:.2f})" for s in scenes))
-    print("* the peer at dt/tau = 1, run in the same rounds")
+    print("* the peer at dt/tau = 1 in the same fluid, run in the same rounds")
 
 
 def report_targets(times: dict[str, float], rounds: list[dict[str, float]]) -> None:

@@ -77,29 +77,46 @@ def test_the_counts_run_the_scene_at_the_step_asked_for(cost, monkeypatch):
 
 
 def test_the_sweep_runs_the_peer_beside_the_scenes_at_every_point(cost, monkeypatch, capsys):
-    # Above dt/tau = 2 the explicit peer runs at dt/tau = 1, in the same round as the scenes there,
-    # and each round's ratio divides by that round's peer (a drift of the machine between the points
-    # must not enter a point's ratio). Times here: the peer doubles from round to round, the scene
-    # costs twice the peer of its round, so every ratio is 2 exactly.
+    # Above dt/tau = 2 the explicit peer runs at dt/tau = 1, in the same fluid and round as the scenes
+    # there, and each round's ratio divides by that round's peer (a drift of the machine between the
+    # points must not enter a point's ratio). Times here: the peer doubles from round to round, the
+    # scene costs twice the peer of its round, so every ratio is 2 exactly.
     calls = []
     state = {"round": 0}
 
-    def loop_time(scene, particles, steps, lmp=None, dt=1e-4):
-        calls.append((scene, dt))
+    def scene_run(scene, particles, steps, lmp=None, dt=1e-4, mu=None):
+        calls.append((scene, dt, mu))
         if scene == "peer":
             state["round"] += 1
-        return 2.0 ** state["round"] * (2.0 if scene == "drag" else 1.0)
+        return 2.0 ** state["round"] * (2.0 if scene == "drag" else 1.0), 0
 
-    monkeypatch.setattr(cost, "loop_time", loop_time)
+    monkeypatch.setattr(cost, "scene_run", scene_run)
     cost.sweep(["drag"], 10, 10, 3)
     for ratio in cost.RATIOS:
-        dt = ratio * cost.TAU
-        peer_dt = dt if ratio <= cost.EXPLICIT_LIMIT else cost.TAU
-        assert calls.count(("peer", peer_dt)) >= 3 and calls.count(("drag", dt)) == 3
+        mu, dt, peer_dt = cost.sweep_point(ratio)
+        assert dt / cost.tau_at(mu) == pytest.approx(ratio)
+        assert peer_dt / cost.tau_at(mu) == pytest.approx(ratio if ratio <= cost.EXPLICIT_LIMIT else 1.0)
+        assert calls.count(("peer", peer_dt, mu)) >= 3 and calls.count(("drag", dt, mu)) == 3
     assert len(calls) == 2 * 3 * len(cost.RATIOS)
     points = {f"{ratio:.0e}" for ratio in cost.RATIOS}
     rows = [line.split() for line in capsys.readouterr().out.splitlines() if line.split()[:1] and
             line.split()[0] in points]
     assert len(rows) == len(cost.RATIOS)
-    assert all(row[-2:] == ["2.00x", "(2.00)"] for row in rows)
-    assert [row[1].endswith("*") for row in rows] == [r > cost.EXPLICIT_LIMIT for r in cost.RATIOS]
+    assert all(row[-2:] == ["2.00x", "(2.00)"] and row[3] == "0/0" for row in rows)
+    assert [row[4].endswith("*") for row in rows] == [r > cost.EXPLICIT_LIMIT for r in cost.RATIOS]
+
+
+def test_the_sweep_keeps_the_displacement_per_step_of_a_users_scene(cost):
+    # Above dt/tau = 1 the sweep makes the grains relax faster (the viscosity as sqrt(dt/tau)), so
+    # that they fall per step what they fall at dt/tau = 1 (g' tau dt), far inside LAMMPS's neighbor
+    # skin: the rows measure the step, not LAMMPS's rebuilds of its lists. With --sweep-by dt the
+    # grains of dt/tau = 1e4 fall 36 diameters per step (the rows before issue 60's second round).
+    def fall(mu, dt):
+        return cost.tau_at(mu) * dt
+    at_one = fall(*cost.sweep_point(1.0)[:2])
+    for ratio in cost.RATIOS:
+        mu, dt, _ = cost.sweep_point(ratio)
+        assert fall(mu, dt) == pytest.approx(min(ratio, 1.0) * at_one)
+    mu, dt, peer_dt = cost.sweep_point(1e4, "dt")
+    assert mu == cost.MU and dt == pytest.approx(1e4 * cost.TAU) and peer_dt == cost.TAU
+    assert fall(mu, dt) == pytest.approx(1e4 * at_one)
