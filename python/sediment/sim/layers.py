@@ -13,7 +13,6 @@ from __future__ import annotations
 import faulthandler
 import os
 import pickle
-import re
 import signal
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -22,6 +21,10 @@ import numpy as np
 
 SCHEMA = "sediment-layers"
 SCHEMA_VERSION = 1
+
+
+ATTRIBUTES = ("columns", "units", "axis", "dimension", "cross_section", "layer_lo", "layer_thickness")
+DATASETS = ("time", "step", "fraction", "layer_centre", "class_edges")
 
 
 class LayerFileError(ValueError):
@@ -120,9 +123,10 @@ def read_layers(path: str | Path) -> LayerFile:
                              class_edges=np.asarray(f["class_edges"]), time=time,
                              step=np.asarray(f["step"][:frames]), fraction=fraction, attributes=extra,
                              complete=f.attrs.get("complete", 0) == 1, identity=identity)
-        except KeyError as exc:    # h5py: "Can't open attribute (can't locate attribute: 'units')"
-            quoted = re.findall(r"'([^']+)'", str(exc))
-            what = ("the attribute " if "attribute" in str(exc) else "the dataset ") + (quoted[-1] if quoted else str(exc))
+        except KeyError as exc:    # h5py's message names the attribute in one file format, not in the other
+            missing = ([f"the attribute {k}" for k in ATTRIBUTES if k not in f.attrs]
+                       + [f"the dataset {k}" for k in DATASETS if k not in f])
+            what = missing[0] if missing else f"readable metadata ({exc})"
             raise LayerFileError(f"{path}: the layer file lacks {what} (damaged, or not written by fix "
                                  "layers/hdf5)") from None
         except OSError as exc:

@@ -295,9 +295,10 @@ def _resume_id(deck: Path, variables: dict[str, str]) -> str:
     return record["run_id"]
 
 
-def _check_partial(deck: Path, variables: dict[str, str]) -> None:
+def _check_partial(deck: Path, variables: dict[str, str], identity: str) -> None:
     """Refuses to resume frames that do not read back whole (read by a child process: HDF5 may crash on
-    a damaged file): the run would continue them into a result no one can read."""
+    a damaged file), or that another run wrote: the run would continue them into a result no one can
+    read, or into a splice."""
     from .layers import LayerFileError, read_layers_guarded
 
     layers = layer_file_of(deck, variables)
@@ -305,10 +306,13 @@ def _check_partial(deck: Path, variables: dict[str, str]) -> None:
     if partial is None or not partial.exists():
         return    # fix layers/hdf5 says which frames are gone
     try:
-        read_layers_guarded(partial)
+        held = read_layers_guarded(partial).identity.get("run_id", "")
     except LayerFileError as exc:
         raise ValueError(f"cannot resume: the interrupted run's frames are damaged: {exc}; start the run anew with "
                          "--force") from None
+    if held and held != identity:
+        raise ValueError(f"cannot resume: {partial} holds the frames of run {held}, not those of the interrupted run "
+                         f"{identity} (put there since?); start the run anew with --force")
 
 
 @dataclass
@@ -393,7 +397,7 @@ def run_deck(deck: Path, ranks: int = 1, variables: dict[str, str] | None = None
                              "run it without --resume")
         identity = _resume_id(deck, variables)
         files = read_record(folder).get("files", {})    # those of the start it continues
-        _check_partial(deck, variables)
+        _check_partial(deck, variables, identity)
         # A restart file that does not match the checksum written beside it (damaged, or written as the run
         # was killed) is passed over for the older one. Restart files of an earlier version have no
         # checksums: they are tried as they are.
