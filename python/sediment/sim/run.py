@@ -220,9 +220,10 @@ def file_digest(path: Path) -> str:
     return digest.hexdigest()
 
 
-def restart_damage(restart: Path) -> str | None:
+def restart_damage(restart: Path, identity: str) -> str | None:
     """Why a restart file does not match the checksum fix layers/hdf5 wrote beside it once LAMMPS had
-    closed it (NAME.crc32), or None if it matches."""
+    closed it (NAME.crc32), or None if it matches; one that does not name the run `identity` (which
+    fix layers/hdf5 stores in it) is said to be another run's."""
     import zlib
 
     sums = restart.with_name(restart.name + ".crc32")
@@ -237,10 +238,13 @@ def restart_damage(restart: Path) -> str | None:
     if restart.stat().st_size != size:
         return (f"{restart.stat().st_size} bytes, {size} when it was last written ({sums.name}): damaged, or being "
                 "written when the run was stopped")
-    found = 0
+    found, named = 0, False
     with open(restart, "rb") as f:
         for block in iter(lambda: f.read(1 << 20), b""):
             found = zlib.crc32(block, found)
+            named = named or identity.encode() in block    # in the fix's state, before the atoms
+    if found != crc and not named:
+        return f"it does not name the interrupted run {identity}: a restart file of another run, or damaged"
     if found != crc:
         return (f"its bytes differ from those it was last written with (CRC-32 {found:08x}, {sums.name} says "
                 f"{crc:08x}): damaged, or being written when the run was stopped")
@@ -403,7 +407,7 @@ def run_deck(deck: Path, ranks: int = 1, variables: dict[str, str] | None = None
         # checksums: they are tried as they are.
         failures = []
         if any(p.with_name(p.name + ".crc32").is_file() for p in restarts):
-            damage = {p: restart_damage(p) for p in restarts}
+            damage = {p: restart_damage(p, identity) for p in restarts}
             restarts = [p for p in restarts if damage[p] is None]
             if not restarts:
                 raise RuntimeError(f"cannot resume: the restart files in {folder} do not match their checksums ("
