@@ -21,7 +21,9 @@
 
 #include <hdf5.h>
 
+#include <algorithm>
 #include <cerrno>
+#include <cstdint>
 #include <cstdio>
 #include <cstring>
 #include <mpi.h>
@@ -114,12 +116,20 @@ std::string read_string_attribute(hid_t where, const char *name)
   return text.data();
 }
 
-// Fixed array (1d) of doubles.
+// Fixed array (1d) of doubles, checksummed: in its object header (whose checksum covers it) if it fits there,
+// else in one chunk with its own checksum.
 void write_array(hid_t where, const char *name, const std::vector<double> &values)
 {
   const hsize_t dims[1] = {values.size()};
   Handle space(H5Screate_simple(1, dims, nullptr), H5Sclose, "dataspace");
-  Handle set(H5Dcreate2(where, name, H5T_NATIVE_DOUBLE, space, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT),
+  Handle props(H5Pcreate(H5P_DATASET_CREATE), H5Pclose, "properties");
+  if (values.size() * sizeof(double) <= 60000) {
+    check(H5Pset_layout(props, H5D_COMPACT), "compact layout");
+  } else {
+    check(H5Pset_chunk(props, 1, dims), "chunking");
+    check(H5Pset_fletcher32(props), "checksums");
+  }
+  Handle set(H5Dcreate2(where, name, H5T_NATIVE_DOUBLE, space, H5P_DEFAULT, props, H5P_DEFAULT),
              H5Dclose, std::string("dataset ") + name);
   if (!values.empty()) check(H5Dwrite(set, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, values.data()), name);
 }
@@ -189,6 +199,75 @@ long long frames_before(hid_t handle, LAMMPS_NS::bigint step)
   return kept;
 }
 
+// The frame datasets read back whole, each chunk's checksum checked, one frame at a time (a large file is
+// not held in memory), with their shapes; `equal`: the three hold as many frames (a finished file: a run
+// killed between them may leave them uneven). Throws saying what does not read back.
+void read_back(hid_t handle, bool equal)
+{
+  hsize_t centres = 0, counts[3] = {0, 0, 0};
+  {
+    Handle set(H5Dopen2(handle, "layer_centre", H5P_DEFAULT), H5Dclose, "dataset layer_centre");
+    Handle space(H5Dget_space(set), H5Sclose, "dataspace");
+    H5Sget_simple_extent_dims(space, &centres, nullptr);
+  }
+  const std::string columns = read_string_attribute(handle, "columns");
+  const hsize_t column_count = columns.empty() ? 0 : 1 + std::count(columns.begin(), columns.end(), ',');
+  for (int k = 0; k < 3; ++k) {
+    const char *name = FRAME_SETS[k];
+    Handle set(H5Dopen2(handle, name, H5P_DEFAULT), H5Dclose, std::string("dataset ") + name);
+    Handle space(H5Dget_space(set), H5Sclose, "dataspace");
+    const int rank = H5Sget_simple_extent_ndims(space);
+    hsize_t dims[3] = {0, 1, 1};
+    if (rank != (k == 2 ? 3 : 1) || H5Sget_simple_extent_dims(space, dims, nullptr) < 0)
+      throw std::runtime_error(fmt::format("dataset {} has {} dimensions", name, rank));
+    if (k == 2 && (dims[1] != centres || dims[2] != column_count))
+      throw std::runtime_error(fmt::format("dataset fraction has {} layers x {} columns, the file names {} x {}",
+                                           dims[1], dims[2], centres, column_count));
+    counts[k] = dims[0];
+    const hsize_t block[3] = {k == 2 ? 1 : dims[0], dims[1], dims[2]};
+    if (dims[0] == 0) continue;
+    Handle memory(H5Screate_simple(rank, block, nullptr), H5Sclose, "dataspace");
+    std::vector<double> values(block[0] * block[1] * block[2]);
+    for (hsize_t first = 0; first < dims[0]; first += block[0]) {
+      const hsize_t start[3] = {first, 0, 0};
+      check(H5Sselect_hyperslab(space, H5S_SELECT_SET, start, nullptr, block, nullptr), "selection");
+      if (H5Dread(set, H5T_NATIVE_DOUBLE, memory, space, H5P_DEFAULT, values.data()) < 0)
+        throw std::runtime_error(k == 2 ? fmt::format("frame {} of dataset fraction does not read back (damaged: its "
+                                                      "checksum fails)", first)
+                                        : fmt::format("dataset {} does not read back (damaged: its checksum fails)", name));
+    }
+  }
+  if (equal && (counts[0] != counts[1] || counts[1] != counts[2]))
+    throw std::runtime_error(fmt::format("the frame datasets hold {} times, {} steps and {} fractions", counts[0],
+                                         counts[1], counts[2]));
+}
+
+// CRC-32 (IEEE 802.3, as zlib's crc32 and Python's zlib.crc32) and size of a file; false if it cannot be read.
+bool file_crc32(const std::string &name, uint32_t &crc, long long &size)
+{
+  static uint32_t table[256];
+  if (table[1] == 0)
+    for (uint32_t n = 0; n < 256; ++n) {
+      uint32_t c = n;
+      for (int k = 0; k < 8; ++k) c = c & 1 ? 0xEDB88320u ^ (c >> 1) : c >> 1;
+      table[n] = c;
+    }
+  FILE *in = fopen(name.c_str(), "rb");
+  if (!in) return false;
+  std::vector<unsigned char> buffer(1 << 20);
+  crc = 0xFFFFFFFFu;
+  size = 0;
+  size_t n;
+  while ((n = fread(buffer.data(), 1, buffer.size(), in)) > 0) {
+    for (size_t k = 0; k < n; ++k) crc = table[(crc ^ buffer[k]) & 0xFF] ^ (crc >> 8);
+    size += static_cast<long long>(n);
+  }
+  const bool ok = !ferror(in);
+  fclose(in);
+  crc ^= 0xFFFFFFFFu;
+  return ok;
+}
+
 void copy_file(const std::string &from, const std::string &to)
 {
   FILE *in = fopen(from.c_str(), "rb");
@@ -213,7 +292,7 @@ void copy_file(const std::string &from, const std::string &to)
 FixLayersHDF5::FixLayersHDF5(LAMMPS *lmp, int narg, char **arg) :
     Fix(lmp, narg, arg), compute_id(nullptr), particle_density(0.0), grid(nullptr), file(-1),
     frame_sets{-1, -1, -1}, is_open(false), frames(0), last_write(0.0),
-    overwrite(false), end_time(-1.0), resumed_frames(-1), last_frame_step(-1)
+    overwrite(false), end_time(-1.0), resumed_frames(-1), last_frame_step(-1), summed_restart(-1)
 {
   if (narg < 6)
     error->all(FLERR, "Fix layers/hdf5: expected 'fix ID group layers/hdf5 N FILE.h5 c_ID [keyword value ...]'");
@@ -266,6 +345,7 @@ FixLayersHDF5::~FixLayersHDF5()
   if (comm->me == 0 && !writing.empty()) {
     try {
       Handle done(H5Fopen(writing.c_str(), H5F_ACC_RDWR, H5P_DEFAULT), H5Fclose, "reopening");
+      read_back(done, true);    // nothing is marked complete that does not read back whole
       const std::string why = incomplete_reason(done);
       if (!why.empty()) throw std::runtime_error(why);
       set_attribute(done, "complete", 1.0);
@@ -321,12 +401,40 @@ void FixLayersHDF5::setup(int /*vflag*/)
 
 void FixLayersHDF5::end_of_step()
 {
+  sum_restart();
   take_frame(false);
 }
 
 void FixLayersHDF5::post_run()
 {
+  sum_restart();
   close_file();
+}
+
+void FixLayersHDF5::sum_restart()
+{
+  // Rank 0 wrote the newest of the two restart files and closed it (LAMMPS writes them between steps):
+  // its checksum goes beside it, in NAME.crc32, so that `sediment run --resume` can tell a damaged one.
+  // A kill before this leaves the file newer than its checksum, which --resume passes over. Restart
+  // files per rank (%) or by MPI-IO get none.
+  if (comm->me != 0 || !output->restart_flag_double || output->last_restart < 0 ||
+      output->last_restart == summed_restart)
+    return;
+  summed_restart = output->last_restart;
+  const std::string name = output->restart_toggle == 1 ? output->restart2a : output->restart2b;
+  if (name.find_first_of("%*") != std::string::npos || (name.size() >= 6 && name.compare(name.size() - 6, 6, ".mpiio") == 0)) return;
+  uint32_t crc = 0;
+  long long size = 0;
+  const std::string sum = name + ".crc32", writing_sum = sum + ".tmp";
+  FILE *out = file_crc32(name, crc, size) ? fopen(writing_sum.c_str(), "w") : nullptr;
+  bool ok = out && fprintf(out, "crc32 %08x size %lld step %lld\n", crc, size,
+                           static_cast<long long>(summed_restart)) > 0;
+  ok = out && fclose(out) == 0 && ok && rename(writing_sum.c_str(), sum.c_str()) == 0;
+  if (!ok) {
+    remove(writing_sum.c_str());
+    error->warning(FLERR, "Fix layers/hdf5: the checksum of {} cannot be written ({}): --resume will pass it over",
+                   name, strerror(errno));
+  }
 }
 
 void FixLayersHDF5::open_file()
@@ -358,7 +466,11 @@ void FixLayersHDF5::open_file()
       check(H5Fflush(file, H5F_SCOPE_GLOBAL), "flush");
       return;
     }
-    file = H5Fcreate(writing.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT);
+    // The file format of HDF5 1.8 on: its superblock, object headers and indexes carry checksums, so that
+    // damaged metadata is refused on reading rather than read as data (or crash the reader).
+    Handle access(H5Pcreate(H5P_FILE_ACCESS), H5Pclose, "file access properties");
+    check(H5Pset_libver_bounds(access, H5F_LIBVER_V18, H5F_LIBVER_LATEST), "file format");
+    file = H5Fcreate(writing.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, access);
     if (file < 0) throw std::runtime_error("cannot be created");
     frames = 0;
     write_attribute(file, "schema", SCHEMA);
@@ -482,6 +594,7 @@ std::string FixLayersHDF5::choose_file(bigint step_now, size_t layers, size_t co
       const std::string held_id = read_string_attribute(old, "run_id");
       if (!held_id.empty() && !run_id.empty() && held_id != run_id)
         other_run = fmt::format("run {}, this is run {}", held_id, run_id);
+      read_back(old, false);    // frames that do not read back are never continued
       before = frames_before(old, step_now);
     } catch (const std::invalid_argument &e) {
       throw std::runtime_error(e.what());

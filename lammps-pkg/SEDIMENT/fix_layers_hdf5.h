@@ -63,6 +63,7 @@ class FixLayersHDF5 : public Fix {
   // restart file of this fix).
   long long resumed_frames;
   bigint last_frame_step;    // step of the newest frame taken (rank 0)
+  bigint summed_restart;     // step of the newest restart file whose checksum is written (rank 0)
   std::string writing;  // the file the frames go to (rank 0): PATH.partial until LAMMPS is done
 
   void open_file();
@@ -74,6 +75,7 @@ class FixLayersHDF5 : public Fix {
   void write_pending();
   void open_frame_sets();    // rank 0, the file open
   void close_file();
+  void sum_restart();    // rank 0: the checksum of a restart file written since the last call
   // Runs `action` on rank 0 and stops every rank with its message if it failed.
   template <typename Action> void on_rank0(Action action);
 };

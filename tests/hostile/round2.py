@@ -124,7 +124,7 @@ def main() -> int:
     partial = deck.parent / "layers.h5.partial"
     partial.write_bytes(partial.read_bytes()[:3000])
     done = sediment("run", deck, "--resume", "--quiet")
-    case("resume with a damaged layers.h5.partial", refused(done, "damaged", "remove it"), done.stderr)
+    case("resume with a damaged layers.h5.partial", refused(done, "damaged", "--force"), done.stderr)
     deck = interrupted(root, "np")
     done = sediment("run", deck, "--resume", "--quiet", "--np", "2")
     whole = sample(root / "np-whole", PSD, *LONG)

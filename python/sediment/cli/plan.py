@@ -113,6 +113,10 @@ def run(args: argparse.Namespace) -> int:
         options = dict(geometry=args.geometry, width=args.width, classes=args.classes, layers=args.layers,
                        t_end=args.t_end)
         scene = SampleScene(test, options, args.particles, args.courant, tolerance, args.replicas, not args.no_models)
+        if args.temperature_record is not None:    # its trial runs follow it, and its report names it
+            from ..lab.sheet import read_temperature_record
+
+            scene.water_record = read_temperature_record(args.temperature_record)
         name = args.psd.stem
         if args.contact_cut is not None and not args.measure_contacts:
             raise ValueError("--contact-cut sets the reduced scene of --measure-contacts: give both")

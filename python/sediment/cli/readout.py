@@ -72,18 +72,22 @@ def run(args: argparse.Namespace) -> int:
     from ..lab.readout import Column, Hydrometer, Suspension
     from ..lab.synthetic import settling_column
 
+    compared = []    # the tables beside the layer file that the frames are compared with
     if args.layers is not None:    # PSD tables that `sediment sample` wrote beside the run
         for option, name in (("psd", "input_psd.csv"), ("simulated", "simulated_psd.csv")):
             beside = args.layers.parent / name
             if getattr(args, option) is None and beside.is_file():
                 setattr(args, option, beside)
+                compared.append(beside)
                 print(f"using {beside}")
     psd = read_psd(args.psd) if args.psd else None
     simulated = read_psd(args.simulated) if args.simulated else None
     if args.layers is not None:
-        from ..sim.layers import read_layers
-        layers = read_layers(args.layers)
-        check_inputs(args.layers, layers.identity.get("run_id", ""))
+        from ..sim.layers import check_layer_file, read_layers_guarded
+        check_layer_file(args.layers)
+        check_digest(args.layers)
+        layers = read_layers_guarded(args.layers)
+        check_inputs(args.layers, layers.identity.get("run_id", ""), compared)
         if not layers.complete:
             message = (f"{args.layers} is partial: the run writing it did not finish ({len(layers.time)} frames, the "
                        f"last at {layers.time[-1] / 60:.4g} min)")
@@ -140,18 +144,38 @@ def _measured(values: list[float]) -> list[float]:
     return [check(v, q, f"--hydrometer {n}") for v, q, n in zip(values, quantities, names)]
 
 
-def check_inputs(path: Path, identity: str) -> None:
+def check_digest(path: Path) -> None:
+    """Refuses a layer file whose bytes are not those its run recorded when it completed it (in the
+    folder's run record): damaged, or replaced since."""
+    from ..sim.run import RECORD, file_digest, read_record
+
+    record = read_record(path.parent)
+    done = (record or {}).get("layers", {})
+    if done.get("file") == path.name and file_digest(path) != done.get("sha256"):
+        raise ValueError(f"{path} is damaged or was replaced: its bytes are not those its run {record['run_id']} "
+                         f"completed (SHA-256 in {path.parent / RECORD}); run the deck again (sediment run --force)")
+
+
+def check_inputs(path: Path, identity: str, compared: list[Path] = ()) -> None:
     """Refuses a layer file beside a deck whose inputs are not those of the run that wrote it (the
-    folder sampled again since): its frames would be read against another test's tables."""
-    from ..sim.run import input_files, inputs_id, read_record
+    folder sampled again since), or beside tables (`compared`) other than those its run started with:
+    its frames would be read against another test's. The run record names what differs."""
+    from ..sim.run import RECORD, file_digest, input_files, inputs_id, read_record
 
     record = read_record(path.parent)
     deck = path.parent / (record["deck"] if record else "in.sedimentation")
     held = identity.split("-")
-    if len(held) != 3 or not deck.is_file():
-        return
-    if inputs_id(deck) != held[0]:
+    started = record.get("files", {}) if record and record["run_id"] == identity else {}
+    changed = [p.name for p in [deck, *(input_files(deck) if deck.is_file() else []), *compared]
+               if p.name in started and (not p.is_file() or file_digest(p) != started[p.name])]
+    if len(held) == 3 and deck.is_file() and inputs_id(deck) != held[0]:
         reads = ", ".join([deck.name] + [p.name for p in input_files(deck)])
-        raise ValueError(f"{path} was written by a run of other inputs than those now in its folder ({reads}): it was "
-                         "sampled again since, and its tables describe another test; run the deck again, or read the "
-                         "frames where their own tables are")
+        which = f"; {', '.join(changed)} changed since it started" if changed else ""
+        raise ValueError(f"{path} was written by a run of other inputs than those now in its folder ({reads}{which}): "
+                         "it was sampled again since, and its tables describe another test; run the deck again, or "
+                         "read the frames where their own tables are")
+    if changed:
+        raise ValueError(f"{', '.join(changed)} beside {path} changed since its run started (replaced, by another "
+                         f"sample's for one; {RECORD} holds the SHA-256 of what the run started with): the frames "
+                         "would be compared with another test's tables; put the run's own back, or give --psd and "
+                         "--simulated")

@@ -106,6 +106,11 @@ def run(args: argparse.Namespace) -> int:
     from ..sim.scene import describe, plan, runs_replaced, write
 
     psd = read_psd(args.psd)
+    record = ()
+    if args.temperature_record is not None:
+        from ..lab.sheet import read_temperature_record
+
+        record = read_temperature_record(args.temperature_record)
     if args.plan is not None:
         from ..planner.scenes import decided_options
 
@@ -119,6 +124,10 @@ def run(args: argparse.Namespace) -> int:
                     t_end=args.t_end, mass=args.mass, particle_density=args.particle_density,
                     cylinder_area=cylinder.area, height=cylinder.height, temperature=args.temperature)
         differ = [f"{k} {planned[k]} (here {v})" for k, v in here.items() if k in planned and planned[k] != v]
+        # a plan of an earlier version recorded no temperature record: it planned for a constant water
+        if [list(r) for r in record] != planned.get("temperature_record", []):
+            differ.append(f"the temperature record ({_record_name(planned.get('temperature_record', []))} in the "
+                          f"plan, here {args.temperature_record or 'none'}: {_record_name(record)})")
         if "psd" not in planned:
             print(f"warning: {args.plan} does not record the PSD it was made for (a plan of an earlier version)")
         elif not _same_psd(planned["psd"], psd):
@@ -129,14 +138,11 @@ def run(args: argparse.Namespace) -> int:
         print(f"the plan's decision ({args.plan}): --drag {args.drag} --hindrance {args.hindrance} "
               f"--particles {args.particles} --courant {args.courant:g}")
 
-    record = ()
     suspension = suspension_of(args)
-    if args.temperature_record is not None:
+    if record:
         from ..lab.readout import Suspension
-        from ..lab.sheet import read_temperature_record
 
         # the time steps for the warmest water of the record, where the grains fall fastest
-        record = read_temperature_record(args.temperature_record)
         suspension = Suspension.at_temperature(max(t for _, t in record), args.particle_density)
     scene = plan(psd, geometry=args.geometry, cylinder=cylinder_of(args), mass=args.mass,
                  suspension=suspension, width=args.width,
@@ -149,6 +155,14 @@ def run(args: argparse.Namespace) -> int:
     args.outputs.remove_also(runs_replaced(args.final_out, args.out / "in.sedimentation", force=args.force))
     print(f"next: sediment run {args.final_out / 'in.sedimentation'}")
     return 0
+
+
+def _record_name(record) -> str:
+    """A temperature record in a few words."""
+    if not record:
+        return "none"
+    temperatures = [t for _, t in record]
+    return f"{len(record)} rows over {record[-1][0] / 60:g} min, {min(temperatures):g}-{max(temperatures):g} C"
 
 
 def _same_psd(recorded: dict, psd) -> bool:

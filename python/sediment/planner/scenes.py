@@ -101,6 +101,7 @@ class SampleScene:
                  tolerance: float, replicas: int = 3, models: bool = True):
         self.test = test
         self.options = options              # further keyword arguments of scene.plan
+        self.water_record: tuple = ()       # the water's temperature over the test (--temperature-record)
         self.running: set = set()           # runs under way (stopped together on an interrupt)
         if not particles or any(p < 1 for p in particles):
             raise ValueError("the particle ladder needs at least one count >= 1")
@@ -129,14 +130,17 @@ class SampleScene:
         t = self.test
         return dict(self.options, mass=t.mass, particle_density=t.suspension.particle_density,
                     cylinder_area=t.cylinder.area, height=t.cylinder.height, temperature=t.suspension.temperature,
+                    temperature_record=[list(r) for r in self.water_record],
                     psd={"diameter_um": (t.psd.diameter * 1e6).tolist(), "percent_finer": t.psd.percent_finer.tolist()})
 
     def _scene(self, settings: dict, seed: int):
         from ..sim.scene import Effects, plan
         t = self.test
-        return plan(t.psd, cylinder=t.cylinder, mass=t.mass, suspension=t.suspension, seed=seed,
-                    particles=int(settings["particles"]), courant=float(settings["courant"]),
-                    effects=Effects(settings["drag"], hindrance=settings["hindrance"]), **self.options)
+        scene = plan(t.psd, cylinder=t.cylinder, mass=t.mass, suspension=t.suspension, seed=seed,
+                     particles=int(settings["particles"]), courant=float(settings["courant"]),
+                     effects=Effects(settings["drag"], hindrance=settings["hindrance"]), **self.options)
+        scene.water_record = self.water_record
+        return scene
 
     def write(self, settings: dict, folder: Path, seed: int) -> Path:
         """Writes the scene of a setting into `folder`; returns its deck."""

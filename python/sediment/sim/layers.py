@@ -10,7 +10,10 @@ Schema (version 1; lammps-pkg/SEDIMENT/doc/fix_layers_hdf5.rst): root attributes
 """
 from __future__ import annotations
 
-import re
+import faulthandler
+import os
+import pickle
+import signal
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -18,6 +21,10 @@ import numpy as np
 
 SCHEMA = "sediment-layers"
 SCHEMA_VERSION = 1
+
+
+ATTRIBUTES = ("columns", "units", "axis", "dimension", "cross_section", "layer_lo", "layer_thickness")
+DATASETS = ("time", "step", "fraction", "layer_centre", "class_edges")
 
 
 class LayerFileError(ValueError):
@@ -116,10 +123,92 @@ def read_layers(path: str | Path) -> LayerFile:
                              class_edges=np.asarray(f["class_edges"]), time=time,
                              step=np.asarray(f["step"][:frames]), fraction=fraction, attributes=extra,
                              complete=f.attrs.get("complete", 0) == 1, identity=identity)
-        except KeyError as exc:    # h5py: "Can't open attribute (can't locate attribute: 'units')"
-            quoted = re.findall(r"'([^']+)'", str(exc))
-            what = ("the attribute " if "attribute" in str(exc) else "the dataset ") + (quoted[-1] if quoted else str(exc))
+        except KeyError as exc:    # h5py's message names the attribute in one file format, not in the other
+            missing = ([f"the attribute {k}" for k in ATTRIBUTES if k not in f.attrs]
+                       + [f"the dataset {k}" for k in DATASETS if k not in f])
+            what = missing[0] if missing else f"readable metadata ({exc})"
             raise LayerFileError(f"{path}: the layer file lacks {what} (damaged, or not written by fix "
                                  "layers/hdf5)") from None
         except OSError as exc:
             raise LayerFileError(f"{path}: unreadable layer data (truncated or corrupt?): {exc}") from None
+
+
+_SIGNATURE = b"\x89HDF\r\n\x1a\n"
+
+
+def check_layer_file(path: str | Path) -> None:
+    """Refuses (LayerFileError) a file that cannot be a whole HDF5 file, before HDF5 sees it: empty, without
+    the HDF5 signature where the format puts it, a superblock of no known layout, or shorter than the
+    end of file its superblock names (truncated)."""
+    path = Path(path)
+    if not path.is_file():
+        raise LayerFileError(f"{path}: no such layer file")
+    size = path.stat().st_size
+    if size == 0:
+        raise LayerFileError(f"{path}: the layer file is empty (0 bytes)")
+    with open(path, "rb") as f:
+        # the superblock sits at 0 or, after a user block, at 512, 1024, 2048, ... bytes
+        at = 0
+        while at + 8 <= size:
+            f.seek(at)
+            if f.read(8) == _SIGNATURE:
+                break
+            at = 512 if at == 0 else 2 * at
+        else:
+            raise LayerFileError(f"{path}: not an HDF5 file: no HDF5 signature at its start (damaged, or another kind "
+                                 "of file)")
+        head = f.read(56)
+    version = head[0] if head else -1
+    if version in (0, 1):
+        offsets, lengths, eof_at = (head[5], head[6], 16 + (4 if version == 1 else 0)) if len(head) > 6 else (0, 0, 0)
+        eof_at += 2 * offsets    # after the base and free-space addresses
+    elif version in (2, 3):
+        offsets, lengths = (head[1], head[2]) if len(head) > 2 else (0, 0)
+        eof_at = 4 + 2 * offsets    # after the base and superblock-extension addresses
+    else:
+        raise LayerFileError(f"{path}: damaged HDF5 superblock (version {version}, which HDF5 never wrote)")
+    if offsets not in (2, 4, 8) or lengths not in (2, 4, 8) or len(head) < eof_at + offsets:
+        raise LayerFileError(f"{path}: damaged HDF5 superblock (addresses of {offsets} bytes, lengths of {lengths})")
+    end = int.from_bytes(head[eof_at:eof_at + offsets], "little")
+    if end > size - at:
+        raise LayerFileError(f"{path}: truncated: {size} bytes, its HDF5 superblock says {end + at}")
+
+
+def read_layers_guarded(path: str | Path) -> LayerFile:
+    """`read_layers` in a child process, after `check_layer_file`: HDF5 may crash on a damaged file (a few
+    bytes changed in its metadata), and the crash is then the child's, reported as a LayerFileError that
+    names the file. Any other error while reading is reported as damage too."""
+    check_layer_file(path)
+    reader, writer = os.pipe()
+    child = os.fork()
+    if child == 0:    # the child: the frames or the reason, pickled, then out without clean-up
+        code = 0
+        try:
+            os.close(reader)
+            faulthandler.disable()    # a crash is the parent's one line, not a dump of this process
+            try:
+                answer = read_layers(path)
+            except LayerFileError as exc:
+                answer = exc
+            except Exception as exc:    # h5py and numpy on damaged metadata: anything may come
+                answer = LayerFileError(f"{path}: unreadable layer file (damaged?): {type(exc).__name__}: {exc}")
+            with os.fdopen(writer, "wb") as out:
+                pickle.dump(answer, out)
+        except BaseException:
+            code = 1
+        os._exit(code)
+    os.close(writer)
+    with os.fdopen(reader, "rb") as answer_pipe:
+        data = answer_pipe.read()
+    _, status = os.waitpid(child, 0)
+    if os.WIFSIGNALED(status):
+        name = signal.Signals(os.WTERMSIG(status)).name
+        raise LayerFileError(f"{path}: damaged: reading it crashed the HDF5 library ({name})")
+    try:
+        answer = pickle.loads(data)
+    except Exception:
+        raise LayerFileError(f"{path}: the process reading it ended without an answer (exit "
+                             f"{os.waitstatus_to_exitcode(status)})") from None
+    if isinstance(answer, LayerFileError):
+        raise answer
+    return answer

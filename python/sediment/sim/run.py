@@ -147,7 +147,10 @@ def _signals_stop():
 
 
 RECORD = ".sediment-run.json"    # the folder's latest run: its identity, deck, variables and state
-RUN_OUTPUTS = ("restart.a.bin", "restart.b.bin", "log.lammps", "log.failed.lammps", RECORD)
+RUN_OUTPUTS = ("restart.a.bin", "restart.b.bin", "restart.a.bin.crc32", "restart.b.bin.crc32", "log.lammps",
+               "log.failed.lammps", RECORD)
+# Tables beside a run that it does not read but that its readout compares its frames with.
+COMPARED = ("input_psd.csv", "simulated_psd.csv")
 
 
 # Commands whose first literal argument (after an ID for molecule) is a file the deck reads.
@@ -208,6 +211,46 @@ def _finished(layers: Path, identity: str) -> bool:
         return False
 
 
+def file_digest(path: Path) -> str:
+    """The SHA-256 of a file's bytes, in hexadecimal."""
+    digest = hashlib.sha256()
+    with open(path, "rb") as f:
+        for block in iter(lambda: f.read(1 << 20), b""):
+            digest.update(block)
+    return digest.hexdigest()
+
+
+def restart_damage(restart: Path, identity: str) -> str | None:
+    """Why a restart file does not match the checksum fix layers/hdf5 wrote beside it once LAMMPS had
+    closed it (NAME.crc32), or None if it matches; one that does not name the run `identity` (which
+    fix layers/hdf5 stores in it) is said to be another run's."""
+    import zlib
+
+    sums = restart.with_name(restart.name + ".crc32")
+    if not sums.is_file():
+        return f"no checksum beside it ({sums.name}): the run was stopped before it recorded one"
+    try:
+        words = sums.read_text().split()
+        held = dict(zip(words[::2], words[1::2]))
+        crc, size = int(held["crc32"], 16), int(held["size"])
+    except (ValueError, KeyError, UnicodeDecodeError):
+        return f"its checksum file {sums.name} is damaged"
+    if restart.stat().st_size != size:
+        return (f"{restart.stat().st_size} bytes, {size} when it was last written ({sums.name}): damaged, or being "
+                "written when the run was stopped")
+    found, named = 0, False
+    with open(restart, "rb") as f:
+        for block in iter(lambda: f.read(1 << 20), b""):
+            found = zlib.crc32(block, found)
+            named = named or identity.encode() in block    # in the fix's state, before the atoms
+    if found != crc and not named:
+        return f"it does not name the interrupted run {identity}: a restart file of another run, or damaged"
+    if found != crc:
+        return (f"its bytes differ from those it was last written with (CRC-32 {found:08x}, {sums.name} says "
+                f"{crc:08x}): damaged, or being written when the run was stopped")
+    return None
+
+
 def run_id(deck: Path, variables: dict[str, object]) -> str:
     """A new run's identity, INPUTS-VARIABLES-START: the hash of what the deck reads (`inputs_id`), of
     its variables, and a token of this start. Stored in the layer file and in each restart file: a
@@ -254,6 +297,26 @@ def _resume_id(deck: Path, variables: dict[str, str]) -> str:
         raise ValueError(f"the interrupted run had the variables {record.get('variables')}, this one {variables}: "
                          "resume it with the same --var options")
     return record["run_id"]
+
+
+def _check_partial(deck: Path, variables: dict[str, str], identity: str) -> None:
+    """Refuses to resume frames that do not read back whole (read by a child process: HDF5 may crash on
+    a damaged file), or that another run wrote: the run would continue them into a result no one can
+    read, or into a splice."""
+    from .layers import LayerFileError, read_layers_guarded
+
+    layers = layer_file_of(deck, variables)
+    partial = layers.with_name(layers.name + ".partial") if layers is not None else None
+    if partial is None or not partial.exists():
+        return    # fix layers/hdf5 says which frames are gone
+    try:
+        held = read_layers_guarded(partial).identity.get("run_id", "")
+    except LayerFileError as exc:
+        raise ValueError(f"cannot resume: the interrupted run's frames are damaged: {exc}; start the run anew with "
+                         "--force") from None
+    if held and held != identity:
+        raise ValueError(f"cannot resume: {partial} holds the frames of run {held}, not those of the interrupted run "
+                         f"{identity} (put there since?); start the run anew with --force")
 
 
 @dataclass
@@ -325,7 +388,9 @@ def run_deck(deck: Path, ranks: int = 1, variables: dict[str, str] | None = None
             launch = dict(variables, sediment_run_id=run_id(deck, variables))
             if force:
                 launch["overwrite"] = "yes"
-            return _run_recorded(deck, ranks, variables, launch, progress)
+            files = {p.name: file_digest(p) for p in [deck, *input_files(deck), *(folder / n for n in COMPARED)]
+                     if p.is_file()}
+            return _run_recorded(deck, ranks, variables, launch, progress, files)
         if "${resume}" not in deck.read_text(errors="replace"):
             raise ValueError(f"{deck.name} cannot be resumed: it has no 'resume' variable (decks written by "
                              "`sediment sample` have one)")
@@ -335,15 +400,31 @@ def run_deck(deck: Path, ranks: int = 1, variables: dict[str, str] | None = None
             raise ValueError(f"nothing to resume in {folder}: no restart file (restart.a.bin, restart.b.bin); "
                              "run it without --resume")
         identity = _resume_id(deck, variables)
-        # The newest restart file may be damaged (a kill while it was written): then the older one, if the
-        # failed attempt wrote no restart file of its own. A restart file of another run is refused by
-        # fix layers/hdf5 and passed over likewise.
+        files = read_record(folder).get("files", {})    # those of the start it continues
+        _check_partial(deck, variables, identity)
+        # A restart file that does not match the checksum written beside it (damaged, or written as the run
+        # was killed) is passed over for the older one. Restart files of an earlier version have no
+        # checksums: they are tried as they are.
+        failures = []
+        if any(p.with_name(p.name + ".crc32").is_file() for p in restarts):
+            damage = {p: restart_damage(p, identity) for p in restarts}
+            restarts = [p for p in restarts if damage[p] is None]
+            if not restarts:
+                raise RuntimeError(f"cannot resume: the restart files in {folder} do not match their checksums ("
+                                   + "; ".join(f"{p.name}: {why}" for p, why in damage.items())
+                                   + "): start the run anew with --force")
+            for p, why in damage.items():
+                if why:
+                    print(f"passing over {p.name} ({why}); resuming from {restarts[0].name}", file=sys.stderr)
+        # The newest restart file may yet fail to load: then the older one, if the failed attempt wrote no
+        # restart file of its own. A restart file of another run is refused by fix layers/hdf5 and passed
+        # over likewise.
         failures = []
         for k, restart in enumerate(restarts):
             stamps = [p.stat().st_mtime_ns for p in restarts]
             launch = dict(variables, sediment_run_id=identity, resume="yes", restart_file=restart.name)
             try:
-                return _run_recorded(deck, ranks, variables, launch, progress)
+                return _run_recorded(deck, ranks, variables, launch, progress, files)
             except RunInterrupted:    # a stop asked for, not a restart file that failed
                 raise
             except RuntimeError as exc:
@@ -361,10 +442,12 @@ def run_deck(deck: Path, ranks: int = 1, variables: dict[str, str] | None = None
 
 
 def _run_recorded(deck: Path, ranks: int, variables: dict[str, str], launch: dict[str, str],
-                  progress: bool) -> RunResult:
+                  progress: bool, files: dict[str, str]) -> RunResult:
     """Runs the deck with the `launch` variables (the folder locked), keeping the folder's run record:
-    running, then finished, failed or interrupted."""
-    record = dict(run_id=launch["sediment_run_id"], deck=deck.name, variables=variables)
+    running, then finished, failed or interrupted. It names the SHA-256 of the files the run started
+    with (`files`: the deck, what it reads and the tables compared with its frames) and, once finished,
+    of its layer file: what a readout checks."""
+    record = dict(run_id=launch["sediment_run_id"], deck=deck.name, variables=variables, files=files)
     _write_record(deck.parent, **record, state="running")
     try:
         result = _run(deck, ranks, launch, progress)
@@ -374,6 +457,9 @@ def _run_recorded(deck: Path, ranks: int, variables: dict[str, str], launch: dic
     except BaseException:
         _write_record(deck.parent, **record, state="failed")
         raise
+    layers = layer_file_of(deck, variables)
+    if layers is not None and _finished(layers, record["run_id"]):
+        record["layers"] = {"file": layers.name, "sha256": file_digest(layers)}
     _write_record(deck.parent, **record, state="finished")
     return result
 
