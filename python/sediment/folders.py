@@ -3,9 +3,9 @@
 
 A command writes its results into a stage inside the output folder (``.sediment-stage-PID``) and
 `OutputSet.publish` moves them into place together, under the folder's lock. The folder's manifest
-(``.sediment-files.json``) records which command's set wrote each file, by size, modification time
-and inode (a rename keeps all three; a copy or an edit does not). A command replaces or removes only
-files its own earlier set wrote and nobody changed since, and never a file it reads.
+(``.sediment-files.json``) records which command's set wrote each file, by its size and SHA-256 (a
+copy of the folder keeps them; an edit does not). A command replaces or removes only files its own
+earlier set wrote and nobody changed since, and never a file it reads.
 
 A publish is journaled: ``.sediment-publishing.json`` is written before the first file moves, so a
 command killed while moving files is completed by the next one that locks the folder, and until then
@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import datetime
 import fcntl
+import hashlib
 import json
 import os
 import shutil
@@ -24,6 +25,8 @@ import threading
 from contextlib import contextmanager
 from pathlib import Path
 from typing import Iterable, Iterator
+
+from .results import write_text
 
 LOCK = ".sediment.lock"                    # one sediment command at a time writes into a folder
 MANIFEST = ".sediment-files.json"
@@ -85,7 +88,7 @@ class OutputSet:
         self.stage = self.folder / f"{STAGE}{os.getpid()}"
         self.published = False
         self._foreign: list[str] = []
-        self.removed_sets: list[str] = []    # other sets publish() removed with the files they were made from
+        self.removed_sets: list[tuple[str, Path]] = []    # sets (name, folder) removed with what they were made from
         self._created = [p for p in (self.folder, *self.folder.parents) if not p.exists()]
         self._lock = folder_lock(self.folder, "write")
 
@@ -137,7 +140,8 @@ class OutputSet:
         self._derived(sets)
         now = datetime.datetime.now().astimezone().isoformat(timespec="seconds")
         sets[self.name] = {"written": now, "files": new,
-                           "inputs": {str(p.resolve()): _files(p)[p.name] for p in self.inputs if p.is_file()}}
+                           "inputs": {os.path.relpath(p.resolve(), self.folder.resolve()): _files(p)[p.name]
+                                      for p in self.inputs if p.is_file()}}
         for other in sets.values():
             other["files"] = {r: i for r, i in other["files"].items() if _entry(r) not in self._foreign}
         sets = {k: v for k, v in sets.items() if v["files"] or k == self.name}
@@ -150,16 +154,36 @@ class OutputSet:
             os.rename(self.stage / JOURNAL, self.folder / JOURNAL)
             self.published = True
             _complete(self.folder, journal)
+        for name, below in self.removed_sets:    # their files are gone; so goes their record below
+            if below != self.folder:
+                record = read_manifest(below)
+                record["sets"].pop(name, None)
+                write_text(below / MANIFEST, json.dumps(record) + "\n")
         return [self.folder / e for e in entries]
 
     def _derived(self, sets: dict) -> None:
-        """Adds to the files removed with the set the other sets of the folder made from them (a
-        readout of a run's frames goes with the frames)."""
-        gone = {str((self.folder / r).resolve()) for r in self._foreign}
+        """Adds to the files removed with the set the sets made from them, in the folder and in the
+        folders below it (a readout of a run's frames goes with the frames)."""
+        gone = {(self.folder / r).resolve() for r in self._foreign}
+        if not gone:
+            return
+
+        def made_from_gone(where: Path, content: dict) -> bool:
+            return any((where / r).resolve() in gone for r in content.get("inputs", {}))
+
         for name, other in sets.items():
-            if name != self.name and gone & set(other.get("inputs", {})):
+            if name != self.name and made_from_gone(self.folder, other):
                 self._foreign += sorted({_entry(r) for r in other["files"]} - set(self._foreign))
-                self.removed_sets.append(name)
+                self.removed_sets.append((name, self.folder))
+        for manifest in sorted(self.folder.glob(f"*/**/{MANIFEST}")):
+            below = manifest.parent
+            if any(part.startswith(_OWN) for part in below.relative_to(self.folder).parts):
+                continue
+            for name, other in read_manifest(below)["sets"].items():
+                if made_from_gone(below, other):
+                    where = below.relative_to(self.folder)
+                    self._foreign += sorted({str(where / _entry(r)) for r in other["files"]} - set(self._foreign))
+                    self.removed_sets.append((name, below))
 
     def _refuse_foreign(self, touched: set[str], old: dict, sets: dict) -> None:
         owners = {r: name for name, s in sets.items() if name != self.name for r in s.get("files", {})}
@@ -197,10 +221,12 @@ def read_manifest(folder: Path) -> dict:
     try:
         manifest = json.loads(path.read_text())
         sets = manifest["sets"]
+        if not isinstance(sets, dict):
+            raise ValueError
         for name, content in sets.items():
             files = content["files"]
             if not (isinstance(name, str) and isinstance(files, dict) and all(map(_inside, files))
-                    and all(isinstance(i, list) and len(i) == 3 for i in files.values())):
+                    and all(isinstance(i, list) and len(i) == 2 for i in files.values())):
                 raise ValueError
     except (ValueError, KeyError, TypeError, UnicodeDecodeError):
         raise ValueError(f"{path} is damaged: it records which sediment command wrote each file of {folder}; "
@@ -266,12 +292,17 @@ def _journal_names(folder: Path, stage: Path) -> bool:
         return False
 
 
-def _files(root: Path, prefix: str = "") -> dict[str, list[int]]:
+def _files(root: Path, prefix: str = "") -> dict[str, list]:
     """Every file and link under `root` (or `root` itself) by path relative to it (after `prefix`):
-    size, modification time and inode. The folders' bookkeeping is left out."""
-    def identity(path: str) -> list[int]:
-        st = os.lstat(path)
-        return [st.st_size, st.st_mtime_ns, st.st_ino]
+    its size and SHA-256 (of a link, of its target's name). The folders' bookkeeping is left out."""
+    def identity(path: str) -> list:
+        if os.path.islink(path):
+            return [0, hashlib.sha256(os.fsencode(os.readlink(path))).hexdigest()]
+        digest = hashlib.sha256()
+        with open(path, "rb") as handle:
+            for block in iter(lambda: handle.read(1 << 20), b""):
+                digest.update(block)
+        return [os.path.getsize(path), digest.hexdigest()]
 
     if not os.path.lexists(root):
         return {}

@@ -117,7 +117,7 @@ def must(*args, timeout: float = 300) -> Done:
 
 
 # ---- folders ------------------------------------------------------------------------------------
-IGNORED = re.compile(r"\.lock$")
+IGNORED = re.compile(r"\.lock$|^\.sediment-files\.json$")    # locks, and the manifest every publish updates
 
 
 def tree(folder: Path) -> dict[str, str]:

@@ -257,7 +257,7 @@ def main() -> int:
     case("readout into a folder with the user's files keeps them", (mine / "notes.txt").read_text() == "mine"
          and not (mine / "pipette.csv").exists(), done.stderr)
     (mine / ".sediment-files.json").write_text('{"format": 1, "sets": {"readout": {"files": '
-                                               '{"../copied/layers.h5": [1, 1, 1], "notes.txt": [1, 1, 1]}}}}')
+                                               '{"../copied/layers.h5": [1, "ab"], "notes.txt": [1, "ab"]}}}}')
     sediment("readout", deck.parent / "layers.h5", "--out", mine, "--instrument", "hydrometer")
     case("a forged list of saved files deletes nothing outside the folder", (deck.parent / "layers.h5").is_file(), "")
     bad = sum(1 for _, good, _ in results if not good)

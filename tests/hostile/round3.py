@@ -693,13 +693,13 @@ for _name, _content in {"empty": "", "not-json": "{nope", "a-list": "[1, 2]", "n
 
 
 def readout_saved(content: str) -> Callable:
-    """A damaged or forged .sediment-saved in a readout folder: nothing outside the folder goes."""
+    """A damaged or forged manifest (.sediment-files.json) in a readout folder: nothing outside the
+    folder goes, and no mixed set."""
     def fn(ctx: Ctx):
         run = ctx.copy("run")
-        (run / "r" / ".sediment-saved").write_text(content)
+        (run / "r" / ".sediment-files.json").write_text(content)
         (ctx.tmp / "precious.txt").write_text("mine")
         before = tree(run)
-        before.pop("r/.sediment-saved")
         before = {k: v for k, v in before.items() if not k.startswith("r/")}
         done = sed("readout", run / "layers.h5", "--out", run / "r", "--instrument", "hydrometer", timeout=60)
         after = {k: v for k, v in tree(run).items() if not k.startswith("r/")}
@@ -713,13 +713,15 @@ def readout_saved(content: str) -> Callable:
             extra = [n for n in left if n.startswith(("buoyancy", "pipette"))]
             return ("wrong", f"a mixed set: {extra} of the earlier readout beside the new one") if extra else \
                 ("ok", "one readout, nothing outside deleted")
-        return refusal(done, [(".sediment-saved", "saved")])
+        return refusal(done, [(".sediment-files.json",), ("damaged",)])
     return fn
 
 
-for _name, _content in {"outside": "../input_psd.csv\n../../precious.txt\n", "absolute": "/etc/hostname\n",
-                        "binary": "\x00\x01\x02", "empty": ""}.items():
-    add(f"readout/damaged-.sediment-saved/{_name}", "readout", "damaged", readout_saved(_content), quick=True,
+_FORGED = '{"format": 1, "sets": {"readout": {"files": {%s}}}}'
+for _name, _content in {"outside": _FORGED % '"../input_psd.csv": [1, "a"], "../../precious.txt": [1, "a"]',
+                        "absolute": _FORGED % '"/etc/hostname": [1, "a"]', "binary": "\x00\x01\x02", "empty": "",
+                        "not-a-set": '{"format": 1, "sets": [1, 2]}'}.items():
+    add(f"readout/damaged-manifest/{_name}", "readout", "damaged", readout_saved(_content), quick=True,
         needs=("run",))
 
 
@@ -824,8 +826,8 @@ def _drop(key):
 
 def _setdec(key, value):
     def f(r):
-        if isinstance(r.get("decision"), dict):
-            r["decision"][key] = value
+        if isinstance(r.get("decision"), dict) and isinstance(r["decision"].get("settings"), dict):
+            r["decision"]["settings"][key] = value
         return r
     return f
 

@@ -64,6 +64,15 @@ def test_a_set_refuses_to_replace_what_it_did_not_write(tmp_path, meddle, why):
     assert contents(tmp_path) == before and not list(tmp_path.glob(".sediment-stage-*"))
 
 
+def test_a_copied_folder_stays_the_commands(tmp_path):
+    import shutil
+
+    publish(tmp_path / "a", "readout", {"table.csv": "t1", "runs/x": "r"})
+    shutil.copytree(tmp_path / "a", tmp_path / "b")
+    publish(tmp_path / "b", "readout", {"table.csv": "t2"})
+    assert contents(tmp_path / "b") == {"table.csv": "t2"}
+
+
 def test_a_set_never_replaces_its_own_input(tmp_path):
     publish(tmp_path, "invert", {"fit.csv": "f1"})
     with pytest.raises(ValueError, match="fit.csv is an input of this sediment invert"):
@@ -94,7 +103,7 @@ def test_damaged_bookkeeping_is_named(tmp_path):
     with pytest.raises(ValueError, match=f"{JOURNAL} is damaged"):
         settle(tmp_path)
     (tmp_path / JOURNAL).unlink()
-    for files in ('{"a": 3}', '{"../outside": [1, 2, 3]}', '{"/etc/passwd": [1, 2, 3]}', '{"a/../../b": [1, 2, 3]}'):
+    for files in ('{"a": 3}', '{"../outside": [1, "ab"]}', '{"/etc/passwd": [1, "ab"]}', '{"a/../../b": [1, "ab"]}'):
         (tmp_path / MANIFEST).write_text('{"sets": {"x": {"files": %s}}}' % files)
         with pytest.raises(ValueError, match=f"{MANIFEST} is damaged"):
             publish(tmp_path, "x", {"a": "1"})
@@ -187,10 +196,13 @@ def test_sample_force_removes_the_run_and_what_was_read_from_it(tmp_path, capsys
     assert cli.main(["sample", str(SAMPLE5)] + small) == 0
     (out / "layers.h5").write_bytes(b"frames")    # stands in for a run: readout's inputs are only recorded
     publish(out, "readout", {"hydrometer.csv": "h"}, inputs=[out / "layers.h5"])
+    publish(out / "r", "readout", {"pipette.csv": "p"}, inputs=[out / "layers.h5"])    # as run.sh reads it
+    publish(out / "mine", "readout", {"pipette.csv": "p"}, inputs=[SAMPLE5])
     other = REPO / "examples" / "granulometry" / "psd" / "sample1.csv"
     assert cli.main(["sample", str(other)] + small) == 2
     assert "holds a run of another scene (layers.h5)" in capsys.readouterr().err
     assert cli.main(["sample", str(other), "--force"] + small) == 0
     assert "removed the results of sediment readout" in capsys.readouterr().out
     assert not (out / "layers.h5").exists() and not (out / "hydrometer.csv").exists()
-    assert set(read_manifest(out)["sets"]) == {"sample"}
+    assert not (out / "r" / "pipette.csv").exists() and (out / "mine" / "pipette.csv").is_file()
+    assert set(read_manifest(out)["sets"]) == {"sample"} and read_manifest(out / "r")["sets"] == {}

@@ -15,7 +15,6 @@ import threading
 from pathlib import Path
 
 from .. import __version__
-from ..sim.run import RunInterrupted
 from . import budget, calibrate, case_a, invert, paste, plan, readout, run, sample, spheres, sweep, terminal
 
 # In the order of the work: plan a test, sample it, run it, read it; the physics' uncertainty; a
@@ -56,6 +55,26 @@ def build_parser() -> argparse.ArgumentParser:
 def main(argv: list[str] | None = None) -> int:
     """Runs one command. Errors end with one line on stderr: exit status 2 for a problem with the
     input or the files, 130 when interrupted (Ctrl-C or SIGTERM; a run stops every rank first)."""
+    # SIGINT and SIGTERM stop every command alike, through its clean-up, also where SIGINT came in
+    # ignored (a background job of a script): `sediment run` takes them so while its run lasts.
+    previous = {}
+    if threading.current_thread() is threading.main_thread():    # where Python lets a handler be set
+        previous = {sig: signal.signal(sig, _interrupt) for sig in (signal.SIGINT, signal.SIGTERM)}
+    try:
+        return _command(argv)
+    except KeyboardInterrupt as exc:    # while the command's parts loaded
+        print(f"sediment: interrupted by {exc or 'SIGINT'} before the command began; nothing was written",
+              file=sys.stderr)
+        return 130
+    finally:
+        for sig, handler in previous.items():
+            signal.signal(sig, handler)
+
+
+def _command(argv: list[str] | None) -> int:
+    """`main` with the signals taken."""
+    from ..sim.run import RunInterrupted
+
     args = build_parser().parse_args(argv)
     try:
         from .. import _core    # noqa: F401  (every command but --help needs it)
@@ -65,11 +84,6 @@ def main(argv: list[str] | None = None) -> int:
         return 2
     stdout = sys.stdout
     sys.stdout = _ReaderMayLeave(stdout)
-    # SIGINT and SIGTERM stop every command alike, through its clean-up, also where SIGINT came in
-    # ignored (a background job of a script): `sediment run` takes them so while its run lasts.
-    previous = {}
-    if threading.current_thread() is threading.main_thread():    # where Python lets a handler be set
-        previous = {sig: signal.signal(sig, _interrupt) for sig in (signal.SIGINT, signal.SIGTERM)}
     outputs = None
     try:
         if getattr(args, "out", None) is None:
@@ -99,8 +113,6 @@ def main(argv: list[str] | None = None) -> int:
         return 2
     finally:
         sys.stdout = stdout
-        for sig, handler in previous.items():
-            signal.signal(sig, handler)
 
 
 def _publish(outputs) -> None:
@@ -109,8 +121,8 @@ def _publish(outputs) -> None:
         return
     written = outputs.publish()
     print(f"wrote {outputs.folder}: " + ", ".join(p.name + ("/" if p.is_dir() else "") for p in written))
-    for name in outputs.removed_sets:
-        print(f"removed the results of sediment {name} in {outputs.folder}: they were made from files this "
+    for name, folder in outputs.removed_sets:
+        print(f"removed the results of sediment {name} in {folder}: they were made from files this "
               f"{outputs.name} removed")
 
 

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import sys
 from pathlib import Path
 
 from ..constants import D422_CYLINDER_AREA, D422_CYLINDER_HEIGHT, SOIL_PARTICLE_DENSITY
@@ -147,7 +148,12 @@ def _invert(args: argparse.Namespace, test, sheets) -> int:
     print(result.table().text(), end="")
     print(result.texture().table().text(), end="")
     print("\n".join(notes))           # the verdict last
-    return 0 if result.consistent else 3
+    if result.consistent:
+        return 0
+    twice = sorted({s.instrument for s in readings if sum(r.instrument == s.instrument for r in readings) > 1})
+    hint = f" (two {' and two '.join(twice)} sheets: of two samples?)" if twice else ""
+    print(f"sediment invert: no PSD explains the sheets together{hint} (exit 3): {notes[-1]}", file=sys.stderr)
+    return 3
 
 
 def _design(args: argparse.Namespace, test) -> int:

@@ -116,11 +116,14 @@ def run(args: argparse.Namespace) -> int:
         if args.temperature_record is not None:    # its trial runs follow it, and its report names it
             from ..lab.sheet import read_temperature_record
 
-            scene.water_record = read_temperature_record(args.temperature_record)
+            scene.water_record = read_temperature_record(args.temperature_record, args.t_end)
         name = args.psd.stem
         if args.contact_cut is not None and not args.measure_contacts:
             raise ValueError("--contact-cut sets the reduced scene of --measure-contacts: give both")
         if args.screen_only:
+            if args.set:
+                pin(scene, dict(args.set))    # a wrong setting named first
+                raise ValueError("--set pins what the planner would decide: --screen-only decides nothing")
             _print_screens(scene.screens)
             if args.measure_contacts:
                 _measure_contacts(test, args, tolerance)

@@ -80,14 +80,15 @@ def run(args: argparse.Namespace) -> int:
                 setattr(args, option, beside)
                 compared.append(beside)
                 print(f"using {beside}")
-    psd = read_psd(args.psd) if args.psd else None
-    simulated = read_psd(args.simulated) if args.simulated else None
-    if args.layers is not None:
+    if args.layers is not None:    # the frames and what they are compared with checked before they are read
         from ..sim.layers import check_layer_file, read_layers_guarded
         check_layer_file(args.layers)
         check_digest(args.layers)
         layers = read_layers_guarded(args.layers)
         check_inputs(args.layers, layers.identity.get("run_id", ""), compared)
+    psd = read_psd(args.psd) if args.psd else None
+    simulated = read_psd(args.simulated) if args.simulated else None
+    if args.layers is not None:
         if not layers.complete:
             message = (f"{args.layers} is partial: the run writing it did not finish ({len(layers.time)} frames, the "
                        f"last at {layers.time[-1] / 60:.4g} min)")

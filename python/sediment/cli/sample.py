@@ -110,7 +110,7 @@ def run(args: argparse.Namespace) -> int:
     if args.temperature_record is not None:
         from ..lab.sheet import read_temperature_record
 
-        record = read_temperature_record(args.temperature_record)
+        record = read_temperature_record(args.temperature_record, args.t_end)
     if args.plan is not None:
         from ..planner.scenes import decided_options
 

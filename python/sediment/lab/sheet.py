@@ -190,10 +190,11 @@ def _numbers(table: CsvFile, name: str, blank: bool = False) -> list[float]:
         raise SheetError(str(exc)) from None
 
 
-def read_temperature_record(path: str | Path) -> tuple[tuple[float, float], ...]:
+def read_temperature_record(path: str | Path, t_end: float | None = None) -> tuple[tuple[float, float], ...]:
     """The water's temperature over a test, (time [s], temperature [C]) pairs, from any CSV with the
     columns time_min and temperature_C (a sheet of readings serves; rows without a temperature are
-    left out)."""
+    left out). With the test's end `t_end` [s], a record that ends before a tenth of it is refused:
+    its times are hours or seconds, not minutes, or it is another test's."""
     table = _table(path)
     path = table.path
     if not {"time_min", "temperature_C"} <= set(table.header):
@@ -210,6 +211,10 @@ def read_temperature_record(path: str | Path) -> tuple[tuple[float, float], ...]
         raise SheetError(f"{path}: no temperatures recorded")
     if record[0][0] < 0 or any(b[0] <= a[0] for a, b in zip(record[:-1], record[1:])):
         raise SheetError(f"{path}: the times must be >= 0 and increase from row to row")
+    if t_end is not None and record[-1][0] < 0.1 * t_end:
+        raise SheetError(f"{path}: the record ends at {record[-1][0] / 60:g} min, before a tenth of the test's "
+                         f"{t_end / 60:g} min: time_min is in minutes (times in hours?), or the record is another "
+                         "test's")
     return record
 
 
@@ -226,6 +231,9 @@ def check_sheet(sheet: Sheet, whole: float, resolution: float) -> None:
         raise SheetError(f"{sheet.label}: the reading at {sheet.time[k] / 60:g} min ({sheet.reading[k]:g}) is beyond what "
                          f"the whole sample in suspension reads ({whole:.4g}): check the sample mass, the units or the "
                          "sheet")
+    if sheet.instrument == "pipette" and sheet.reading.max() < 0.005 * whole:
+        raise SheetError(f"{sheet.label}: every sample weighs under 0.5 % of what the whole sample in suspension gives "
+                         f"({whole:.4g} g): mass_g is in grams (masses in kg?), or the sample mass is wrong")
     same_depth = np.ones(len(signal), bool) if sheet.instrument != "pipette" else np.r_[True, np.diff(sheet.depth) == 0]
     rises = np.flatnonzero((np.diff(signal) > resolution) & same_depth[1:])
     if len(rises):

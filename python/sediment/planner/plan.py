@@ -313,8 +313,16 @@ def pin(scene, pins: dict[str, str]) -> None:
             value = next((v for v in knob.values if str(v) == text), None)
             if value is None:
                 raise ValueError(f"{name} takes {', '.join(str(v) for v in knob.values)}, not '{text}'")
+        elif isinstance(knob.values[0], (int, float)):
+            try:
+                number = float(text)
+            except ValueError:
+                number = math.nan
+            if not (math.isfinite(number) and number > 0):
+                raise ValueError(f"{name} is a resolution: it takes a number > 0, not '{text}'")
+            value = type(knob.values[0])(number)
         else:
-            value = type(knob.values[0])(float(text)) if isinstance(knob.values[0], (int, float)) else text
+            value = text
         knobs[name] = replace(knob, values=(value,), drops=())
     scene.knobs = list(knobs.values())
 

@@ -77,8 +77,15 @@ def decided_options(report: Path) -> tuple[dict, dict]:
         hindrance = decision.get("hindrance", "difelice" if decision["drag"] == "difelice" else "none")
         if hindrance not in HINDRANCES:
             raise ValueError(f"hindrance '{hindrance}'")
-        return ({"drag": decision["drag"], "hindrance": hindrance, "particles": int(decision["particles"]),
-                 "courant": float(decision["courant"])}, dict(content.get("scene_options", {})))
+        particles, courant = decision["particles"], decision["courant"]
+        if not (isinstance(particles, int) and particles > 0):
+            raise ValueError(f"particles {particles!r}")
+        if not (isinstance(courant, (int, float)) and math.isfinite(courant) and courant > 0):
+            raise ValueError(f"courant {courant!r}")
+        if not isinstance(content.get("scene_options"), dict):
+            raise ValueError("test options (scene_options): a plan of an earlier version, or damaged")
+        return ({"drag": decision["drag"], "hindrance": hindrance, "particles": particles, "courant": float(courant)},
+                content["scene_options"])
     except (json.JSONDecodeError, UnicodeDecodeError) as exc:
         raise ValueError(f"{report} is not a plan's report.json: {exc}") from None
     except (KeyError, TypeError, ValueError) as exc:

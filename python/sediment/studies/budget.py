@@ -282,13 +282,25 @@ def plot(budgets: list[Budget], path: Path) -> Path:
 def band_of(budget_file: Path, sample: str | None = None) -> dict[str, float]:
     """The physical total of a budget (budget.json), per instrument [pp]: the band the physical
     uncertainty puts around a simulated reading of that test."""
-    content = json.loads(Path(budget_file).read_text())
-    if not isinstance(content, list) or not content:
-        raise ValueError(f"{budget_file} is not a budget.json of `sediment budget`")
+    what = f"{budget_file} is not a budget.json of `sediment budget`"
+    try:
+        content = json.loads(Path(budget_file).read_text())
+    except (UnicodeDecodeError, json.JSONDecodeError) as exc:
+        raise ValueError(f"{what}: {exc}") from None
+    if not (isinstance(content, list) and content and all(isinstance(b, dict) and isinstance(b.get("sample"), str)
+                                                          and isinstance(b.get("physical_total_pp"), dict)
+                                                          for b in content)):
+        raise ValueError(f"{what}: a list of samples, each with its physical_total_pp, was expected")
     if sample is None and len(content) > 1:
         raise ValueError(f"{budget_file} holds {len(content)} samples ({', '.join(b['sample'] for b in content)}): "
                          "name one")
     chosen = content[0] if sample is None else next((b for b in content if b["sample"] == sample), None)
     if chosen is None:
         raise ValueError(f"{budget_file} has no sample '{sample}'")
-    return {k: float(v) for k, v in chosen["physical_total_pp"].items()}
+    try:
+        band = {k: float(v) for k, v in chosen["physical_total_pp"].items()}
+    except (TypeError, ValueError):
+        band = {}
+    if not band or not all(math.isfinite(v) and v >= 0 for v in band.values()):
+        raise ValueError(f"{what}: the physical totals of '{chosen['sample']}' are not numbers >= 0")
+    return band
