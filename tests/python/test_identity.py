@@ -9,14 +9,13 @@ import os
 import shutil
 import signal
 import subprocess
-import time
 from pathlib import Path
 
 import h5py
 import numpy as np
 import pytest
 
-from test_faults import PSD, REPO, SEDIMENT, digest, processes_in, sample, sediment, wait_for
+from test_faults import HANG_GUARD, PSD, REPO, SEDIMENT, digest, processes_in, sample, sediment, wait_for
 
 from sediment.sim.layers import read_layers
 
@@ -33,12 +32,10 @@ def kill_when(folder: Path, condition, *options) -> subprocess.Popen:
     """Starts `sediment run --force` in `folder`, SIGKILLs it once `condition()` holds."""
     run = subprocess.Popen(SEDIMENT + ["run", str(folder / "in.sedimentation"), "--quiet", "--force", *options],
                            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-    end = time.monotonic() + 60
-    while not condition() and time.monotonic() < end:
-        time.sleep(0.01)
+    wait_for(condition, process=run)    # killed at that event, not after some time
     run.send_signal(signal.SIGKILL)
     run.wait()
-    wait_for(lambda: not processes_in(folder), 15)
+    wait_for(lambda: not processes_in(folder))
     return run
 
 
@@ -102,9 +99,9 @@ def test_3_lost_frames_are_never_taken_for_a_result(tmp_path):
     for name in ("restart.a.bin", "restart.b.bin"):
         (deck.parent / name).unlink()
     run = subprocess.Popen(SEDIMENT + ["run", str(deck), "--quiet", "--force"], stderr=subprocess.PIPE, text=True)
-    wait_for(lambda: (deck.parent / "restart.a.bin").is_file())    # the run is past its first stages
+    wait_for(lambda: (deck.parent / "restart.a.bin").is_file(), process=run)    # the run is past its first stages
     (deck.parent / "layers.h5.partial").unlink()
-    _, err = run.communicate(timeout=120)
+    _, err = run.communicate(timeout=HANG_GUARD)
     assert run.returncode == 2 and "vanished" in err
     assert digest(deck.parent / "layers.h5") == finished
 
@@ -133,11 +130,11 @@ def test_4_stale_frames_are_not_paired_with_new_tables(tmp_path):
 def test_4_sample_waits_for_no_run_but_refuses_a_busy_folder(tmp_path):
     deck = sample(tmp_path / "x", *LONG)
     run = subprocess.Popen(SEDIMENT + ["run", str(deck), "--quiet"], stderr=subprocess.PIPE, text=True)
-    wait_for(lambda: (deck.parent / "layers.h5.partial").is_file())
+    wait_for(lambda: (deck.parent / "layers.h5.partial").is_file(), process=run)
     busy = sediment("sample", SAMPLE1, "--out", deck.parent, "--force")
     assert busy.returncode == 2 and "another sediment command" in busy.stderr
     run.send_signal(signal.SIGINT)
-    run.communicate(timeout=30)
+    run.communicate(timeout=HANG_GUARD)
 
 
 def _small_plan(out: Path, psd: Path = PSD) -> subprocess.CompletedProcess:
@@ -156,9 +153,9 @@ def test_5_the_planner_replaces_its_folder_whole_or_not_at_all(tmp_path):
                             stderr=subprocess.PIPE, text=True)
     # as soon as its first run has a folder (a run's layers.h5.partial lives a fraction of a second,
     # between two looks when the machine is busy; the folder stays until the plan is swapped in)
-    wait_for(lambda: [run for run in tmp_path.glob(".plan.new-*/runs/*") if run.is_dir()])
+    wait_for(lambda: [run for run in tmp_path.glob(".plan.new-*/runs/*") if run.is_dir()], process=plan)
     plan.send_signal(signal.SIGINT)
-    plan.communicate(timeout=30)
+    plan.communicate(timeout=HANG_GUARD)
     assert plan.returncode == 130
     assert {p.relative_to(out): digest(p) for p in out.rglob("*") if p.is_file()} == before
     assert not list(tmp_path.glob(".plan.*new*"))
@@ -233,10 +230,10 @@ def test_7_no_mpirun_outlives_a_killed_sediment(tmp_path):
     deck = sample(tmp_path / "x", *LONG)
     run = subprocess.Popen(SEDIMENT + ["run", str(deck), "--quiet", "--np", "16", "--oversubscribe"],
                            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-    wait_for(lambda: len(processes_in(deck.parent)) >= 2)    # mpirun started (its ranks may still start)
+    wait_for(lambda: len(processes_in(deck.parent)) >= 2, process=run)    # mpirun started (its ranks may still start)
     run.send_signal(signal.SIGKILL)
     run.wait()
-    wait_for(lambda: not processes_in(deck.parent), 20)
+    wait_for(lambda: not processes_in(deck.parent))
 
 
 def test_8_a_damaged_partial_says_to_remove_it_and_force_replaces_it(tmp_path):
@@ -340,8 +337,8 @@ def test_8_ctrl_c_during_a_resume_stops_it(tmp_path):
     kill_when(deck.parent, lambda: len(restart_stamps(deck.parent)) == 2)
     run = subprocess.Popen(SEDIMENT + ["run", str(deck), "--resume", "--quiet"], stderr=subprocess.PIPE, text=True)
     stamps = restart_stamps(deck.parent)
-    wait_for(lambda: restart_stamps(deck.parent) != stamps)    # the resumed run under way
+    wait_for(lambda: restart_stamps(deck.parent) != stamps, process=run)    # the resumed run under way
     run.send_signal(signal.SIGINT)
-    _, err = run.communicate(timeout=30)
+    _, err = run.communicate(timeout=HANG_GUARD)
     assert run.returncode == 130 and "stopped by SIGINT" in err and "trying restart" not in err
     assert "layers.h5.partial" in err and not (deck.parent / "layers.h5").exists()
