@@ -106,9 +106,11 @@ test-lammps-2022: build
 	cd $(LAMMPS_2022_SEDIMENT) && ctest -j $(JOBS) -L deck -R '^deck\.(style_|mpi_consistency)' --output-on-failure
 
 # The documentation site (Sphinx from Debian's packages, warnings as errors): the README and docs/,
-# the style pages, the notebook as a tutorial and the Python API from its docstrings.
+# the style pages, the notebook as a tutorial (executed here with this build, its printed text and
+# figures on the page; its run in $(BUILD)/docs-src-notebook) and the Python API from its docstrings.
 docs: build
-	$(PYTHON) scripts/docs-stage.py $(BUILD)/docs-src
+	PYTHONPATH=$(abspath python) SEDIMENT_LMP=$(abspath $(BUILD))/lmp_sediment \
+	  $(PYTHON) scripts/docs-stage.py $(BUILD)/docs-src
 	SEDIMENT_PYTHON=$(abspath python) $(PYTHON) -m sphinx -W --keep-going -q -b html $(BUILD)/docs-src $(BUILD)/docs
 	@echo "docs: $(BUILD)/docs/index.html"
 
