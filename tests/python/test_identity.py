@@ -9,6 +9,7 @@ import os
 import shutil
 import signal
 import subprocess
+import time
 from pathlib import Path
 
 import h5py
@@ -29,12 +30,41 @@ def restart_stamps(folder: Path) -> dict[str, int]:
 
 
 def kill_when(folder: Path, condition, *options) -> subprocess.Popen:
-    """Starts `sediment run --force` in `folder`, SIGKILLs it once `condition()` holds."""
+    """Starts `sediment run --force` in `folder` and SIGKILLs it and its LAMMPS at the first look where
+    `condition()` holds and no restart file is being written. Each look is taken with LAMMPS stopped
+    (SIGSTOP), so the files it sees are those the kill leaves, however busy the machine: a restart
+    file half-written at the kill (a damaged one, which the tests of damaged files make on purpose)
+    cannot come from a look that came late."""
     run = subprocess.Popen(SEDIMENT + ["run", str(folder / "in.sedimentation"), "--quiet", "--force", *options],
                            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-    wait_for(condition, process=run)    # killed at that event, not after some time
+
+    def signal_all(pids: list[int], sig: int) -> None:
+        for pid in pids:
+            try:
+                os.kill(pid, sig)
+            except ProcessLookupError:
+                pass
+
+    def writing_restart(pids: list[int]) -> bool:
+        for pid in pids:
+            try:
+                if any(os.readlink(fd.path).startswith(str(folder / "restart.")) for fd in os.scandir(f"/proc/{pid}/fd")):
+                    return True
+            except OSError:
+                continue
+        return False
+
+    while True:
+        lammps = processes_in(folder)
+        signal_all(lammps, signal.SIGSTOP)
+        if lammps and condition() and not writing_restart(lammps):
+            break
+        signal_all(lammps, signal.SIGCONT)
+        assert run.poll() is None, f"the run ended (exit {run.returncode}) before the event"
+        time.sleep(0.01)
     run.send_signal(signal.SIGKILL)
     run.wait()
+    signal_all(lammps, signal.SIGKILL)    # as a crash: nothing written after the look
     wait_for(lambda: not processes_in(folder))
     return run
 
