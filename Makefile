@@ -44,8 +44,12 @@ demo: build-demo
 test-cpp: build
 	cd $(BUILD) && ctest -j $(JOBS) --output-on-failure
 
+# The test files in $(JOBS) workers (pytest-xdist): most tests wait on one single-rank LAMMPS run or on
+# Python, so one worker leaves a core idle. No test's outcome depends on the clock or the load; the
+# tests of the installed package share one worker and its venv.
 test-python: build
-	PYTHONPATH=python SEDIMENT_LMP=$(abspath $(BUILD))/lmp_sediment $(PYTHON) -m pytest -q tests/python
+	PYTHONPATH=python SEDIMENT_LMP=$(abspath $(BUILD))/lmp_sediment $(PYTHON) -m pytest -q -n $(JOBS) --dist loadgroup \
+	  tests/python
 
 # The C++ and deck tests again, built with AddressSanitizer and UndefinedBehaviorSanitizer. No Python
 # module there: the deck harness imports the one of $(BUILD). Leak checks are off (LAMMPS and Open MPI
