@@ -58,7 +58,8 @@ SANITIZE_BUILD ?= build-sanitize
 check-sanitize: build
 	cmake -S . -B $(SANITIZE_BUILD) -DCMAKE_BUILD_TYPE=RelWithDebInfo -DSEDIMENT_SANITIZE=ON \
 	      -DSEDIMENT_BUILD_PYTHON=OFF -DLAMMPS_SOURCE_DIR=$(abspath $(BUILD))/lammps-headers
-	cmake --build $(SANITIZE_BUILD) -j $(JOBS)
+	@# what its tests run, no more (no plugin, no benchmarks)
+	cmake --build $(SANITIZE_BUILD) -j $(JOBS) --target test_core lmp_sediment
 	@# every check serially, and with 2 ranks those that exercise the MPI paths (ghost atoms, file
 	@# writing on rank 0, restarts): the full 2-rank set runs uninstrumented in test-cpp
 	cd $(SANITIZE_BUILD) && export ASAN_OPTIONS=detect_leaks=0:abort_on_error=1 \
@@ -81,7 +82,8 @@ test-lammps-current: build
 	      -DLAMMPS_SOURCE_DIR=$(abspath $(CURRENT))/lammps/src \
 	      -DLAMMPS_LIBRARY=$(abspath $(CURRENT))/build/liblammps.so \
 	      -DSEDIMENT_DECK_LMP=$(abspath $(CURRENT))/build/lmp >/dev/null
-	cmake --build $(CURRENT_SEDIMENT) -j $(JOBS)
+	@# the plugin and the driver, which the route tests run (the core's tests ran in test-cpp)
+	cmake --build $(CURRENT_SEDIMENT) -j $(JOBS) --target sedimentplugin lmp_sediment
 	cd $(CURRENT_SEDIMENT) && ctest -j $(JOBS) -L "deck|route" --output-on-failure
 	@# the doc pages of the in-tree package are in LAMMPS's command tables: no style entry missing
 	$(PYTHON) $(CURRENT)/lammps/doc/utils/check-styles.py > $(CURRENT)/check-styles.txt
