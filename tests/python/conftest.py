@@ -48,6 +48,7 @@ def pytest_configure(config):
     config.addinivalue_line("markers", "xdist_group(name): tests that run in one worker of pytest -n (pytest-xdist)")
 
 
+@pytest.hookimpl(tryfirst=True)    # before xdist's own, which reads the groups
 def pytest_collection_modifyitems(config, items):
     """Under pytest -n N --dist loadgroup (make test-python), the tests of the installed package run in
     one worker, so that the venv is installed once, not once per worker."""
