@@ -44,8 +44,12 @@ demo: build-demo
 test-cpp: build
 	cd $(BUILD) && ctest -j $(JOBS) --output-on-failure
 
+# The test files in $(JOBS) workers (pytest-xdist): most tests wait on one single-rank LAMMPS run or on
+# Python, so one worker leaves a core idle. No test's outcome depends on the clock or the load; the
+# tests of the installed package share one worker and its venv.
 test-python: build
-	PYTHONPATH=python SEDIMENT_LMP=$(abspath $(BUILD))/lmp_sediment $(PYTHON) -m pytest -q tests/python
+	PYTHONPATH=python SEDIMENT_LMP=$(abspath $(BUILD))/lmp_sediment $(PYTHON) -m pytest -q -n $(JOBS) --dist loadgroup \
+	  tests/python
 
 # The C++ and deck tests again, built with AddressSanitizer and UndefinedBehaviorSanitizer. No Python
 # module there: the deck harness imports the one of $(BUILD). Leak checks are off (LAMMPS and Open MPI
@@ -54,7 +58,8 @@ SANITIZE_BUILD ?= build-sanitize
 check-sanitize: build
 	cmake -S . -B $(SANITIZE_BUILD) -DCMAKE_BUILD_TYPE=RelWithDebInfo -DSEDIMENT_SANITIZE=ON \
 	      -DSEDIMENT_BUILD_PYTHON=OFF -DLAMMPS_SOURCE_DIR=$(abspath $(BUILD))/lammps-headers
-	cmake --build $(SANITIZE_BUILD) -j $(JOBS)
+	@# what its tests run, no more (no plugin, no benchmarks)
+	cmake --build $(SANITIZE_BUILD) -j $(JOBS) --target test_core lmp_sediment
 	@# every check serially, and with 2 ranks those that exercise the MPI paths (ghost atoms, file
 	@# writing on rank 0, restarts): the full 2-rank set runs uninstrumented in test-cpp
 	cd $(SANITIZE_BUILD) && export ASAN_OPTIONS=detect_leaks=0:abort_on_error=1 \
@@ -77,7 +82,8 @@ test-lammps-current: build
 	      -DLAMMPS_SOURCE_DIR=$(abspath $(CURRENT))/lammps/src \
 	      -DLAMMPS_LIBRARY=$(abspath $(CURRENT))/build/liblammps.so \
 	      -DSEDIMENT_DECK_LMP=$(abspath $(CURRENT))/build/lmp >/dev/null
-	cmake --build $(CURRENT_SEDIMENT) -j $(JOBS)
+	@# the plugin and the driver, which the route tests run (the core's tests ran in test-cpp)
+	cmake --build $(CURRENT_SEDIMENT) -j $(JOBS) --target sedimentplugin lmp_sediment
 	cd $(CURRENT_SEDIMENT) && ctest -j $(JOBS) -L "deck|route" --output-on-failure
 	@# the doc pages of the in-tree package are in LAMMPS's command tables: no style entry missing
 	$(PYTHON) $(CURRENT)/lammps/doc/utils/check-styles.py > $(CURRENT)/check-styles.txt
@@ -110,9 +116,11 @@ test-lammps-2022: build
 	  --output-on-failure
 
 # The documentation site (Sphinx from Debian's packages, warnings as errors): the README and docs/,
-# the style pages, the notebook as a tutorial and the Python API from its docstrings.
+# the style pages, the notebook as a tutorial (executed here with this build, its printed text and
+# figures on the page; its run in $(BUILD)/docs-src-notebook) and the Python API from its docstrings.
 docs: build
-	$(PYTHON) scripts/docs-stage.py $(BUILD)/docs-src
+	PYTHONPATH=$(abspath python) SEDIMENT_LMP=$(abspath $(BUILD))/lmp_sediment \
+	  $(PYTHON) scripts/docs-stage.py $(BUILD)/docs-src
 	SEDIMENT_PYTHON=$(abspath python) $(PYTHON) -m sphinx -W --keep-going -q -b html $(BUILD)/docs-src $(BUILD)/docs
 	@echo "docs: $(BUILD)/docs/index.html"
 

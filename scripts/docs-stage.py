@@ -4,13 +4,19 @@
     scripts/docs-stage.py OUT
 docs/site/ (configuration, index, API page), docs/*.md and their figures, the README, the style pages
 (lammps-pkg/SEDIMENT/doc/*.rst under styles/) and the notebook as a tutorial page. A link to a file
-of the repository that is not a page of the site becomes the file's name in code."""
+of the repository that is not a page of the site becomes the file's name in code.
+
+The tutorial shows the notebook as it runs here: it is executed (nbclient, the python3 kernel) with the
+checkout's package (PYTHONPATH) and SEDIMENT_LMP as the environment gives them (make docs sets both),
+its run in OUT-notebook/ beside OUT with the executed notebook, and its printed text and figures go
+into the page. Nothing executed is committed: the repository keeps the notebook without outputs."""
 from __future__ import annotations
 
-import json
+import base64
 import re
 import shutil
 import sys
+import warnings
 from pathlib import Path
 
 REPO = Path(__file__).resolve().parents[1]
@@ -31,13 +37,60 @@ def relink(text: str, folder: str) -> str:
     return LINK.sub(one, text)
 
 
-def notebook_page(path: Path) -> str:
-    """A notebook as a page: its markdown cells, and its code cells as Python blocks."""
-    cells = json.loads(path.read_text())["cells"]
+ANSI = re.compile(r"\x1b\[[0-9;]*[A-Za-z]")
+
+
+def execute_notebook(path: Path, run: Path) -> dict:
+    """The notebook executed in `run` (its SEDIMENT_NOTEBOOK_OUT), which also gets the executed copy."""
+    import os
+
+    import nbformat
+    from nbclient import NotebookClient
+
+    shutil.rmtree(run, ignore_errors=True)
+    run.mkdir(parents=True)
+    from nbformat.warnings import MissingIDFieldWarning
+
+    with warnings.catch_warnings():    # the checked-in notebook's cells carry no ids: given here, not in the file
+        warnings.simplefilter("ignore", MissingIDFieldWarning)
+        notebook = nbformat.read(path, as_version=4)
+    os.environ["SEDIMENT_NOTEBOOK_OUT"] = str(run)
+    os.environ["PYDEVD_DISABLE_FILE_VALIDATION"] = "1"    # the kernel's debugger note on frozen modules
+    # no cell timeout: the run's length is the machine's business; a failing cell stops the build
+    NotebookClient(notebook, timeout=None, kernel_name="python3", resources={"metadata": {"path": str(run)}}).execute()
+    nbformat.write(notebook, run / path.name)
+    return notebook
+
+
+def fenced(text: str, language: str = "text") -> str:
+    """A fenced block that no backtick run inside `text` can close."""
+    fence = "`" * max(3, max((len(m) for m in re.findall(r"`+", text)), default=0) + 1)
+    return f"{fence}{language}\n{text.rstrip()}\n{fence}"
+
+
+def notebook_page(notebook: dict, figures: Path) -> str:
+    """A notebook as a page: its markdown cells, its code cells as Python blocks, each followed by what
+    it printed and the figures it drew (PNG files written into `figures`, beside the page)."""
+    figures.mkdir(parents=True, exist_ok=True)
     parts = []
-    for cell in cells:
+    for k, cell in enumerate(notebook["cells"]):
         source = "".join(cell["source"])
-        parts.append(relink(source, "notebooks") if cell["cell_type"] == "markdown" else f"```python\n{source}\n```")
+        if cell["cell_type"] == "markdown":
+            parts.append(relink(source, "notebooks"))
+            continue
+        parts.append(fenced(source, "python"))
+        for j, output in enumerate(cell.get("outputs", [])):
+            kind, data = output["output_type"], output.get("data", {})
+            if kind == "stream":
+                parts.append(fenced(ANSI.sub("", "".join(output["text"]))))
+            elif kind == "error":
+                raise RuntimeError(f"notebook cell {k} failed: {output['ename']}: {output['evalue']}")
+            elif "image/png" in data:
+                name = f"cell{k:02d}-{j}.png"
+                (figures / name).write_bytes(base64.b64decode(data["image/png"]))
+                parts.append(f"![output of the cell above]({figures.name}/{name})")
+            elif "text/plain" in data:
+                parts.append(fenced(ANSI.sub("", "".join(data["text/plain"]))))
     return "\n\n".join(parts) + "\n"
 
 
@@ -53,7 +106,8 @@ def main() -> None:
     (out / "styles").mkdir()
     for page in (REPO / "lammps-pkg" / "SEDIMENT" / "doc").glob("*.rst"):
         shutil.copy(page, out / "styles" / page.name)
-    (out / "tutorial.md").write_text(notebook_page(REPO / "notebooks" / "sedimentation_test.ipynb"))
+    notebook = execute_notebook(REPO / "notebooks" / "sedimentation_test.ipynb", out.parent / f"{out.name}-notebook")
+    (out / "tutorial.md").write_text(notebook_page(notebook, out / "tutorial"))
 
 
 if __name__ == "__main__":

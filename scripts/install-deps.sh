@@ -6,7 +6,7 @@ packages=(
   cmake g++ make dpkg-dev xz-utils util-linux procps
   lammps liblammps-dev python3-lammps openmpi-bin libopenmpi-dev libfftw3-dev
   pybind11-dev python3-pybind11 libgtest-dev libbenchmark-dev libhdf5-dev
-  python3-numpy python3-scipy python3-matplotlib python3-h5py python3-pytest python3-tqdm
+  python3-numpy python3-scipy python3-matplotlib python3-h5py python3-pytest python3-pytest-xdist python3-tqdm
   python3-nbclient python3-nbformat python3-nbconvert python3-ipykernel python3-sphinx python3-myst-parser python3-numpydoc
   python3-pip python3-venv python3-setuptools python3-wheel
 )

@@ -42,3 +42,16 @@ def installed(tmp_path_factory) -> Path:
     subprocess.run(["bash", "-c", command], check=True, cwd=source, capture_output=True)
     assert not (source / "build").exists() and (source / "build-pip").is_dir()
     return source / ".venv"
+
+
+def pytest_configure(config):
+    config.addinivalue_line("markers", "xdist_group(name): tests that run in one worker of pytest -n (pytest-xdist)")
+
+
+@pytest.hookimpl(tryfirst=True)    # before xdist's own, which reads the groups
+def pytest_collection_modifyitems(config, items):
+    """Under pytest -n N --dist loadgroup (make test-python), the tests of the installed package run in
+    one worker, so that the venv is installed once, not once per worker."""
+    for item in items:
+        if "installed" in getattr(item, "fixturenames", ()):
+            item.add_marker(pytest.mark.xdist_group("installed"))

@@ -16,7 +16,7 @@ import h5py
 import numpy as np
 import pytest
 
-from test_faults import PSD, REPO, SEDIMENT, digest, processes_in, sample, sediment, wait_for
+from test_faults import HANG_GUARD, PSD, REPO, SEDIMENT, digest, processes_in, sample, sediment, wait_for
 
 from sediment.sim.layers import read_layers
 
@@ -30,15 +30,42 @@ def restart_stamps(folder: Path) -> dict[str, int]:
 
 
 def kill_when(folder: Path, condition, *options) -> subprocess.Popen:
-    """Starts `sediment run --force` in `folder`, SIGKILLs it once `condition()` holds."""
+    """Starts `sediment run --force` in `folder` and SIGKILLs it and its LAMMPS at the first look where
+    `condition()` holds and no restart file is being written. Each look is taken with LAMMPS stopped
+    (SIGSTOP), so the files it sees are those the kill leaves, however busy the machine: a restart
+    file half-written at the kill (a damaged one, which the tests of damaged files make on purpose)
+    cannot come from a look that came late."""
     run = subprocess.Popen(SEDIMENT + ["run", str(folder / "in.sedimentation"), "--quiet", "--force", *options],
                            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-    end = time.monotonic() + 60
-    while not condition() and time.monotonic() < end:
+
+    def signal_all(pids: list[int], sig: int) -> None:
+        for pid in pids:
+            try:
+                os.kill(pid, sig)
+            except ProcessLookupError:
+                pass
+
+    def writing_restart(pids: list[int]) -> bool:
+        for pid in pids:
+            try:
+                if any(os.readlink(fd.path).startswith(str(folder / "restart.")) for fd in os.scandir(f"/proc/{pid}/fd")):
+                    return True
+            except OSError:
+                continue
+        return False
+
+    while True:
+        lammps = processes_in(folder)
+        signal_all(lammps, signal.SIGSTOP)
+        if lammps and condition() and not writing_restart(lammps):
+            break
+        signal_all(lammps, signal.SIGCONT)
+        assert run.poll() is None, f"the run ended (exit {run.returncode}) before the event"
         time.sleep(0.01)
     run.send_signal(signal.SIGKILL)
     run.wait()
-    wait_for(lambda: not processes_in(folder), 15)
+    signal_all(lammps, signal.SIGKILL)    # as a crash: nothing written after the look
+    wait_for(lambda: not processes_in(folder))
     return run
 
 
@@ -102,9 +129,9 @@ def test_3_lost_frames_are_never_taken_for_a_result(tmp_path):
     for name in ("restart.a.bin", "restart.b.bin"):
         (deck.parent / name).unlink()
     run = subprocess.Popen(SEDIMENT + ["run", str(deck), "--quiet", "--force"], stderr=subprocess.PIPE, text=True)
-    wait_for(lambda: (deck.parent / "restart.a.bin").is_file())    # the run is past its first stages
+    wait_for(lambda: (deck.parent / "restart.a.bin").is_file(), process=run)    # the run is past its first stages
     (deck.parent / "layers.h5.partial").unlink()
-    _, err = run.communicate(timeout=120)
+    _, err = run.communicate(timeout=HANG_GUARD)
     assert run.returncode == 2 and "vanished" in err
     assert digest(deck.parent / "layers.h5") == finished
 
@@ -133,11 +160,11 @@ def test_4_stale_frames_are_not_paired_with_new_tables(tmp_path):
 def test_4_sample_waits_for_no_run_but_refuses_a_busy_folder(tmp_path):
     deck = sample(tmp_path / "x", *LONG)
     run = subprocess.Popen(SEDIMENT + ["run", str(deck), "--quiet"], stderr=subprocess.PIPE, text=True)
-    wait_for(lambda: (deck.parent / "layers.h5.partial").is_file())
+    wait_for(lambda: (deck.parent / "layers.h5.partial").is_file(), process=run)
     busy = sediment("sample", SAMPLE1, "--out", deck.parent, "--force")
     assert busy.returncode == 2 and "another sediment command" in busy.stderr
     run.send_signal(signal.SIGINT)
-    run.communicate(timeout=30)
+    run.communicate(timeout=HANG_GUARD)
 
 
 def _small_plan(out: Path, psd: Path = PSD) -> subprocess.CompletedProcess:
@@ -157,9 +184,9 @@ def test_5_the_planner_replaces_its_own_files_whole_or_not_at_all(tmp_path):
                             stderr=subprocess.PIPE, text=True)
     # as soon as its first run has a folder (a run's layers.h5.partial lives a fraction of a second,
     # between two looks when the machine is busy; the folder stays until the plan is swapped in)
-    wait_for(lambda: [run for run in out.glob(".sediment-stage-*/runs/*") if run.is_dir()])
+    wait_for(lambda: [run for run in out.glob(".sediment-stage-*/runs/*") if run.is_dir()], process=plan)
     plan.send_signal(signal.SIGINT)
-    _, err = plan.communicate(timeout=30)
+    _, err = plan.communicate(timeout=HANG_GUARD)
     assert plan.returncode == 130
     assert {p.relative_to(out): digest(p) for p in out.rglob("*") if p.is_file() and p.name != ".sediment.lock"} == before
     assert not list(out.glob(".sediment-stage-*")) and f"{out} is as it was" in err
@@ -239,10 +266,10 @@ def test_7_no_mpirun_outlives_a_killed_sediment(tmp_path):
     deck = sample(tmp_path / "x", *LONG)
     run = subprocess.Popen(SEDIMENT + ["run", str(deck), "--quiet", "--np", "16", "--oversubscribe"],
                            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-    wait_for(lambda: len(processes_in(deck.parent)) >= 2)    # mpirun started (its ranks may still start)
+    wait_for(lambda: len(processes_in(deck.parent)) >= 2, process=run)    # mpirun started (its ranks may still start)
     run.send_signal(signal.SIGKILL)
     run.wait()
-    wait_for(lambda: not processes_in(deck.parent), 20)
+    wait_for(lambda: not processes_in(deck.parent))
 
 
 def test_8_a_damaged_partial_says_to_remove_it_and_force_replaces_it(tmp_path):
@@ -346,8 +373,8 @@ def test_8_ctrl_c_during_a_resume_stops_it(tmp_path):
     kill_when(deck.parent, lambda: len(restart_stamps(deck.parent)) == 2)
     run = subprocess.Popen(SEDIMENT + ["run", str(deck), "--resume", "--quiet"], stderr=subprocess.PIPE, text=True)
     stamps = restart_stamps(deck.parent)
-    wait_for(lambda: restart_stamps(deck.parent) != stamps)    # the resumed run under way
+    wait_for(lambda: restart_stamps(deck.parent) != stamps, process=run)    # the resumed run under way
     run.send_signal(signal.SIGINT)
-    _, err = run.communicate(timeout=30)
+    _, err = run.communicate(timeout=HANG_GUARD)
     assert run.returncode == 130 and "stopped by SIGINT" in err and "trying restart" not in err
     assert "layers.h5.partial" in err and not (deck.parent / "layers.h5").exists()

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import json
 import math
+import time
 from pathlib import Path
 
 import numpy as np
@@ -205,27 +206,54 @@ def test_bad_input_is_refused_with_the_reason(tmp_path, capsys):
 
 @pytest.mark.parametrize("stop", ["SIGINT", "SIGTERM"])
 def test_an_interrupted_plan_stops_every_run_and_says_so(tmp_path, stop):
-    """Ctrl-C (or SIGTERM) while trials run in parallel: exit 130 with one line, no LAMMPS left
-    running, and no decision written. The plan starts with SIGINT ignored, as a background job of a
-    script does (and as make test's own processes may): it is stopped all the same."""
+    """Ctrl-C (or SIGTERM) while trials run in parallel: the plan stops its runs rather than waiting for
+    them, exits 130 with one line, leaves no LAMMPS running and the previous plan in --out as it was.
+    The plan starts with SIGINT ignored, as a background job of a script does (and as make test's own
+    processes may): it is stopped all the same. Every wait is on an event, none on the clock."""
     import signal
     import subprocess
 
     from test_faults import processes_in, wait_for
 
     out = tmp_path / "plan"
-    plan = subprocess.Popen([str(REPO / "bin" / "sediment"), "plan", str(SAMPLE5), "--out", str(out), "--particles",
-                             "40000,20000", "--courant", "1,2", "--t-end", "7200"], stderr=subprocess.PIPE, text=True,
-                            preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_IGN))
-    def busy() -> list[Path]:    # the plan works in a new folder beside --out until it is done
-        return [f for f in out.glob(".sediment-stage-*/runs/*") if f.is_dir() and processes_in(f)]
+    out.mkdir()    # earlier results there: every one of them stays as it was
+    (out / "report.json").write_text('{"earlier": "plan"}\n')
+    (out / "decision").mkdir()
+    (out / "decision" / "in.sedimentation").write_text("# the earlier decision\n")
+    before = {p.relative_to(out): p.read_bytes() for p in out.rglob("*") if p.is_file()}
+    with open(tmp_path / "stderr.txt", "w") as stderr:    # a file: nothing blocks on a full pipe
+        plan = subprocess.Popen([str(REPO / "bin" / "sediment"), "plan", str(SAMPLE5), "--out", str(out), "--particles",
+                                 "40000,20000", "--courant", "1,2", "--t-end", "7200"], stderr=stderr, text=True,
+                                preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_IGN))
 
-    wait_for(lambda: len(busy()) == 2)      # two trials at once (--jobs 2)
+    def trials() -> list[Path]:    # the plan works in a new folder beside --out until it is done
+        return [f for f in out.glob(".sediment-stage-*/runs/*") if f.is_dir()]
+
+    def finished() -> list[Path]:    # a trial run to its end leaves its layer file
+        return [f for f in trials() if (f / "layers.h5").is_file()]
+
+    wait_for(lambda: len([f for f in trials() if processes_in(f)]) == 2, process=plan)    # two at once (--jobs 2)
+    lammps = [pid for f in trials() for pid in processes_in(f)]
+    assert not finished()
     plan.send_signal(getattr(signal, stop))
-    _, err = plan.communicate(timeout=20)     # not after the runs end (about 40 s each)
+    # Stopped, not waited for: the plan ends before any of its runs (some 40 s each) could end.
+    while plan.poll() is None:
+        assert not finished(), "a trial ran to its end after the signal"
+        time.sleep(0.05)
+    err = (tmp_path / "stderr.txt").read_text()
     assert plan.returncode == 130 and "Traceback" not in err and f"interrupted by {stop}" in err
-    wait_for(lambda: not busy(), seconds=10)
-    assert not (out / "report.json").exists() and not list(out.glob(".sediment-stage-*"))
+    wait_for(lambda: not [pid for pid in lammps if _alive(pid)])
+    assert {p.relative_to(out): p.read_bytes() for p in out.rglob("*") if p.is_file() and p.name != ".sediment.lock"} \
+        == before
+    assert not list(out.glob(".sediment-stage-*"))
+
+
+def _alive(pid: int) -> bool:
+    """A process that exists and is not a zombie."""
+    try:
+        return Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0] != "Z"
+    except OSError:
+        return False
 
 
 def _narrow_psd(tmp_path: Path) -> Path:
