@@ -11,9 +11,13 @@ def _interrupt(signum: int, _frame: object) -> None:
 
 for _signal in (signal.SIGINT, signal.SIGTERM):
     signal.signal(_signal, _interrupt)
+_began = False
 try:
     from .cli import main
-except KeyboardInterrupt as exc:
-    print(f"sediment: interrupted by {exc} before the command began; nothing was written", file=sys.stderr)
+
+    _began = True
+    sys.exit(main())
+except KeyboardInterrupt as exc:    # while the command's parts loaded, or a second signal as it ended
+    print(f"sediment: interrupted by {exc} " + ("as the command ended (its own message says what it left)" if _began
+                                                else "before the command began; nothing was written"), file=sys.stderr)
     sys.exit(130)
-sys.exit(main())

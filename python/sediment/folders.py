@@ -150,7 +150,7 @@ class OutputSet:
         journal = {"set": self.name, "stage": self.stage.name, "move": entries,
                    "remove": sorted(touched - set(entries)) + self._foreign}
         (self.stage / JOURNAL).write_text(json.dumps(journal) + "\n")
-        with _signals_held():    # Ctrl-C waits until every file is in place
+        with signals_held():    # Ctrl-C waits until every file is in place
             os.rename(self.stage / JOURNAL, self.folder / JOURNAL)
             self.published = True
             _complete(self.folder, journal)
@@ -341,7 +341,7 @@ def _shown(filename: object, outputs: OutputSet) -> str:
 
 
 @contextmanager
-def _signals_held() -> Iterator[None]:
+def signals_held() -> Iterator[None]:
     """SIGINT and SIGTERM held back for the block and raised after it. Python's handlers, not the
     signal mask: the mask is per thread, and a process's signal may land in another thread."""
     if threading.current_thread() is not threading.main_thread():    # only the main thread sets handlers

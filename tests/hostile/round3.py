@@ -9,7 +9,7 @@ Each case sets up its own temporary folder, runs the command(s) and says exactly
 crash or vague (tests/hostile/harness.py says what each means). Run it as
 
     PYTHONPATH=python SEDIMENT_LMP=build/lmp_sediment tests/hostile/round3.py [--quick] [--only PATTERN]
-        [--jobs 2] [--table docs/hostile-table.md] [--list]
+        [--jobs 2] [--json OUTCOMES.json] [--list]      (tests/hostile/report.py OUTCOMES.json: the doc's tables)
 
 `--quick` runs the cases that take seconds and no LAMMPS run of their own (they share one small
 finished run, built once); tests/python/test_hostile_quick.py runs those under pytest, with the cases
@@ -27,7 +27,7 @@ import subprocess
 import sys
 import tempfile
 import time
-from collections import Counter, defaultdict
+from collections import Counter
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable
@@ -1643,31 +1643,11 @@ def select(only: str | None, quick: bool) -> list[str]:
     return names
 
 
-def table(results: list, path: Path) -> None:
-    lines = ["| case | command | kind | outcome | detail |", "|---|---|---|---|---|"]
-    for name, outcome, detail, _ in sorted(results):
-        c = CASES[name]
-        lines.append(f"| `{name}` | {c.command} | {c.kind} | {outcome} | {detail.replace('|', '/')} |")
-    by_cmd = defaultdict(Counter)
-    for name, outcome, _, _ in results:
-        by_cmd[CASES[name].command][outcome] += 1
-    counts = ["| command | cases | ok | wrong | crash | vague |", "|---|---|---|---|---|---|"]
-    total = Counter()
-    for cmd in sorted(by_cmd):
-        k = by_cmd[cmd]
-        total.update(k)
-        counts.append(f"| {cmd} | {sum(k.values())} | {k['ok']} | {k['wrong']} | {k['crash']} | {k['vague']} |")
-    counts.append(f"| all | {sum(total.values())} | {total['ok']} | {total['wrong']} | {total['crash']} | "
-                  f"{total['vague']} |")
-    path.write_text("\n".join(counts) + "\n\n" + "\n".join(lines) + "\n")
-
-
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--quick", action="store_true", help="only the cases that take seconds (no LAMMPS run of their own)")
     ap.add_argument("--only", help="cases whose name matches this glob or contains this text")
     ap.add_argument("--jobs", type=int, default=2)
-    ap.add_argument("--table", type=Path, help="write a Markdown table of the outcomes here")
     ap.add_argument("--json", type=Path, help="write the outcomes as JSON here")
     ap.add_argument("--list", action="store_true", help="list the cases and stop")
     ap.add_argument("--names", type=Path, help="run the cases named in this file (one a line)")
@@ -1701,8 +1681,6 @@ def main(argv=None) -> int:
     counts = Counter(o for _, o, _, _ in results)
     print(f"{len(results)} cases in {time.monotonic() - t0:.0f} s: " +
           ", ".join(f"{counts[o]} {o}" for o in ("ok", "wrong", "crash", "vague")))
-    if args.table:
-        table(results, args.table)
     if args.json:
         args.json.write_text(json.dumps({n: [o, d, round(s, 1)] for n, o, d, s in sorted(results)}, indent=1))
     shutil.rmtree(root, ignore_errors=True)

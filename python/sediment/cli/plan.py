@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from ..progress import bar as progress_bar
 from .sample import add_test_options, cylinder_of, suspension_of
 from .types import count, positive, positive_list, quantity, setting
 
@@ -144,8 +145,6 @@ def _measure_contacts(test, args: argparse.Namespace, tolerance: float) -> None:
     import sys
     from concurrent.futures import ThreadPoolExecutor
 
-    from tqdm import tqdm
-
     from ..planner.contacts import ReducedScene, measure_contacts
     from ..planner.scenes import prepare
     from ..results import write_text
@@ -161,8 +160,8 @@ def _measure_contacts(test, args: argparse.Namespace, tolerance: float) -> None:
     kinds = ["contacts_lubrication" if setup.lubrication else "contacts" for setup in setups]
     running: set = set()
     # One bar per run in steps (the relaxation and the measured window), with tqdm's ETA.
-    bars = [tqdm(total=1, desc=kind, unit="step", position=k, file=sys.stderr, dynamic_ncols=True, mininterval=0.5)
-            for k, kind in enumerate(kinds)]
+    bars = [progress_bar(total=1, desc=kind, unit="step", position=k, file=sys.stderr, dynamic_ncols=True,
+                     mininterval=0.5) for k, kind in enumerate(kinds)]
 
     def follow(bar):
         def update(done: int, total: int) -> None:

@@ -29,6 +29,7 @@ from pathlib import Path
 import numpy as np
 
 from .. import figures
+from ..progress import bar as progress_bar
 from ..results import Table, write_text
 from ..sim.run import stop_all
 from .scenes import Knob, Outcome, prepare
@@ -467,8 +468,7 @@ def _run_all(scene, trials: list[Trial], runs: Path, jobs: int, progress: bool, 
         return
     bar = None
     if progress:
-        from tqdm import tqdm
-        bar = tqdm(total=len(trials), desc=f"plan: {what}", unit="run")
+        bar = progress_bar(total=len(trials), desc=f"plan: {what}", unit="run")
     pool = ThreadPoolExecutor(max_workers=jobs)
     try:
         futures = {pool.submit(scene.run, t.settings, runs / t.name, t.seed): t for t in trials}

@@ -25,6 +25,7 @@ from typing import Callable
 import numpy as np
 
 from ..folders import folder_lock
+from ..progress import bar as progress_bar
 from ..results import write_text
 from .paths import lmp_executable, mpirun_prefix
 
@@ -195,6 +196,21 @@ def layer_file_of(deck: Path, variables: dict[str, str]) -> Path | None:
     if not name or "$" in name:
         return None
     return Path(deck).parent / name
+
+
+def _refuse_earlier_frames(deck: Path, variables: dict[str, str], force: bool) -> None:
+    """A start without --force beside another run's frames is refused before LAMMPS starts, saying
+    what the frames are and which option goes on."""
+    layers = layer_file_of(deck, variables)
+    if force or layers is None:
+        return
+    partial = layers.with_name(layers.name + ".partial")
+    if partial.exists():
+        raise ValueError(f"{partial} holds an unfinished run's frames: sediment run --resume continues it from its "
+                         "last restart file (if it wrote one), --force starts it anew")
+    if layers.exists():
+        raise ValueError(f"{layers} holds the frames of a finished run: --force runs the deck again (they are "
+                         "replaced only when the new run completes)")
 
 
 def _finished(layers: Path, identity: str) -> bool:
@@ -385,6 +401,7 @@ def run_deck(deck: Path, ranks: int = 1, variables: dict[str, str] | None = None
     folder = deck.parent
     with folder_lock(folder, "run"):
         if not resume:
+            _refuse_earlier_frames(deck, variables, force)
             launch = dict(variables, sediment_run_id=run_id(deck, variables))
             if force:
                 launch["overwrite"] = "yes"
@@ -398,7 +415,7 @@ def run_deck(deck: Path, ranks: int = 1, variables: dict[str, str] | None = None
                           key=lambda p: p.stat().st_mtime, reverse=True)
         if not restarts:
             raise ValueError(f"nothing to resume in {folder}: no restart file (restart.a.bin, restart.b.bin); "
-                             "run it without --resume")
+                             "start it anew with --force")
         identity = _resume_id(deck, variables)
         files = read_record(folder).get("files", {})    # those of the start it continues
         _check_partial(deck, variables, identity)
@@ -489,10 +506,9 @@ def _run(deck: Path, ranks: int, variables: dict[str, str], progress: bool) -> R
         elif line.startswith("SEDIMENT plan") and len(words) >= 6:
             total_steps, t_end = int(words[3]), float(words[5])
             if progress:
-                from tqdm import tqdm
-                bar = tqdm(total=t_end, unit="s", desc="simulated", file=sys.stderr, dynamic_ncols=True,
-                           mininterval=0.5, bar_format="{desc}: {percentage:3.0f}%|{bar}| "
-                                                       "{n:.4g}/{total:.4g} s [{elapsed}{postfix}]")
+                bar = progress_bar(total=t_end, unit="s", desc="simulated", file=sys.stderr, dynamic_ncols=True,
+                               mininterval=0.5, bar_format="{desc}: {percentage:3.0f}%|{bar}| "
+                                                           "{n:.4g}/{total:.4g} s [{elapsed}{postfix}]")
         elif len(words) >= 2 and words[0].isdigit() and _is_float(words[1]):
             step, now = int(words[0]), float(words[1])
             if bar is not None and step:

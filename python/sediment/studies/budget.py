@@ -30,6 +30,7 @@ from ..lab.granulometry import read_all
 from ..lab.psd import PSD
 from ..lab.readout import SCHEDULES, Column, Suspension
 from ..planner.scenes import SampleScene
+from ..progress import bar as progress_bar
 from ..results import Table, write_text
 from ..sim.layers import read_layers
 from ..sim.run import run_batch
@@ -215,8 +216,7 @@ def error_budget(psd: PSD, folder: Path, *, particles: int = 20000, courant: flo
 
     bar = None
     if progress:
-        from tqdm import tqdm
-        bar = tqdm(total=len(runs), desc=f"budget {name}", unit="run")
+        bar = progress_bar(total=len(runs), desc=f"budget {name}", unit="run")
     results = {}
     with ThreadPoolExecutor(max_workers=jobs) as pool:
         for key, found in zip(runs, pool.map(one, runs)):

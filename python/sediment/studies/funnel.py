@@ -21,6 +21,7 @@ from pathlib import Path
 import numpy as np
 
 from .. import figures
+from ..progress import bar as progress_bar
 from ..results import Table, write_text
 from ..sim.deck import index_variables
 from ..sim.run import run_batch
@@ -256,7 +257,6 @@ class FunnelStudy:
 def funnel_study(runs: int = 15, jobs: int = 2, dt: float = 1e-6, settings: dict[str, str] | None = None,
                  progress: bool = True) -> FunnelStudy:
     """`runs` pours with seeds 1..runs, `jobs` at a time, with deck variables `settings`."""
-    from tqdm import tqdm
 
     settings = dict(settings or {})
     check_settings(settings)    # before any run
@@ -264,7 +264,7 @@ def funnel_study(runs: int = 15, jobs: int = 2, dt: float = 1e-6, settings: dict
         settings["eta_B"] = f"{PLASTIC_VISCOSITY[settings['law']]:g}"
     with ThreadPoolExecutor(max_workers=jobs) as pool:
         pours = pool.map(lambda seed: pour(seed, dt, settings=settings), range(1, runs + 1))
-        return FunnelStudy(list(tqdm(pours, total=runs, desc="pours", unit="run", disable=not progress)), settings, dt)
+        return FunnelStudy(list(progress_bar(pours, total=runs, desc="pours", unit="run", disable=not progress)), settings, dt)
 
 
 @dataclass

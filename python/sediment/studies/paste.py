@@ -16,6 +16,7 @@ import numpy as np
 from scipy.optimize import brentq
 
 from .. import _core, figures
+from ..progress import bar as progress_bar
 from ..results import Table, write_text
 from ..constants import GRAVITY
 from ..lab.calibrate import restitution_from_drops
@@ -219,11 +220,10 @@ class BallStudy:
 def ball_study(diameters=BALL_DIAMETERS, falls=FALL_HEIGHTS, progress: bool = True, law: str = LAW,
                plastic_viscosity: float | None = None) -> BallStudy:
     """Every ball from every fall height, with and without partial submergence, under a drag law."""
-    from tqdm import tqdm
 
     plan = [(d, h, sub) for sub in (True, False) for d in diameters for h in falls]
     return BallStudy([drop_ball(d, h, sub, law=law, plastic_viscosity=plastic_viscosity)
-                      for d, h, sub in tqdm(plan, desc="balls", unit="run", disable=not progress)])
+                      for d, h, sub in progress_bar(plan, desc="balls", unit="run", disable=not progress)])
 
 
 def _plot_balls(drops: list[BallDrop], path: Path) -> Path:

@@ -27,6 +27,7 @@ from pathlib import Path
 import numpy as np
 
 from .. import figures
+from ..progress import bar as progress_bar
 from ..results import Table, write_text
 from ..sim.run import run_batch
 
@@ -278,8 +279,7 @@ def run_sweep(deck: Path, values: list[float], observables: list[str], integrato
     work_dir.mkdir(parents=True, exist_ok=True)
     plan = [(i, v) for i in (integrators or [None]) for v in sorted(set(values))]
     if progress:
-        from tqdm import tqdm
-        plan_iter = tqdm(plan, desc=f"sweep {deck.name}", unit="run")
+        plan_iter = progress_bar(plan, desc=f"sweep {deck.name}", unit="run")
     else:
         plan_iter = plan
     runs = []

@@ -15,6 +15,7 @@ from pathlib import Path
 import numpy as np
 
 from .. import _core, figures
+from ..progress import bar as progress_bar
 from ..results import Table, write_text
 from ..constants import GRAVITY
 from ..csvfile import number, read_csv
@@ -205,11 +206,10 @@ class SpheresStudy:
 
 def study(csv_path: Path, laws=("bingham", "zhang-li"), progress: bool = True) -> SpheresStudy:
     """Settles every sphere of the CSV under every law."""
-    from tqdm import tqdm
 
     spheres = read_spheres(csv_path)
     plan = [(s, law) for law in laws for s in spheres]
-    return SpheresStudy([settle(s, law) for s, law in tqdm(plan, desc="spheres", unit="run", disable=not progress)])
+    return SpheresStudy([settle(s, law) for s, law in progress_bar(plan, desc="spheres", unit="run", disable=not progress)])
 
 
 def plot(results: list[Settling], path: Path) -> Path:
