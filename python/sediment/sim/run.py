@@ -26,7 +26,7 @@ import numpy as np
 
 from ..folders import folder_lock
 from ..progress import bar as progress_bar
-from ..results import write_text
+from ..results import write_atomic, write_text
 from .paths import lmp_executable, mpirun_prefix
 
 
@@ -198,19 +198,12 @@ def layer_file_of(deck: Path, variables: dict[str, str]) -> Path | None:
     return Path(deck).parent / name
 
 
-def _refuse_earlier_frames(deck: Path, variables: dict[str, str], force: bool) -> None:
-    """A start without --force beside another run's frames is refused before LAMMPS starts, saying
-    what the frames are and which option goes on."""
-    layers = layer_file_of(deck, variables)
-    if force or layers is None:
-        return
-    partial = layers.with_name(layers.name + ".partial")
-    if partial.exists():
-        raise ValueError(f"{partial} holds an unfinished run's frames: sediment run --resume continues it from its "
-                         "last restart file (if it wrote one), --force starts it anew")
-    if layers.exists():
-        raise ValueError(f"{layers} holds the frames of a finished run: --force runs the deck again (they are "
-                         "replaced only when the new run completes)")
+def _stamp(layers: Path | None) -> tuple:
+    """What says whether a run touched its frames: the layer file's and its .partial's size and time."""
+    if layers is None:
+        return ()
+    return tuple((p.stat().st_size, p.stat().st_mtime_ns) if p.exists() else None
+                 for p in (layers, layers.with_name(layers.name + ".partial")))
 
 
 def _finished(layers: Path, identity: str) -> bool:
@@ -401,7 +394,6 @@ def run_deck(deck: Path, ranks: int = 1, variables: dict[str, str] | None = None
     folder = deck.parent
     with folder_lock(folder, "run"):
         if not resume:
-            _refuse_earlier_frames(deck, variables, force)
             launch = dict(variables, sediment_run_id=run_id(deck, variables))
             if force:
                 launch["overwrite"] = "yes"
@@ -415,7 +407,7 @@ def run_deck(deck: Path, ranks: int = 1, variables: dict[str, str] | None = None
                           key=lambda p: p.stat().st_mtime, reverse=True)
         if not restarts:
             raise ValueError(f"nothing to resume in {folder}: no restart file (restart.a.bin, restart.b.bin); "
-                             "start it anew with --force")
+                             "run it without --resume, or start it anew with --force")
         identity = _resume_id(deck, variables)
         files = read_record(folder).get("files", {})    # those of the start it continues
         _check_partial(deck, variables, identity)
@@ -465,16 +457,20 @@ def _run_recorded(deck: Path, ranks: int, variables: dict[str, str], launch: dic
     with (`files`: the deck, what it reads and the tables compared with its frames) and, once finished,
     of its layer file: what a readout checks."""
     record = dict(run_id=launch["sediment_run_id"], deck=deck.name, variables=variables, files=files)
+    earlier = (deck.parent / RECORD).read_bytes() if (deck.parent / RECORD).is_file() else None
+    layers = layer_file_of(deck, variables)
+    frames = _stamp(layers)
     _write_record(deck.parent, **record, state="running")
     try:
         result = _run(deck, ranks, launch, progress)
-    except RunInterrupted:
-        _write_record(deck.parent, **record, state="interrupted")
+    except BaseException as exc:
+        if earlier is not None and layers is not None and _stamp(layers) == frames:
+            # refused before it wrote a frame (fix layers/hdf5 keeps an earlier run's frames): the
+            # record still describes the run whose frames are there
+            write_atomic(deck.parent / RECORD, lambda tmp: tmp.write_bytes(earlier))
+        else:
+            _write_record(deck.parent, **record, state="interrupted" if isinstance(exc, RunInterrupted) else "failed")
         raise
-    except BaseException:
-        _write_record(deck.parent, **record, state="failed")
-        raise
-    layers = layer_file_of(deck, variables)
     if layers is not None and _finished(layers, record["run_id"]):
         record["layers"] = {"file": layers.name, "sha256": file_digest(layers)}
     _write_record(deck.parent, **record, state="finished")
