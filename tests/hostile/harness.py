@@ -117,6 +117,7 @@ def must(*args, timeout: float = 300) -> Done:
 
 
 # ---- folders ------------------------------------------------------------------------------------
+STAGE = ".sediment-stage-"    # a killed command's stage: hidden, cleared by the next command in the folder
 IGNORED = re.compile(r"\.lock$|^\.sediment-files\.json$")    # locks, and the manifest every publish updates
 
 
@@ -128,7 +129,8 @@ def tree(folder: Path) -> dict[str, str]:
     if not folder.exists():
         return {}
     return {str(p.relative_to(folder)): hashlib.sha256(p.read_bytes()).hexdigest()
-            for p in sorted(folder.rglob("*")) if p.is_file() and not IGNORED.search(p.name)}
+            for p in sorted(folder.rglob("*")) if p.is_file() and not IGNORED.search(p.name)
+            and not any(part.startswith(STAGE) for part in p.relative_to(folder).parts)}
 
 
 TIMED = ("sweep.csv", "trials.csv", "effects.csv")   # tables with wall times in them: by name only

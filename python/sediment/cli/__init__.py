@@ -102,6 +102,8 @@ def _command(argv: list[str] | None) -> int:
     except KeyboardInterrupt as exc:
         if outputs is None:
             left = "files being written were left as *.partial or not written"
+            if args.command == "run":
+                left += "; sediment run --resume continues a run from its last restart file, --force starts it anew"
         elif outputs.published:
             left = f"after its results were written into {args.final_out}"
         else:
