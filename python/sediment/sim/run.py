@@ -491,12 +491,13 @@ def _run(deck: Path, ranks: int, variables: dict[str, str], progress: bool) -> R
     errors: list[str] = []
     tail: deque = deque(maxlen=5)
     bar = None
-    total_steps, t_end, step, now = 0, 0.0, 0, 0.0
+    total_steps, t_end, step, now, loops = 0, 0.0, 0, 0.0, 0
 
     def take(line: str) -> None:
-        nonlocal bar, total_steps, t_end, step, now
+        nonlocal bar, total_steps, t_end, step, now, loops
         tail.append(line.rstrip())
         words = line.split()
+        loops += line.startswith("Loop time of ")
         if line.startswith("ERROR"):
             errors.append(line.strip())
         elif line.startswith("SEDIMENT plan") and len(words) >= 6:
@@ -551,6 +552,10 @@ def _run(deck: Path, ranks: int, variables: dict[str, str], progress: bool) -> R
         keep_failed_log()
         message = errors[0] if errors else "\n".join(tail)
         raise RuntimeError(f"{deck.name} failed (exit {code}): {message} (see {failed_log})")
+    if not loops:
+        keep_failed_log()
+        raise RuntimeError(f"{deck.name} ran no run (LAMMPS printed no 'Loop time'): an empty or cut deck, or one "
+                           f"without a run command (see {failed_log})")
     if total_steps and step < total_steps:
         keep_failed_log()
         raise RuntimeError(f"{deck.name} ended at step {step} of the {total_steps} it announced (t = {now:.6g} s): "
