@@ -1410,13 +1410,13 @@ def run_signal(sig: int, phase: str) -> Callable:
         deck = folder / "in.sedimentation"
         t0 = time.monotonic()
         proc = start(["run", deck, "--quiet"])
-        trigger = {"start": 0.1, "lammps-start": "log.lammps", "first-frames": "layers.h5.partial",
+        trigger = {"start": 0.1, "lammps-start": ".log.lammps.*.partial", "first-frames": "layers.h5.partial",
                    "first-restart": "restart.a.bin", "both-restarts": "restart.b.bin"}[phase]
         while proc.poll() is None and time.monotonic() - t0 < 60:
             if isinstance(trigger, float) and time.monotonic() - t0 > trigger:
                 break
-            if isinstance(trigger, str) and (folder / trigger).exists() and (folder / trigger).stat().st_size:
-                break
+            if isinstance(trigger, str) and any(p.stat().st_size for p in folder.glob(trigger)):
+                break    # (LAMMPS's log is written under a partial name, log.lammps only once it finished)
             time.sleep(0.002)
         finished = proc.poll() is not None
         if not finished:

@@ -198,6 +198,18 @@ def layer_file_of(deck: Path, variables: dict[str, str]) -> Path | None:
     return Path(deck).parent / name
 
 
+def _unresumable(deck: Path, variables: dict[str, str]) -> bool:
+    """Whether the deck's folder holds the frames of an interrupted run that wrote no restart file: no
+    --resume can continue them, so a new start replaces them without --force (and says so)."""
+    layers = layer_file_of(deck, variables)
+    partial = layers.with_name(layers.name + ".partial") if layers is not None else None
+    if partial is None or not partial.exists() or any((deck.parent / n).exists() for n in RUN_OUTPUTS[:2]):
+        return False
+    print(f"{partial.name}: frames of an interrupted run that wrote no restart file, which no --resume can "
+          "continue: starting anew over them", file=sys.stderr)
+    return True
+
+
 def _stamp(layers: Path | None) -> tuple:
     """What says whether a run touched its frames: the layer file's and its .partial's size and time."""
     if layers is None:
@@ -395,7 +407,7 @@ def run_deck(deck: Path, ranks: int = 1, variables: dict[str, str] | None = None
     with folder_lock(folder, "run"):
         if not resume:
             launch = dict(variables, sediment_run_id=run_id(deck, variables))
-            if force:
+            if force or _unresumable(deck, variables):
                 launch["overwrite"] = "yes"
             files = {p.name: file_digest(p) for p in [deck, *input_files(deck), *(folder / n for n in COMPARED)]
                      if p.is_file()}
