@@ -18,6 +18,7 @@ try:
     _began = True
     sys.exit(main())
 except KeyboardInterrupt as exc:    # while the command's parts loaded, or a second signal as it ended
-    print(f"sediment: interrupted by {exc} " + ("as the command ended (its own message says what it left)" if _began
-                                                else "before the command began; nothing was written"), file=sys.stderr)
+    left = ("as the command ended (its own message says what it left)" if _began else
+            "before the command began; nothing was written: run it again")
+    print(f"sediment: interrupted by {exc} {left}", file=sys.stderr)
     sys.exit(130)

@@ -1553,19 +1553,8 @@ for _free, _label in ((0, "no-space"), (64 << 10, "64k-free"), (600 << 10, "600k
 # ==== runner ================================================================================================
 OUTCOME_NAMES = ("ok", "wrong", "crash", "vague")
 KNOWN_BAD: set[str] = {   # not ok in the round of docs/hostile.md; take a case off when it is fixed
-    "calibrate/concurrent-with-calibrate-tilt",
     "paste-balls/unit--viscosity=279",
-    "run/SIGINT-first-frames",
-    "run/SIGINT-lammps-start",
-    "run/SIGINT-start",
-    "run/SIGKILL-first-frames",
-    "run/SIGKILL-lammps-start",
-    "run/SIGTERM-first-frames",
-    "run/SIGTERM-lammps-start",
-    "run/SIGTERM-start",
     "run/again-after-it-finished",
-    "run/concurrent-sample-force",
-    "run/damaged-in.sedimentation/empty",
     "run/damaged-sample.data/text",
     "run/resume-damaged-run-record/other-run-id",
     "spheres/spheres/binary-garbage",

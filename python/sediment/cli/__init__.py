@@ -63,8 +63,8 @@ def main(argv: list[str] | None = None) -> int:
     try:
         return _command(argv)
     except KeyboardInterrupt as exc:    # while the command's parts loaded
-        print(f"sediment: interrupted by {exc or 'SIGINT'} before the command began; nothing was written",
-              file=sys.stderr)
+        print(f"sediment: interrupted by {exc or 'SIGINT'} before the command began; nothing was written: run it "
+              "again", file=sys.stderr)
         return 130
     finally:
         for sig, handler in previous.items():
