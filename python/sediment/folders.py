@@ -140,8 +140,8 @@ class OutputSet:
         self._derived(sets)
         now = datetime.datetime.now().astimezone().isoformat(timespec="seconds")
         sets[self.name] = {"written": now, "files": new,
-                           "inputs": {os.path.relpath(p.resolve(), self.folder.resolve()): _files(p)[p.name]
-                                      for p in self.inputs if p.is_file()}}
+                           "inputs": [os.path.relpath(p.resolve(), self.folder.resolve())
+                                      for p in self.inputs if p.is_file()]}
         for other in sets.values():
             other["files"] = {r: i for r, i in other["files"].items() if _entry(r) not in self._foreign}
         sets = {k: v for k, v in sets.items() if v["files"] or k == self.name}
@@ -169,7 +169,7 @@ class OutputSet:
             return
 
         def made_from_gone(where: Path, content: dict) -> bool:
-            return any((where / r).resolve() in gone for r in content.get("inputs", {}))
+            return any((where / r).resolve() in gone for r in content.get("inputs", []))
 
         for name, other in sets.items():
             if name != self.name and made_from_gone(self.folder, other):
