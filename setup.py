@@ -5,8 +5,11 @@ setuptools works in build-pip/, not in build/: build/ is CMake's (make build), a
 must not write into it."""
 from glob import glob
 
-from pybind11.setup_helpers import Pybind11Extension
+from pybind11.setup_helpers import ParallelCompile, Pybind11Extension
 from setuptools import setup
+
+# The core's files compiled side by side, on every core (SEDIMENT_BUILD_JOBS=N to limit them).
+ParallelCompile("SEDIMENT_BUILD_JOBS").install()
 
 core = Pybind11Extension(
     "sediment._core",

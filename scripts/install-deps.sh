@@ -3,7 +3,7 @@
 # Installs the Debian packages SEDIMENT needs, if any is missing (idempotent, quiet when done).
 set -euo pipefail
 packages=(
-  cmake g++ make dpkg-dev xz-utils util-linux procps
+  cmake g++ make ccache dpkg-dev xz-utils util-linux procps
   lammps liblammps-dev python3-lammps openmpi-bin libopenmpi-dev libfftw3-dev
   pybind11-dev python3-pybind11 libgtest-dev libbenchmark-dev libhdf5-dev
   python3-numpy python3-scipy python3-matplotlib python3-h5py python3-pytest python3-pytest-xdist python3-tqdm
