@@ -310,12 +310,13 @@ def test_a_reduced_scene_outside_the_psd_is_refused(tmp_path, capsys):
     assert "--measure-contacts is an option of a sedimentation test" in capsys.readouterr().err
     assert cli.main(["plan", str(SAMPLE5), "--screen-only", "--contact-cut", "30"]) == 2
     assert "--contact-cut sets the reduced scene of --measure-contacts" in capsys.readouterr().err
-    mine = tmp_path / "mine" / "contacts"
-    mine.mkdir(parents=True)
-    (mine / "notes.txt").write_text("kept")
-    assert cli.main(["plan", str(SAMPLE5), "--screen-only", "--measure-contacts", "--out", str(mine.parent)]) == 2
-    assert "notes.txt (not written by sediment plan)" in capsys.readouterr().err
-    assert (mine / "notes.txt").read_text() == "kept"
+    # A screening writes no file, and says so
+    mine = tmp_path / "mine"
+    mine.mkdir()
+    (mine / "report.json").write_text("kept")
+    assert cli.main(["plan", str(SAMPLE5), "--screen-only", "--out", str(mine)]) == 0
+    assert f"wrote nothing into {mine}: this plan writes no file" in capsys.readouterr().out
+    assert (mine / "report.json").read_text() == "kept"
 
 
 def test_the_coarse_part_of_a_psd_keeps_its_shape():

@@ -122,7 +122,10 @@ def _publish(outputs) -> None:
     if outputs.published:
         return
     written = outputs.publish()
-    print(f"wrote {outputs.folder}: " + ", ".join(p.name + ("/" if p.is_dir() else "") for p in written))
+    if written:
+        print(f"wrote {outputs.folder}: " + ", ".join(p.name + ("/" if p.is_dir() else "") for p in written))
+    else:
+        print(f"wrote nothing into {outputs.folder}: this {outputs.name} writes no file")
     for name, folder in outputs.removed_sets:
         print(f"removed the results of sediment {name} in {folder}: they were made from files this "
               f"{outputs.name} removed")
