@@ -10,7 +10,13 @@ mkdir -p "$dest"
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 version=$(dpkg-query -W -f='${source:Version}' liblammps-dev)
-orig=$("$(dirname "$0")/fetch-lammps-source.sh" bookworm "$version" "$dest/../lammps-source-bookworm")
+# The source package (80 MB) is downloaded once per machine, beside the LAMMPS builds of make test,
+# and shared by every clone (one download at a time).
+downloads="${XDG_CACHE_HOME:-$HOME/.cache}/sediment/lammps-source-bookworm"
+mkdir -p "$downloads"
+exec 9>"$downloads/.lock"
+flock 9
+orig=$("$(dirname "$0")/fetch-lammps-source.sh" bookworm "$version" "$downloads")
 tar -xf "$orig" -C "$work" --wildcards '*/src/*.h' '*/src/fmt/*' '*/src/GRANULAR/*' '*/src/PLUGIN/*'
 top=$(ls -d "$work"/*/src)
 cp -r "$top"/. "$dest"/

@@ -34,12 +34,14 @@ def test_a_scene_costs_its_step_per_particle_not_its_start_up(cost):
     # And the count is the same from run to run, which is what it is for (the clock's noise here is
     # 10-15 %). Only the time-step loop is counted: a count of the whole program took in MPI's
     # start-up, which polls for as long as the machine's load makes it wait (215.9 against 211.0 on
-    # a busy machine, issue 59), while the loop on one rank runs the same instructions every time, so its
-    # counts agree to the instruction. Misses of a scene this small (it fits the caches) are near
-    # zero, of either sign.
+    # a busy machine, issue 59), while the loop on one rank runs the same instructions every time but
+    # for a handful: two runs on a loaded machine differed by 5 of 1.7e7 (214.96526 against 214.96533
+    # per particle-step; where, not traced: the loop also reads the clock), so
+    # they must agree to 1e-5, 2000 times closer than the whole program's counts did. Misses of a
+    # scene this small (it fits the caches) are near zero, of either sign.
     first, again = (cost.counts_per_step("plain", 2000, 20) for _ in range(2))
     assert 100 < first["instructions"] < 500
-    assert again["instructions"] == first["instructions"]
+    assert again["instructions"] == pytest.approx(first["instructions"], rel=1e-5)
     assert abs(first["L2 misses"]) < 5 and first["cycles (est.)"] == pytest.approx(
         first["instructions"] + 12 * first["L1 misses"] + 40 * first["L2 misses"])
 

@@ -39,10 +39,14 @@ def test_the_plugin_builds_alone_against_the_headers(tmp_path):
     headers = REPO / "build" / "lammps-headers"
     command = next(line.strip() for line in (REPO / "README.md").read_text().splitlines()
                    if "SEDIMENT_PLUGIN_ONLY=ON" in line and line.strip().startswith("cmake"))
-    command = command.replace("/path/to/lammps/src", str(headers)).replace("build-plugin", str(tmp_path / "plugin"))
+    # Built in a folder of build/, at the same depth in every clone, so that ccache serves what an
+    # earlier clone compiled (paths are hashed relative to the checkout: CMakeLists.txt)
+    folder = REPO / "build" / "test-plugin-only"
+    shutil.rmtree(folder, ignore_errors=True)
+    command = command.replace("/path/to/lammps/src", str(headers)).replace("build-plugin", str(folder))
     subprocess.run(["bash", "-c", command], check=True, cwd=REPO, capture_output=True)
-    plugin = tmp_path / "plugin" / "sedimentplugin.so"
-    assert plugin.is_file() and not list((tmp_path / "plugin").glob("lmp_sediment"))
+    plugin = folder / "sedimentplugin.so"
+    assert plugin.is_file() and not list(folder.glob("lmp_sediment"))
     assert "lammps" not in subprocess.run(["ldd", plugin], capture_output=True, text=True, check=True).stdout
     refused = subprocess.run(["cmake", "-S", REPO, "-B", tmp_path / "lib", f"-DLAMMPS_SOURCE_DIR={headers}",
                               "-DLAMMPS_LIBRARY=/nowhere/liblammps.so"], capture_output=True, text=True)
@@ -55,7 +59,13 @@ def test_the_in_tree_install_on_debian_12s_lammps_checks_first_and_lists_the_pac
     run changes nothing; a tree that lacks a place changes in nothing."""
     import tarfile
 
-    tarball = next((REPO / "build" / "lammps-source-bookworm").glob("lammps_*.orig.tar.*"))
+    # The source package make build fetched for the headers (once per machine), fetched here if a build
+    # older than that cache left it elsewhere
+    downloads = Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "sediment" / "lammps-source-bookworm"
+    version = subprocess.run(["dpkg-query", "-W", "-f=${source:Version}", "liblammps-dev"], capture_output=True,
+                             text=True, check=True).stdout
+    tarball = Path(subprocess.run([REPO / "scripts" / "fetch-lammps-source.sh", "bookworm", version, downloads],
+                                  capture_output=True, text=True, check=True).stdout.split()[0])
     with tarfile.open(tarball) as archive:
         members = [m for m in archive.getmembers() if "/cmake/" in m.name or "/doc/" in m.name
                    or m.name.endswith("/src/lammps.h") or m.name.endswith("/src/GRANULAR/fix_wall_gran.h")]
