@@ -938,21 +938,32 @@ def foreign_folder(kind: str, ctx: Ctx) -> Path:
     return dest
 
 
+def run_watching(folder: Path, args: list, writer: str, whose: str):
+    """Runs `sediment *args` and compares `folder` before and after: the run, a verdict if it crashed
+    or changed a file that was there (`whose` names them), and the two trees."""
+    before = tree(folder)
+    done = sed(*args, timeout=240 if writer in SLOW else 60)
+    after = tree(folder)
+    bad = crashed(done)
+    if bad:
+        return done, ("crash", bad), before, after
+    lost = {k: v for k, v in before.items() if after.get(k) != v}
+    if lost:
+        return done, ("wrong", f"exit {done.rc}: {whose} {diff(lost, {k: after[k] for k in lost if k in after})}"), \
+            before, after
+    return done, None, before, after
+
+
 def out_onto(writer: str, owner: str) -> Callable:
     """`writer --out` a folder `owner` wrote: refused with nothing changed, or done with every file of
     the owner's as it was."""
     def fn(ctx: Ctx):
         prepare(ctx, {writer})
         theirs = foreign_folder(owner, ctx)
-        before = tree(theirs)
-        done = sed(*quick_command(writer, theirs, ctx), timeout=240 if writer in SLOW else 60)
-        after = tree(theirs)
-        bad = crashed(done)
-        if bad:
-            return "crash", bad
-        lost = {k: v for k, v in before.items() if after.get(k) != v}
-        if lost:
-            return "wrong", f"exit {done.rc}: {owner}'s files {diff(lost, {k: after[k] for k in lost if k in after})}"
+        done, verdict, before, after = run_watching(theirs, quick_command(writer, theirs, ctx), writer,
+                                                    f"{owner}'s files")
+        if verdict:
+            return verdict
         if done.rc == 0:
             return "ok", "written beside the other files, none of them touched"
         return refusal(done, [("theirs", "folder", "another", "not written", "own")], before, after)
@@ -1002,15 +1013,9 @@ def out_onto_input(writer: str, which: str) -> Callable:
         first = next(iter(copies.values()))
         target = first if which == "file" else home
         args[args.index(ctx.tmp / "X")] = target
-        before = tree(home)
-        done = sed(*args, timeout=240 if writer in SLOW else 60)
-        after = tree(home)
-        bad = crashed(done)
-        if bad:
-            return "crash", bad
-        lost = {k: v for k, v in before.items() if after.get(k) != v}
-        if lost:
-            return "wrong", f"exit {done.rc}: inputs {diff(lost, {k: after[k] for k in lost if k in after})}"
+        done, verdict, _, _ = run_watching(home, args, writer, "inputs")
+        if verdict:
+            return verdict
         if done.rc == 0:
             return ("wrong", "exit 0 with --out naming an input file") if which == "file" else \
                 ("ok", "written beside its inputs, none touched")
