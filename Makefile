@@ -75,8 +75,9 @@ check-sanitize: build
 # and recompiles only those.
 LAMMPS_CACHE ?= $(or $(XDG_CACHE_HOME),$(HOME)/.cache)/sediment
 # The current LAMMPS (Debian sid's source package, about 7 min to build at -j2 the first time): every
-# deck test on its lmp (in-tree route; on 2 ranks where it also runs on 1), and this project built against it runs the style checks as a
-# plugin loaded at start and through its lmp_sediment (plugin and driver routes).
+# deck test on its lmp (in-tree route; on 2 ranks where it also runs on 1), and this project built
+# against it runs the style checks as a plugin loaded at start and through its lmp_sediment (plugin
+# and driver routes).
 CURRENT ?= $(LAMMPS_CACHE)/lammps-current
 CURRENT_SEDIMENT ?= $(BUILD)/lammps-current-sediment
 test-lammps-current: build
