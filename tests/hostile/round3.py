@@ -1217,14 +1217,21 @@ for _a, _b in CONCURRENT:
         else _a, "concurrent", concurrent(_a, _b), needs=("run",) if "readout" in (_a, _b) else ())
 
 
+def start_run_in(folder: Path, deck: Path):
+    """`sediment run --force` of the deck, started and waited on until its LAMMPS runs under the
+    folder's lock (its log is written, under a partial name), or it ended; the process and its start."""
+    a = start(["run", deck, "--quiet", "--force"])
+    t0 = time.monotonic()
+    while not list(folder.glob(".log.lammps.*.partial")) and a.poll() is None and time.monotonic() - t0 < 20:
+        time.sleep(0.05)
+    return a, t0
+
+
 def run_concurrent(second: list) -> Callable:
     def fn(ctx: Ctx):
         deck = ctx.copy("interrupted") / "in.sedimentation"
         folder = deck.parent
-        a = start(["run", deck, "--quiet", "--force"])
-        t0 = time.monotonic()
-        while not list(folder.glob(".log.lammps.*.partial")) and a.poll() is None and time.monotonic() - t0 < 20:
-            time.sleep(0.05)    # LAMMPS started, under the folder's lock
+        a, t0 = start_run_in(folder, deck)
         args = [folder if x == "@F" else deck if x == "@DECK" else x for x in second]
         before = {k: v for k, v in tree(folder).items() if not k.startswith(("layers", "restart", "log", ".sediment",
                                                                                ".log"))}
@@ -1260,10 +1267,7 @@ for _name, _second in {"run": ["run", "@DECK", "--quiet"], "run-force": ["run", 
         def _fn(ctx):
             deck = ctx.copy("interrupted") / "in.sedimentation"
             folder = deck.parent
-            a = start(["run", deck, "--quiet", "--force"])
-            t0 = time.monotonic()
-            while not list(folder.glob(".log.lammps.*.partial")) and a.poll() is None and time.monotonic() - t0 < 20:
-                time.sleep(0.05)    # LAMMPS started, under the folder's lock
+            a, t0 = start_run_in(folder, deck)
             b = sed("readout", folder / "layers.h5", "--out", folder / "r", timeout=60)
             ad = finish(a, 300, t0)
             for d in (ad, b):
