@@ -45,7 +45,7 @@ sys.path.insert(0, str(HERE.parent / "python"))
 from sediment import _core  # noqa: E402
 from sediment.cli.types import count  # noqa: E402
 from sediment.sim.paths import lmp_executable  # noqa: E402
-from sediment.sim.run import run_batch  # noqa: E402
+from sediment.sim.run import run_batch, run_environment  # noqa: E402
 
 SCENES = {"plain": "nve/sphere + gravity (reference)",
           "peer": "nve/sphere + fix viscous + reduced gravity (LAMMPS's own fixes, same Stokes physics)",
@@ -126,7 +126,7 @@ def counts_per_step(scene: str, particles: int, steps: int, lmp: Path | None = N
                    str(lmp or lmp_executable()), "-in", str(HERE / "in.cost"), "-log", "none", "-screen", "none",
                    "-var", "scene", scene, "-var", "n", str(particles), "-var", "steps", str(run_steps),
                    "-var", "dt", repr(dt), "-var", "mu", repr(MU if mu is None else mu)]
-            done = subprocess.run(cmd, capture_output=True, text=True, env=dict(os.environ, OMP_NUM_THREADS="1"))
+            done = subprocess.run(cmd, capture_output=True, text=True, env=run_environment())
             if done.returncode != 0:
                 sys.exit(f"cost.py --counts: scene {scene} failed under callgrind:\n{done.stderr[-2000:]}")
             totals.append(valgrind_totals(out.read_text()))
