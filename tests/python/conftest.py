@@ -10,6 +10,7 @@ os.environ.setdefault("SEDIMENT_LMP", str(REPO / "build" / "lmp_sediment"))
 import importlib.util
 import shutil
 import subprocess
+import sysconfig
 from types import ModuleType
 
 import pytest
@@ -39,7 +40,13 @@ def installed(tmp_path_factory) -> Path:
                     ignore=shutil.ignore_patterns("_core*.so", "__pycache__"))
     command = next(line.strip() for line in (REPO / "README.md").read_text().splitlines()
                    if "pip install" in line and line.strip().startswith("/usr/bin/python3 -m venv"))
-    subprocess.run(["bash", "-c", command], check=True, cwd=source, capture_output=True)
+    # The command as written; its compiler goes through ccache where installed (the environment's CC,
+    # which setuptools honours), so that a fresh clone recompiles nothing an earlier one compiled:
+    # the copy's paths are hashed relative to it
+    env = dict(os.environ)
+    if shutil.which("ccache"):
+        env.update(CC=f"ccache {sysconfig.get_config_var('CC')}", CCACHE_BASEDIR=str(source))
+    subprocess.run(["bash", "-c", command], check=True, cwd=source, capture_output=True, env=env)
     assert not (source / "build").exists() and (source / "build-pip").is_dir()
     return source / ".venv"
 
