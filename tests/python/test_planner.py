@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import json
 import math
-import time
+import os
 from pathlib import Path
 
 import numpy as np
@@ -232,20 +232,43 @@ def test_an_interrupted_plan_stops_every_run_and_says_so(tmp_path, stop):
     def finished() -> list[Path]:    # a trial run to its end leaves its layer file
         return [f for f in trials() if (f / "layers.h5").is_file()]
 
-    wait_for(lambda: len([f for f in trials() if processes_in(f)]) == 2, process=plan)    # two at once (--jobs 2)
-    lammps = [pid for f in trials() for pid in processes_in(f)]
-    assert not finished()
-    plan.send_signal(getattr(signal, stop))
-    # Stopped, not waited for: the plan ends before any of its runs (some 40 s each) could end.
-    while plan.poll() is None:
+    # Stopped, not waited for: the runs' LAMMPS are paused before the signal, so that none can end by
+    # itself (a trial takes some 6 s here, less than a loaded machine may take to deliver the signal).
+    # A plan that waited for them would never end: the hang guard would fail the test. Only LAMMPS:
+    # Open MPI's daemon shares its folder and ends when its LAMMPS does, which it must be free to do.
+    lmp = Path(os.environ["SEDIMENT_LMP"]).resolve()
+
+    def lammps_in(folder: Path) -> list[int]:
+        return [pid for pid in processes_in(folder) if _executable(pid) == lmp]
+
+    wait_for(lambda: len([f for f in trials() if lammps_in(f)]) == 2, process=plan)    # two at once (--jobs 2)
+    paused = [pid for f in trials() for pid in lammps_in(f)]
+    lammps = paused + [pid for f in trials() for pid in processes_in(f) if pid not in paused]    # and MPI's daemons
+    try:
+        for pid in paused:
+            os.kill(pid, signal.SIGSTOP)
+        assert not finished()
+        plan.send_signal(getattr(signal, stop))
+        wait_for(lambda: plan.poll() is not None)
         assert not finished(), "a trial ran to its end after the signal"
-        time.sleep(0.05)
+    except BaseException:
+        for pid in lammps:    # the test failed: its paused runs go with it
+            if _alive(pid):
+                os.kill(pid, signal.SIGKILL)
+        raise
     err = (tmp_path / "stderr.txt").read_text()
     assert plan.returncode == 130 and "Traceback" not in err and f"interrupted by {stop}" in err
     wait_for(lambda: not [pid for pid in lammps if _alive(pid)])
     assert {p.relative_to(out): p.read_bytes() for p in out.rglob("*") if p.is_file() and p.name != ".sediment.lock"} \
         == before
     assert not list(out.glob(".sediment-stage-*"))
+
+
+def _executable(pid: int) -> Path | None:
+    try:
+        return Path(os.readlink(f"/proc/{pid}/exe"))
+    except OSError:
+        return None
 
 
 def _alive(pid: int) -> bool:
