@@ -52,6 +52,19 @@ def processes_in(folder: Path) -> list[int]:
     return found
 
 
+def lammps_in(folder: Path) -> list[int]:
+    """PIDs of the LAMMPS processes (SEDIMENT_LMP) working in `folder`: not mpirun, not Open MPI's daemon."""
+    lmp = Path(os.environ["SEDIMENT_LMP"]).resolve()
+    found = []
+    for pid in processes_in(folder):
+        try:
+            if Path(os.readlink(f"/proc/{pid}/exe")) == lmp:
+                found.append(pid)
+        except OSError:
+            continue
+    return found
+
+
 # How long a wait may last before it counts as a hang: no test's outcome depends on it (every event
 # awaited comes within seconds, loaded or not); it only turns a hang of a broken build into a failure.
 HANG_GUARD = 600.0
@@ -200,12 +213,14 @@ def test_resume_needs_a_restart_file(tmp_path):
 
 
 def test_two_runs_in_one_folder_and_signals(tmp_path):
-    # Courant 0.1 (28 800 steps, some 8 s on 2 ranks): the second run and the signal must find the
-    # first still running; at Courant 1 it had finished within the second run's start-up now and then
+    # The second run and the signal must find the first still running: its two ranks are paused once
+    # LAMMPS is under way (its log open), so that it cannot end by itself however busy the machine
     deck = sample(tmp_path / "busy", "--particles", 15000, "--courant", 0.1)
     first = subprocess.Popen(SEDIMENT + ["run", str(deck), "--quiet", "--np", "2"], stdout=subprocess.PIPE,
                              stderr=subprocess.PIPE, text=True)
-    wait_for(lambda: (deck.parent / "layers.h5.partial").is_file(), process=first)    # LAMMPS under way, its log open
+    wait_for(lambda: (deck.parent / "layers.h5.partial").is_file() and len(lammps_in(deck.parent)) == 2, process=first)
+    for pid in lammps_in(deck.parent):
+        os.kill(pid, signal.SIGSTOP)
     second = sediment("run", deck, "--quiet")
     assert second.returncode == 2 and "another sediment command" in second.stderr
     first.send_signal(signal.SIGTERM)

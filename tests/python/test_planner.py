@@ -213,7 +213,7 @@ def test_an_interrupted_plan_stops_every_run_and_says_so(tmp_path, stop):
     import signal
     import subprocess
 
-    from test_faults import processes_in, wait_for
+    from test_faults import lammps_in, processes_in, wait_for
 
     out = tmp_path / "plan"
     out.mkdir()    # earlier results there: every one of them stays as it was
@@ -236,11 +236,6 @@ def test_an_interrupted_plan_stops_every_run_and_says_so(tmp_path, stop):
     # itself (a trial takes some 6 s here, less than a loaded machine may take to deliver the signal).
     # A plan that waited for them would never end: the hang guard would fail the test. Only LAMMPS:
     # Open MPI's daemon shares its folder and ends when its LAMMPS does, which it must be free to do.
-    lmp = Path(os.environ["SEDIMENT_LMP"]).resolve()
-
-    def lammps_in(folder: Path) -> list[int]:
-        return [pid for pid in processes_in(folder) if _executable(pid) == lmp]
-
     wait_for(lambda: len([f for f in trials() if lammps_in(f)]) == 2, process=plan)    # two at once (--jobs 2)
     paused = [pid for f in trials() for pid in lammps_in(f)]
     lammps = paused + [pid for f in trials() for pid in processes_in(f) if pid not in paused]    # and MPI's daemons
@@ -262,13 +257,6 @@ def test_an_interrupted_plan_stops_every_run_and_says_so(tmp_path, stop):
     assert {p.relative_to(out): p.read_bytes() for p in out.rglob("*") if p.is_file() and p.name != ".sediment.lock"} \
         == before
     assert not list(out.glob(".sediment-stage-*"))
-
-
-def _executable(pid: int) -> Path | None:
-    try:
-        return Path(os.readlink(f"/proc/{pid}/exe"))
-    except OSError:
-        return None
 
 
 def _alive(pid: int) -> bool:
