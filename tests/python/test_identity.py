@@ -22,7 +22,7 @@ from sediment.sim.layers import read_layers
 
 SAMPLE1 = REPO / "examples" / "granulometry" / "psd" / "sample1.csv"
 # 43 400 steps (24 h at Courant 0.1), restart files every 2170 steps: a kill finds the run going.
-LONG = ("--particles", 6000, "--t-end", 86400, "--courant", 0.1)
+LONG = ("--particles", 2000, "--t-end", 86400, "--courant", 0.1)
 
 
 def restart_stamps(folder: Path) -> dict[str, int]:
