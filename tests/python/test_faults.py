@@ -221,8 +221,12 @@ def test_two_runs_in_one_folder_and_signals(tmp_path):
     wait_for(lambda: (deck.parent / "layers.h5.partial").is_file() and len(lammps_in(deck.parent)) == 2, process=first)
     for pid in lammps_in(deck.parent):
         os.kill(pid, signal.SIGSTOP)
-    second = sediment("run", deck, "--quiet")
-    assert second.returncode == 2 and "another sediment command" in second.stderr
+    try:
+        second = sediment("run", deck, "--quiet")
+        assert second.returncode == 2 and "another sediment command" in second.stderr
+    except BaseException:
+        first.kill()    # the test failed: its run's guard stops the paused ranks
+        raise
     first.send_signal(signal.SIGTERM)
     _, err = first.communicate(timeout=HANG_GUARD)
     assert first.returncode == 130 and "stopped by SIGTERM" in err and "Traceback" not in err
