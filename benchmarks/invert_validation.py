@@ -124,7 +124,7 @@ def main() -> None:
         truth = truth_psd.at(result.diameter)
         error = np.abs(result.percent - truth)
         held = (result.low - HELD_TOLERANCE <= truth) & (truth <= result.high + HELD_TOLERANCE)
-        standard = np.abs(np.concatenate([p - truth_psd.at(d) for _, _, d, p in result.reduction]))
+        standard = np.abs(np.concatenate([r.percent - truth_psd.at(r.diameter) for r in result.reduction]))
         cells = []
         for part in (result.basis == "reading", result.basis == "between"):
             cells.append(f"{error[part].mean():.2f} / {error[part].max():.2f}, {held[part].mean():.0%}" if part.any() else "-")

@@ -87,6 +87,10 @@ RANGES: dict[str, Range] = {
     "correction": Range("g/L", -10.0, 20.0, "a 152H's composite correction is a few g/L (dispersant, temperature, "
                         "meniscus)"),
     "meniscus": Range("g/L", -5.0, 5.0, "a 152H's meniscus is about 1 g/L"),
+    "water_content": Range("", 0.0, 0.5, "a hygroscopic (air-dry) water content, a fraction of the oven-dry mass: "
+                           "0.005-0.1 for most soils", (PERCENT,)),
+    "suspension_volume_m3": Range("m3", 2e-4, 5e-3, "a sedimentation cylinder holds 0.5-2 L (D422's: 1 L)",
+                                  (("L", _times(1e-3)), ("mL", _times(1e-6)))),
     "split": Range("mm", 0.02, 150.0, "a sieve of 20 um to 150 mm; D422 splits at 2.0 mm", (("um", _times(1e-3)),
                                                                                           ("m", _times(1e3)))),
     # the noise of a reading
@@ -123,6 +127,8 @@ RANGES: dict[str, Range] = {
                              (("s", _times(1 / 60)),)),
     "reading": Range("g/L", -5.0, 60.0, "a 152H's scale runs from -5 to 60 g/L"),
     "depth_cm": Range("cm", 1.0, 200.0, "a pipette's depth in a settling column", (("m", _times(100.0)), ("mm", _times(0.1)))),
+    "calibration_cm": Range("cm", 0.5, 40.0, "a hydrometer's graduation lies a few to 25 cm above its bulb's centre "
+                            "(152H: 10-21 cm)", (("mm", _times(0.1)), ("m", _times(100.0)))),
     "apparent_mass_g": Range("g", 0.1, 5000.0, "what a balance shows for a buoyancy sphere in a suspension",
                              (("kg", _times(1e3)), ("mg", _times(1e-3)))),
 }

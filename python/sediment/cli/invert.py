@@ -6,7 +6,8 @@ import argparse
 import sys
 from pathlib import Path
 
-from ..constants import D422_CYLINDER_AREA, D422_CYLINDER_HEIGHT, SOIL_PARTICLE_DENSITY
+from ..constants import D422_CYLINDER_AREA, SOIL_PARTICLE_DENSITY, SUSPENSION_VOLUME
+from ..lab.readout import NOMINAL_BULB_LENGTH, NOMINAL_BULB_VOLUME
 from .types import count, quantity, quantity_list
 
 
@@ -38,17 +39,41 @@ def add_parser(commands) -> argparse.ArgumentParser:
     parser.add_argument("--masses", type=quantity_list("specimen_mass"), default=[0.030, 0.045, 0.060, 0.080],
                         help="with --design: sample masses to compare [kg] (default 0.03,0.045,0.06,0.08)")
     parser.add_argument("--mass", type=quantity("specimen_mass"),
-                        help="dry mass of the hydrometer's specimen [kg] (required with "
-                        "sheets; the part passing --split where one is given)")
+                        help="oven-dry mass of the hydrometer's specimen [kg] (this or --air-dry-mass is required with "
+                        "sheets; the part passing --split where one is given, the whole sample's with --washed)")
+    parser.add_argument("--air-dry-mass", type=quantity("specimen_mass"), metavar="KG",
+                        help="instead of --mass: the specimen's air-dry mass [kg], with --water-content")
+    parser.add_argument("--water-content", type=quantity("water_content"), metavar="W",
+                        help="hygroscopic water content of the air-dry specimen, a fraction (0.035 for 3.5 %%): the "
+                        "oven-dry mass is the air-dry mass / (1 + W)")
     parser.add_argument("--split", type=quantity("split"), metavar="OPENING_MM",
                         help="the hydrometer's specimen is the part of the sample passing this sieve (D422: 2.0); the "
-                        "sieve sheet gives the percent passing it")
+                        "sieve sheet gives the percent passing it, --mass is that part's")
+    parser.add_argument("--washed", type=quantity("split"), metavar="OPENING_MM",
+                        help="the specimen was washed through this sieve before the hydrometer (0.053, 0.075): only the "
+                        "part passing it was in the cylinder; --mass is the whole specimen's dry mass, the sieve sheet "
+                        "(of the whole specimen) gives the share passing")
     parser.add_argument("--particle-density", type=quantity("particle_density"),
                         default=SOIL_PARTICLE_DENSITY, help="[kg/m3] (default 2650)")
     parser.add_argument("--cylinder-area", type=quantity("cylinder_area"),
                         default=D422_CYLINDER_AREA, help="[m2] (default D422's)")
+    parser.add_argument("--volume", type=quantity("suspension_volume_m3"),
+                        help="volume of the suspension [m3] (default 1e-3, the 1000 mL mark); its height in the "
+                        "cylinder is the volume / --cylinder-area")
     parser.add_argument("--height", type=quantity("suspension_height"),
-                        default=D422_CYLINDER_HEIGHT, help="suspension height [m]")
+                        help="instead of --volume: the suspension's height [m] (the volume is then --cylinder-area x "
+                        "--height)")
+    parser.add_argument("--hydrometer-calibration", type=Path, metavar="CSV",
+                        help="the laboratory's calibration of its 152H (D7928): reading,distance_cm, the distance from "
+                        "the graduation of each reading to the bulb's centre, two rows or more (default: the nominal "
+                        "152H of D422)")
+    parser.add_argument("--bulb-volume", type=quantity("bulb_volume"), default=NOMINAL_BULB_VOLUME,
+                        help="the hydrometer bulb's volume [m3], for V_B / 2A (default the nominal 152H's 6.7e-05)")
+    parser.add_argument("--bulb-length", type=quantity("bulb_length"), default=NOMINAL_BULB_LENGTH,
+                        help="the hydrometer bulb's length [m], over which it averages the suspension (default 0.14)")
+    parser.add_argument("--stirred", metavar="HH:MM",
+                        help="when the suspension was stirred, for sheets that give clock times (a clock column, "
+                        "HH:MM, instead of time_min)")
     parser.add_argument("--zero-correction", type=quantity("correction"), default=0.0,
                         help="152H composite correction [g/L], subtracted from each reading (dispersant, zero)")
     parser.add_argument("--meniscus", type=quantity("meniscus"),
@@ -87,20 +112,32 @@ def run(args: argparse.Namespace) -> int:
 
     if (args.design is None) == (not args.sheets):
         raise ValueError("give the sheets of a sample, or --design PSD to plan a test (not both)")
-    if args.design is None and args.mass is None:
-        raise ValueError("--mass is required: the dry mass of the hydrometer's specimen [kg] (0.05 for 50 g)")
+    mass = specimen_mass(args)
+    if args.design is None and mass is None:
+        raise ValueError("--mass is required: the oven-dry mass of the hydrometer's specimen [kg] (0.05 for 50 g), or "
+                         "--air-dry-mass with --water-content")
+    if args.split is not None and args.washed is not None:
+        raise ValueError("--split and --washed: the specimen is either the part passing a sieve (--split, --mass of "
+                         "that part) or washed through one (--washed, --mass of the whole specimen); give one")
+    if args.volume is not None and args.height is not None:
+        raise ValueError("--volume and --height both give the suspension's size: give one (the height is the volume / "
+                         "--cylinder-area)")
+    height = args.height if args.height is not None else (args.volume or SUSPENSION_VOLUME) / args.cylinder_area
     # each within its range, the two may still make a cylinder no laboratory has (27.8 cm2 typed as 0.0278)
-    check(args.cylinder_area * args.height * 1e3, "suspension_volume",
-          f"--cylinder-area {args.cylinder_area:g} m2 x --height {args.height:g} m:")
+    check(args.cylinder_area * height * 1e3, "suspension_volume",
+          f"--cylinder-area {args.cylinder_area:g} m2 x height {height:g} m:")
+    check(height, "suspension_height", f"the suspension's height ({'--volume / ' if args.height is None else ''}"
+          "--cylinder-area):")
     sphere = sphere_density(args.sphere_mass, args.sphere_diameter)
     if sphere is not None:
         raise ValueError(sphere)
     noise = {"hydrometer": args.hydrometer_noise, "buoyancy": args.balance_noise,
              "pipette": args.pipette_noise / (args.pipette_volume * 1e3), "sieve": args.sieve_noise}
-    test = LabTest(0.060 if args.mass is None else args.mass, args.particle_density, args.cylinder_area, args.height, zero_correction=args.zero_correction,
-                   meniscus=args.meniscus, sphere_depth=args.sphere_depth, sphere_diameter=args.sphere_diameter,
-                   sphere_mass=args.sphere_mass, noise=noise, thermometer=args.thermometer)
-    sheets = [read_sheet(p, args.pipette_volume) for p in args.sheets]
+    test = LabTest(0.060 if mass is None else mass, args.particle_density, args.cylinder_area, height,
+                   hydrometer=hydrometer(args), zero_correction=args.zero_correction, meniscus=args.meniscus,
+                   sphere_depth=args.sphere_depth, sphere_diameter=args.sphere_diameter, sphere_mass=args.sphere_mass,
+                   noise=noise, thermometer=args.thermometer)
+    sheets = [read_sheet(p, args.pipette_volume, args.stirred) for p in args.sheets]
     _refuse_repeats(sheets)
     sieves = [s for s in sheets if s.instrument == "sieve"]
     if len(sieves) > 1:
@@ -111,6 +148,35 @@ def run(args: argparse.Namespace) -> int:
         raise ValueError("--zero-correction and a sheet with a blank column: the composite correction is given twice; "
                          "keep one")
     return _design(args, test) if args.design is not None else _invert(args, test, sheets)
+
+
+def specimen_mass(args: argparse.Namespace) -> float | None:
+    """The oven-dry mass [kg] the options give: --mass, or --air-dry-mass / (1 + --water-content)."""
+    if args.air_dry_mass is None:
+        if args.water_content is not None:
+            raise ValueError("--water-content without --air-dry-mass: the water content turns an air-dry mass into an "
+                             "oven-dry one; with --mass (oven-dry) leave it out")
+        return args.mass
+    if args.mass is not None:
+        raise ValueError("--mass and --air-dry-mass: give the oven-dry mass, or the air-dry mass with its water content")
+    if args.water_content is None:
+        raise ValueError("--air-dry-mass needs --water-content (the hygroscopic water content, a fraction: 0.035 for "
+                         "3.5 %): the oven-dry mass is the air-dry mass / (1 + w)")
+    return args.air_dry_mass / (1 + args.water_content)
+
+
+def hydrometer(args: argparse.Namespace):
+    """The 152H the options describe: the laboratory's calibration, or the nominal one of D422."""
+    from ..lab.readout import Hydrometer
+    from ..lab.sheet import read_hydrometer_calibration
+
+    if args.hydrometer_calibration is None:
+        return Hydrometer.astm_152h(bulb_length=args.bulb_length, bulb_volume=args.bulb_volume)
+    readings, distances = read_hydrometer_calibration(args.hydrometer_calibration)
+    try:
+        return Hydrometer.calibrated(readings, distances, args.bulb_volume, args.bulb_length)
+    except ValueError as exc:
+        raise ValueError(f"{args.hydrometer_calibration}: {exc}") from None
 
 
 def _refuse_repeats(sheets: list) -> None:
@@ -140,8 +206,23 @@ def _invert(args: argparse.Namespace, test, sheets) -> int:
         band = max(band_of(args.budget, args.budget_sample)[s.instrument] for s in sheets if s.instrument != "sieve")
     readings = [s for s in sheets if s.instrument != "sieve"]
     sieve = next((s for s in sheets if s.instrument == "sieve"), None)
-    result = invert(readings, test, args.out / "runs", sieve=sieve, split=None if args.split is None else args.split * 1e-3,
+    split = args.split
+    if args.washed is not None:
+        from dataclasses import replace
+
+        from ..inverse.invert import sieve_data
+
+        if sieve is None:
+            raise ValueError("--washed needs the sieve sheet of the whole specimen: the percent passing the wash sieve "
+                             "is the share of --mass that was in the cylinder")
+        share = sieve_data(sieve, args.washed * 1e-3, args.sieve_noise).share
+        whole, test, split = test.mass, replace(test, mass=test.mass * share), args.washed
+    result = invert(readings, test, args.out / "runs", sieve=sieve, split=None if split is None else split * 1e-3,
                     bins=args.bins, particles=args.particles, seed=args.seed, budget_band=band)
+    if args.washed is not None:
+        result.inputs |= {"washed_mm": args.washed, "whole_specimen_mass": whole}
+        result.notes.insert(-1, f"washed through {args.washed:g} mm before the hydrometer: {test.mass * 1e3:.4g} g in "
+                            f"the cylinder, the {share * 100:.4g} % of the {whole * 1e3:.4g} g specimen that passed it")
     result.save(args.out)
     args.publish()    # before the verdict, which comes last
     notes, result.notes = result.notes, []

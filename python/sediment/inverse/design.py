@@ -104,6 +104,6 @@ def clay_reading_time(psd: PSD, test: LabTest, temperatures=(18.0, 20.0, 23.0, 2
     water = Suspension.at_temperature(20.0, test.particle_density)
     reading = psd.at([CLAY_LIMIT])[0] / 100 * test.initial_concentration / gs_correction(water.specific_gravity)
     hydrometer = test.hydrometer
-    depth = hydrometer.stokes_depth(hydrometer.scale_zero - hydrometer.scale_step * reading, test.cylinder_area)
+    depth = hydrometer.effective_depth(reading, test.cylinder_area)
     return [(t, depth / Suspension.at_temperature(t, test.particle_density).stokes_speed(CLAY_LIMIT))
             for t in temperatures]

@@ -13,7 +13,7 @@ from .. import figures
 from ..lab import texture
 from ..lab.psd import NOT_FITTING
 from ..lab.readout import Suspension
-from ..lab.sheet import Sheet, SieveSheet, SheetError, check_sheet, standard_reduction
+from ..lab.sheet import Reduction, Sheet, SieveSheet, SheetError, check_sheet, standard_reduction
 from ..results import Table, write_text
 from .fit import ROUGHNESS_DECADES, draw_placement, end_placement, fit, penalty
 from .grid import NEAR, TOP, SizeGrid, size_grid
@@ -35,7 +35,7 @@ class Inversion:
     high: np.ndarray
     basis: np.ndarray            # what pins each diameter (sediment.inverse.grid)
     draws: np.ndarray            # [draws, diameters] the PSDs the data allow, for the band and the texture
-    reduction: list[tuple[str, np.ndarray, np.ndarray, np.ndarray]]     # instrument, time, D, P (whole sample)
+    reduction: list[Reduction]       # the standard reduction of each sheet (percent of the whole sample)
     fit_rows: list[tuple[str, float, float, float, float, float]]       # instrument, time, opening, data, model, sigma
     chi2: float
     rounds: int
@@ -86,10 +86,15 @@ class Inversion:
         folder = Path(folder)
         first = "" if self.consistent else f"# {NOT_FITTING}: these files come from a fit that does not explain the " \
                                            "sheets (invert.json, 'notes')\n"
-        reduction = Table(["instrument", "time_min", "diameter_um", "percent_finer"])
-        for name, t, d, p in self.reduction:
-            for row in zip(t / 60, d * 1e6, p):
-                reduction.add(name, *map(float, row))
+        reduction = Table(["instrument", "time_min", "reading", "correction", "meniscus", "temperature_C", "depth_cm",
+                           "diameter_um", "percent_finer"],
+                          notes=["152H: depth_cm is D7928's H_m at reading + meniscus (the surface's graduation, from "
+                                 "the hydrometer's calibration, less V_B / 2A); percent_finer is 100 a (reading - "
+                                 "correction) / c0, correction the composite correction (blank) at that reading"])
+        for r in self.reduction:
+            for row in zip(r.time / 60, r.reading, r.correction, r.temperature, r.depth * 100, r.diameter * 1e6,
+                           r.percent):
+                reduction.add(r.instrument, *map(float, row[:3]), r.meniscus, *map(float, row[3:]))
         fitted = Table(["instrument", "time_min", "opening_mm", "measured", "simulated", "residual_sigma"])
         for name, t, opening, measured, model, sigma in self.fit_rows:
             fitted.add(name, "" if math.isnan(t) else t / 60, "" if math.isnan(opening) else opening * 1e3,
@@ -108,7 +113,7 @@ class Inversion:
         written += [write_text(path, first + path.read_text()) if first and path.suffix == ".csv" else path
                     for path in report.save(folder, mark)]
         written += [write_text(folder / "invert.json", json.dumps(summary, indent=1) + "\n"), self.plot(folder / "invert.png")]
-        points = [(f"standard reduction ({name})", d, p) for name, _, d, p in self.reduction]
+        points = [(f"standard reduction ({r.instrument})", r.diameter, r.percent) for r in self.reduction]
         written.append(texture.gradation_figure(folder / "gradation.png", self.diameter, self.percent, self.low,
                                                 self.high, self.sieve, points, title="gradation" + mark))
         return written
@@ -123,8 +128,8 @@ class Inversion:
         ax.plot(d[self.measured], self.percent[self.measured], "C0o", ms=4, label="at a reading's or a sieve's diameter")
         ax.plot(d[~self.measured], self.percent[~self.measured], "o", mec="C0", mfc="white", ms=4,
                 label="between them, or in a tail")
-        for k, (name, _, dd, p) in enumerate(self.reduction):
-            ax.plot(dd * 1e6, p, "s", ms=5, color=f"C{k + 1}", label=f"standard reduction ({name})")
+        for k, r in enumerate(self.reduction):
+            ax.plot(r.diameter * 1e6, r.percent, "s", ms=5, color=f"C{k + 1}", label=f"standard reduction ({r.instrument})")
         if self.sieve is not None:
             ax.plot(self.sieve[0] * 1e6, self.sieve[1], "kv", ms=6, label="sieves")
         ax.set(xscale="log", xlabel="diameter [um]", ylabel="percent finer [%]", ylim=(0, 100),
@@ -253,13 +258,10 @@ def invert(sheets: list[Sheet], test: LabTest, folder: Path, *, sieve: SieveShee
         check_sheet(replace(sheet, reading=reading), whole_sample_reading(sheet, test, water),
                     max(2 * test.noise[sheet.instrument], 0.02 * signal))
     sieves = sieve_data(sieve, split, test.noise["sieve"])
-    reduction = []
-    for sheet, reading in zip(sheets, corrected):
-        d, p = standard_reduction(replace(sheet, reading=reading), water, c0, test.hydrometer, test.cylinder_area,
-                                  test.sphere, test.meniscus)
-        reduction.append((sheet.instrument, sheet.time, d, p))
+    reduction = [standard_reduction(sheet, water, c0, test.hydrometer, test.cylinder_area, test.sphere, test.meniscus,
+                                    test.correction(sheet)) for sheet in sheets]
     times = [effective_times(s, water) for s in sheets]
-    grid = size_grid(cut_diameters(sheets, corrected, times, test, water), bins, sieves.opening, sieves.top)
+    grid = size_grid(cut_diameters(sheets, times, test, water), bins, sieves.opening, sieves.top)
     shares = first_guess(reduction, sieves, grid)
     sieve_rows = 100.0 * grid.cumulative(sieves.opening)
     data = np.concatenate(corrected + [sieves.percent])
@@ -344,7 +346,7 @@ def invert(sheets: list[Sheet], test: LabTest, folder: Path, *, sieve: SieveShee
         "temperatures_C": [float(recorded.min()), float(recorded.max())] if len(recorded) else None,
         "split_mm": None if split is None else split * 1e3, "specimen_share": sieves.share,
         "top_um": sieves.top * 1e6}
-    whole = [(name, t, d, p * sieves.share) for name, t, d, p in reduction]
+    whole = [r.scaled(sieves.share) for r in reduction]
     out = Inversion(*result, whole, rows, chi2, round_number, float(weight), resolution, inputs,
                     None if sieve is None else (sieve.opening, sieve.passing))
     out.notes.append(f"forward model: {resolution}; {round_number} round(s)" + (
@@ -406,9 +408,10 @@ def _inputs_line(test: LabTest, inputs: dict) -> str:
     correction = "; ".join(f"{Path(k).name}: {v if isinstance(v, str) else f'{v:g} g/L'}"
                            for k, v in inputs["composite_correction"].items()) or "none"
     temperatures = inputs["temperatures_C"]
-    return (f"inputs: specimen {test.mass * 1e3:g} g, particle density {test.particle_density:g} kg/m3, cylinder "
-            f"{test.cylinder_area * 1e4:g} cm2 x {test.height * 100:g} cm, composite correction {correction}, meniscus "
-            f"{test.meniscus:g} g/L, water " + (f"{temperatures[0]:g}-{temperatures[1]:g} C" if temperatures else
+    return (f"inputs: specimen {test.mass * 1e3:.5g} g (oven-dry), particle density {test.particle_density:g} kg/m3, "
+            f"suspension {test.cylinder_area * test.height * 1e6:.4g} mL in a cylinder of {test.cylinder_area * 1e4:.4g} "
+            f"cm2 ({test.height * 100:.4g} cm high), hydrometer {test.hydrometer.describe()}, composite correction "
+            f"{correction}, meniscus {test.meniscus:g} g/L, water " + (f"{temperatures[0]:g}-{temperatures[1]:g} C" if temperatures else
                                                "20 C (no temperature recorded)")
             + f", the specimen's largest grain {inputs['top_um']:g} um"
             + (f" (the part passing {inputs['split_mm']:g} mm, {100 * inputs['specimen_share']:.4g} % of the sample)"
@@ -452,12 +455,12 @@ def _whole_sample(grid: SizeGrid, specimen: np.ndarray, draws: np.ndarray, extre
     return diameter, percent, low, high, basis, draws
 
 
-def first_guess(reduction, sieves: SieveData, grid: SizeGrid) -> np.ndarray:
+def first_guess(reduction: list[Reduction], sieves: SieveData, grid: SizeGrid) -> np.ndarray:
     """Bin shares from the standard reduction's points and the sieves (of the specimen), 100 % at the top,
     interpolated in log d and made non-decreasing, mixed with a tenth of an even split so that every bin
     has mass for the run to scale."""
-    d = np.concatenate([r[2] for r in reduction] + [sieves.opening, [sieves.top]])
-    p = np.concatenate([r[3] for r in reduction] + [sieves.percent, [100.0]])
+    d = np.concatenate([r.diameter for r in reduction] + [sieves.opening, [sieves.top]])
+    p = np.concatenate([r.percent for r in reduction] + [sieves.percent, [100.0]])
     order = np.argsort(d)
     d, p = d[order], np.maximum.accumulate(np.clip(p[order], 0, 100))
     at_edges = np.interp(np.log(grid.edges), np.log(d), p, left=p[0], right=100.0)

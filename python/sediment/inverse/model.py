@@ -12,7 +12,8 @@ import numpy as np
 
 from .. import _core
 from ..lab.psd import PSD
-from ..lab.readout import BuoyancySphere, Column, Hydrometer, Pipette, Suspension, gs_correction
+from ..constants import WATER_20C_DENSITY
+from ..lab.readout import R_FACTOR, BuoyancySphere, Column, Hydrometer, Pipette, Suspension, gs_correction
 from ..lab.sheet import Sheet, standard_reduction
 from .grid import SizeGrid
 
@@ -50,18 +51,23 @@ class LabTest:
         depth = 0.3 * self.height if self.sphere_depth is None else self.sphere_depth
         return BuoyancySphere(depth, self.sphere_diameter, self.sphere_mass)
 
-    def corrected(self, sheet: Sheet) -> np.ndarray:
-        """The sheet's readings after the hydrometer's composite correction: the sheet's own `blank`
-        column where it has one, else the test's zero correction."""
+    def correction(self, sheet: Sheet) -> np.ndarray:
+        """The 152H's composite correction at each reading [g/L]: the sheet's own `blank` column where
+        it has one, else the test's zero correction (0 for other instruments)."""
         if sheet.instrument != "hydrometer":
-            return sheet.reading
-        return sheet.reading - (sheet.blank if len(sheet.blank) else self.zero_correction)
+            return np.zeros(len(sheet.time))
+        return np.array(sheet.blank, float) if len(sheet.blank) else np.full(len(sheet.time), self.zero_correction)
+
+    def corrected(self, sheet: Sheet) -> np.ndarray:
+        """The sheet's readings after the hydrometer's composite correction."""
+        return sheet.reading - self.correction(sheet)
 
     def record(self) -> dict:
         """Every value the inverse takes from the test, in SI units, for invert.json and the console."""
         values = asdict(self)
         values["hydrometer"] = asdict(self.hydrometer)
         values["sphere_depth"] = self.sphere.depth
+        values["volume_m3"] = self.cylinder_area * self.height
         return values
 
 
@@ -114,13 +120,28 @@ class ForwardRun:
         column = Column.from_layers(self.layers, fraction=fraction)
         return replace(column, suspension=self.water)
 
+    def hydrometer_readings(self, column: Column, sheet: Sheet, times: np.ndarray) -> np.ndarray:
+        """The 152H's readings of a column, composite-corrected as the sheet's are. The instrument floats
+        in the companion cylinder's liquid (water and dispersant at the reading's temperature: what the
+        composite correction and the meniscus read there) with the solids, so its bulb sits where the
+        sheet's reading puts it (D7928's H_m at the reading as read plus the meniscus)."""
+        liquid = self.test.correction(sheet) + self.test.meniscus    # the liquid's reading at its surface [g/L]
+        out = np.empty(len(times))
+        for value in np.unique(liquid):
+            at = liquid == value
+            density = WATER_20C_DENSITY + R_FACTOR * value    # the 152H's scale: 0.6226 kg/m3 per g/L
+            read = self.test.hydrometer.read(replace(column, suspension=replace(self.water, fluid_density=density)),
+                                             times[at], cylinder_area=self.test.cylinder_area).reading
+            out[at] = read - value
+        return out
+
     def readings(self, shares: np.ndarray, sheets: list[Sheet], times: list[np.ndarray]) -> np.ndarray:
         """Every sheet's modelled readings, in order, for a split of the mass."""
         column = self.column(shares)
         out = []
         for sheet, t in zip(sheets, times):
             if sheet.instrument == "hydrometer":
-                out.append(self.test.hydrometer.read(column, t, cylinder_area=self.test.cylinder_area).reading)
+                out.append(self.hydrometer_readings(column, sheet, t))
             elif sheet.instrument == "pipette":
                 out.append(np.array([Pipette(z).read(column, [ti]).reading[0] for z, ti in zip(sheet.depth, t)]))
             else:
@@ -182,8 +203,7 @@ def psd_of(shares: np.ndarray, grid: SizeGrid, name: str = "") -> PSD:
     return PSD(np.concatenate([[grid.floor], grid.edges]), np.maximum.accumulate(percent), name)
 
 
-def cut_diameters(sheets: list[Sheet], readings: list[np.ndarray], times: list[np.ndarray], test: LabTest,
-                  water: Suspension) -> np.ndarray:
+def cut_diameters(sheets: list[Sheet], times: list[np.ndarray], test: LabTest, water: Suspension) -> np.ndarray:
     """The diameter each reading cuts in the forward model: the grains whose hindered terminal speed (the
     standard drag curve, Richardson & Zaki at the solids finer than them, the reading's own percent
     finer) takes them past the instrument's depth by the reading's time in the run's water. The
@@ -191,11 +211,11 @@ def cut_diameters(sheets: list[Sheet], readings: list[np.ndarray], times: list[n
     from ..planner.screening import terminal_speeds
 
     out = []
-    for sheet, reading, t in zip(sheets, readings, times):
-        run_sheet = replace(sheet, time=t, reading=reading, temperature=np.full(len(t), np.nan))
-        stokes, percent = standard_reduction(run_sheet, water, test.initial_concentration, test.hydrometer,
-                                             test.cylinder_area, test.sphere, test.meniscus)
-        for d_stokes, p in zip(stokes, np.clip(percent, 0.0, 100.0)):
+    for sheet, t in zip(sheets, times):
+        run_sheet = replace(sheet, time=t, temperature=np.full(len(t), np.nan))
+        reduced = standard_reduction(run_sheet, water, test.initial_concentration, test.hydrometer,
+                                     test.cylinder_area, test.sphere, test.meniscus, test.correction(sheet))
+        for d_stokes, p in zip(reduced.diameter, np.clip(reduced.percent, 0.0, 100.0)):
             speed = water.stokes_speed(d_stokes)
             voidage = 1.0 - test.initial_concentration / test.particle_density * p / 100.0
             low, high = math.log(0.5 * d_stokes), math.log(2.0 * d_stokes)

@@ -20,6 +20,8 @@ from ..constants import (D422_CYLINDER_AREA, GRAVITY, LAB_TEMPERATURE, SCHEDULES
                          WATER_20C_DENSITY, WATER_20C_VISCOSITY)
 
 R_FACTOR = 1 - 1 / 2.65    # 152H: R = (rho_s - rho_w) / 0.6226 in g/L, calibrated for Gs = 2.65
+NOMINAL_BULB_LENGTH = 0.140    # m, the 152H of D422
+NOMINAL_BULB_VOLUME = 67.0e-6  # m3
 
 @dataclass(frozen=True)
 class Suspension:
@@ -193,7 +195,9 @@ class Readings:
 @dataclass(frozen=True)
 class Hydrometer:
     """A hydrometer as a cylindrical bulb under a cylindrical stem, with its scale on the stem:
-    the surface crosses the stem at distance `scale_zero - scale_step R` above the bulb top."""
+    the surface crosses the stem at distance `scale_zero - scale_step R` above the bulb top. A
+    laboratory's `calibration` (D7928's H_r: rows of reading [g/L] and the distance [m] from that
+    graduation to the bulb's centre) places the scale instead, linear between and beyond its rows."""
 
     bulb_length: float      # L2 [m]
     bulb_volume: float      # VB [m3]
@@ -201,23 +205,91 @@ class Hydrometer:
     mass: float             # [kg]
     scale_zero: float       # L1 at R = 0 [m]
     scale_step: float       # decrease of L1 per unit of R [m per g/L]
+    calibration: tuple[tuple[float, float], ...] = ()    # (R [g/L], H_r [m]) by increasing R; () the linear scale
 
     @classmethod
-    def astm_152h(cls, bulb_length=0.140, bulb_volume=67.0e-6, scale_zero=0.105, scale_at_50=0.023,
+    def astm_152h(cls, bulb_length=NOMINAL_BULB_LENGTH, bulb_volume=NOMINAL_BULB_VOLUME, scale_zero=0.105, scale_at_50=0.023,
                   water_density=WATER_20C_DENSITY) -> "Hydrometer":
         """The nominal 152H of ASTM D422. Stem area and mass follow from the calibration: it floats
         with the surface at L1(R) in a uniform suspension of density rho_w + 0.6226 R."""
-        step = (scale_zero - scale_at_50) / 50.0
+        return cls._floating(bulb_length, bulb_volume, scale_zero, (scale_zero - scale_at_50) / 50.0, water_density)
+
+    @classmethod
+    def _floating(cls, bulb_length, bulb_volume, scale_zero, step, water_density=WATER_20C_DENSITY,
+                  calibration: tuple[tuple[float, float], ...] = ()) -> "Hydrometer":
+        """The stem and mass with which the bulb top floats `scale_zero - step R` deep in a uniform
+        suspension of density rho_w + 0.6226 R (exactly at R = 0 and 50)."""
+        scale_at_50 = scale_zero - 50.0 * step
         rho50 = water_density + R_FACTOR * 50.0
         stem = (rho50 - water_density) * bulb_volume / (water_density * scale_zero - rho50 * scale_at_50)
         mass = water_density * (bulb_volume + stem * scale_zero)
-        return cls(bulb_length, bulb_volume, stem, mass, scale_zero, step)
+        return cls(bulb_length, bulb_volume, stem, mass, scale_zero, step, calibration)
 
     @classmethod
     def measured(cls, bulb_length, bulb_volume, stem_diameter, mass, scale_zero, scale_at_50) -> "Hydrometer":
         """An instrument measured in the laboratory (stem diameter, mass, scale marks)."""
         return cls(bulb_length, bulb_volume, np.pi / 4 * stem_diameter ** 2, mass, scale_zero,
                    (scale_zero - scale_at_50) / 50.0)
+
+    @classmethod
+    def calibrated(cls, readings, distances, bulb_volume: float = NOMINAL_BULB_VOLUME,
+                   bulb_length: float = NOMINAL_BULB_LENGTH) -> "Hydrometer":
+        """A 152H from a laboratory's calibration (D7928 9.x: the distance H_r [m] from the graduation of
+        each reading [g/L] to the bulb's centre; at least two readings, the distance falling as the
+        reading rises). The scale reads the rows, linear between and beyond them; the instrument
+        floats as the straight line through its first and last rows says (a uniform stem)."""
+        readings, distances = np.asarray(readings, float), np.asarray(distances, float)
+        order = np.argsort(readings)
+        readings, distances = readings[order], distances[order]
+        if len(readings) < 2 or np.any(np.diff(readings) <= 0):
+            raise ValueError("a hydrometer calibration needs at least two distinct readings")
+        if np.any(np.diff(distances) >= 0):
+            raise ValueError("a hydrometer calibration's distance to the bulb's centre must fall as the reading rises "
+                             "(a higher reading is a graduation lower on the stem)")
+        step = (distances[0] - distances[-1]) / (readings[-1] - readings[0])
+        scale_zero = distances[0] + step * readings[0] - bulb_length / 2
+        lowest = distances[-1] - bulb_length / 2
+        if lowest <= 0:
+            raise ValueError(f"the {readings[-1]:g} g/L graduation lies {distances[-1] * 100:.3g} cm above the bulb's "
+                             f"centre, inside a bulb of {bulb_length * 100:.3g} cm: check the calibration's distances "
+                             "(cm, to the bulb's centre) or the bulb's length")
+        return cls._floating(bulb_length, bulb_volume, scale_zero, step,
+                             calibration=tuple(zip(readings.tolist(), distances.tolist())))
+
+    def centre_distance(self, reading):
+        """H_r [m]: from the graduation of `reading` [g/L] to the bulb's centre."""
+        reading = np.asarray(reading, float)
+        if not self.calibration:
+            return self.scale_zero + self.bulb_length / 2 - self.scale_step * reading
+        r, h = np.array(self.calibration).T
+        inside = np.interp(reading, r, h)
+        below = h[0] + (reading - r[0]) * (h[1] - h[0]) / (r[1] - r[0])
+        above = h[-1] + (reading - r[-1]) * (h[-1] - h[-2]) / (r[-1] - r[-2])
+        return np.where(reading < r[0], below, np.where(reading > r[-1], above, inside))
+
+    def reading_at(self, distance):
+        """The reading [g/L] whose graduation lies `distance` [m] above the bulb's centre."""
+        distance = np.asarray(distance, float)
+        if not self.calibration:
+            return (self.scale_zero + self.bulb_length / 2 - distance) / self.scale_step
+        r, h = np.array(self.calibration).T
+        inside = np.interp(distance, h[::-1], r[::-1])
+        above = r[0] + (distance - h[0]) * (r[1] - r[0]) / (h[1] - h[0])
+        below = r[-1] + (distance - h[-1]) * (r[-1] - r[-2]) / (h[-1] - h[-2])
+        return np.where(distance > h[0], above, np.where(distance < h[-1], below, inside))
+
+    def effective_depth(self, reading, cylinder_area: float = D422_CYLINDER_AREA):
+        """D7928's H_m [m]: the bulb's centre below the surface at `reading` (corrected for the
+        meniscus), less the rise of the surface as the bulb enters, V_B / 2A."""
+        return self.centre_distance(reading) - self.bulb_volume / (2 * cylinder_area)
+
+    def describe(self) -> str:
+        """The instrument as the console echoes it."""
+        scale = ("calibrated: H_r " + ", ".join(f"{h * 100:g} cm at {r:g} g/L" for r, h in self.calibration)
+                 if self.calibration else
+                 f"nominal 152H of D422: H_r {self.centre_distance(0.0) * 100:.4g} cm at 0 g/L, "
+                 f"{self.centre_distance(50.0) * 100:.4g} cm at 50 g/L")
+        return f"{scale}; bulb {self.bulb_volume * 1e6:.3g} mL, {self.bulb_length * 100:.3g} cm"
 
     def bulb_top_depth(self, column: Column, t: float) -> float:
         """Depth of the bulb top where the hydrostatic force on the immersed stem and bulb equals
@@ -259,7 +331,7 @@ class Hydrometer:
         rows = []
         for t in times_s:
             top = self.bulb_top_depth(column, t)
-            reading = (self.scale_zero - top) / self.scale_step
+            reading = float(self.reading_at(top + self.bulb_length / 2))
             depth = self.stokes_depth(top, cylinder_area, level_rise)
             rows.append((t, depth, reading, suspension.stokes_diameter(depth, t), _percent(reading * a, c0)))
         return _readings("hydrometer", rows)

@@ -17,11 +17,12 @@ sample in suspension reads.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
 
+from ..constants import LAB_TEMPERATURE
 from ..csvfile import CsvError, CsvFile, read_csv
 from ..plausible import RANGES, Range, pipette_mass
 from .readout import BuoyancySphere, Hydrometer, Suspension, gs_correction
@@ -75,9 +76,12 @@ class SieveSheet:
         return f"{self.path.name} (sieve)"
 
 
-def read_sheet(path: str | Path, pipette_volume: float = 25e-6) -> Sheet | SieveSheet:
-    """Reads and checks one sheet (its kind from its header); a pipette's masses become g/L of the sample."""
+def read_sheet(path: str | Path, pipette_volume: float = 25e-6, stirred: str | None = None) -> Sheet | SieveSheet:
+    """Reads and checks one sheet (its kind from its header); a pipette's masses become g/L of the sample.
+    A `clock` column (HH:MM of each reading) stands for `time_min`, counted from `stirred` (HH:MM)."""
     table = _table(path)
+    if "clock" in table.header:
+        table = _clock_to_minutes(table, stirred)
     path, header = table.path, table.header
     kinds = [k for k, columns in KINDS.items() if set(columns) <= set(header)]
     if not kinds:
@@ -133,6 +137,51 @@ def read_sheet(path: str | Path, pipette_volume: float = 25e-6) -> Sheet | Sieve
         _plausible(path, lines, values, "apparent_mass_g", "apparent_mass_g")
         reading = values["apparent_mass_g"]
     return Sheet(kind, path, time, reading, temperature, depth, blank)
+
+
+def clock_minutes(text: str, where: str) -> int:
+    """Minutes after midnight of a clock time HH:MM (or H:MM, HH:MM:SS to the minute's fraction)."""
+    parts = text.strip().split(":")
+    try:
+        values = [int(p) for p in parts]
+    except ValueError:
+        values = []
+    if len(values) not in (2, 3) or not (0 <= values[0] < 24 and all(0 <= v < 60 for v in values[1:])):
+        raise SheetError(f"{where}: '{text.strip()}' is not a clock time HH:MM (24-hour, 14:05 for 2:05 pm)")
+    return values[0] * 60 + values[1] + (values[2] / 60 if len(values) == 3 else 0)
+
+
+NEXT_DAY_AFTER = 120.0    # min: a clock that falls later than this in a test is past midnight, earlier a slip
+
+
+def _clock_to_minutes(table: CsvFile, stirred: str | None) -> CsvFile:
+    """The sheet with its `clock` column turned into `time_min` after the stirring. A clock that falls
+    is a reading past midnight (the next day) where it falls by more than 12 h (23:55 to 00:10), or
+    where the reading before it came at least two hours into the test, as the long readings do
+    (D7928's 4 and 24 h, Bouyoucos's 2 h); a smaller fall minutes into the test is refused as a slip."""
+    if "time_min" in table.header:
+        raise SheetError(f"{table.path}: both clock and time_min columns: give the readings' times once")
+    if stirred is None:
+        raise SheetError(f"{table.path}: the sheet gives clock times: say when the suspension was stirred with "
+                         "--stirred HH:MM")
+    start = clock_minutes(stirred, "--stirred")
+    k = table.header.index("clock")
+    rows, previous, day = [], 0.0, 0
+    for line, row in table.rows:
+        minutes = clock_minutes(row[k], table.where(line)) - start + 1440 * day
+        if minutes <= previous and (rows or minutes + 1440 > 0):
+            if rows and previous < NEXT_DAY_AFTER and previous - minutes < 720:
+                raise SheetError(f"{table.where(line)}: the clock goes back to {row[k].strip()}, {previous:g} min after "
+                                 f"the stirring at {stirred}: a slip (a reading past midnight comes after the long "
+                                 "readings, not minutes into the test)")
+            day += 1
+            minutes += 1440
+        if minutes <= previous:
+            raise SheetError(f"{table.where(line)}: the reading at {row[k].strip()} is not after the one before it")
+        rows.append((line, row[:k] + [f"{minutes:.6g}"] + row[k + 1:]))
+        previous = minutes
+    header = table.header[:k] + ["time_min"] + table.header[k + 1:]
+    return replace(table, header=header, rows=rows)
 
 
 def _plausible(path: Path, lines: list[int], values: dict[str, np.ndarray], column: str,
@@ -243,20 +292,44 @@ def check_sheet(sheet: Sheet, whole: float, resolution: float) -> None:
                          "at a depth only fall as the test goes on (a misread, or a flocculating sample)")
 
 
+@dataclass(frozen=True)
+class Reduction:
+    """The standard reduction of one sheet, with every correction it applied: per reading the
+    composite correction subtracted from it (152H: the blank or the zero correction), the meniscus
+    added to it for the depth, the water's temperature, the depth Stokes' law took (152H: D7928's
+    H_m at the reading plus the meniscus), the diameter and the percent finer."""
+
+    instrument: str
+    time: np.ndarray            # s
+    reading: np.ndarray         # as on the sheet (152H g/L, pipette g/L of the sample, sphere apparent mass g)
+    correction: np.ndarray      # subtracted from the reading for the percent (152H), else 0
+    meniscus: float             # g/L added to a 152H's reading for its depth
+    temperature: np.ndarray     # C
+    depth: np.ndarray           # m
+    diameter: np.ndarray        # m
+    percent: np.ndarray         # of the specimen (the inverse scales it to the whole sample)
+
+    def scaled(self, share: float) -> "Reduction":
+        """The same reduction with its percent finer of a sample of which the specimen is `share`."""
+        return replace(self, percent=self.percent * share)
+
+
 def standard_reduction(sheet: Sheet, suspension: Suspension, initial_concentration: float,
                        hydrometer: Hydrometer, cylinder_area: float, sphere: BuoyancySphere,
-                       meniscus: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
+                       meniscus: float = 0.0, correction: float | np.ndarray = 0.0) -> Reduction:
     """The ASTM reduction of each reading: Stokes' diameter at the instrument's depth with the water at
-    the reading's temperature (the test's where none was recorded), and percent finer from the reading
-    (152H: 100 a R / c0)."""
+    the reading's temperature (the test's where none was recorded), and percent finer from the reading.
+    152H (D7928): the depth H_m at the reading as read plus the `meniscus` (the surface's graduation),
+    the percent 100 a (R - `correction`) / c0, the composite correction measured at the same time."""
     temperature = np.where(np.isfinite(sheet.temperature), sheet.temperature,
-                           suspension.temperature if suspension.temperature is not None else 20.0)
+                           suspension.temperature if suspension.temperature is not None else LAB_TEMPERATURE)
     waters = [Suspension.at_temperature(t, suspension.particle_density) for t in temperature]
     gs = suspension.specific_gravity
+    applied = np.zeros(len(sheet.time))
     if sheet.instrument == "hydrometer":
-        depth = hydrometer.stokes_depth(hydrometer.scale_zero - hydrometer.scale_step * (sheet.reading + meniscus),
-                                        cylinder_area)
-        percent = 100 * gs_correction(gs) * sheet.reading / initial_concentration
+        applied = applied + correction
+        depth = hydrometer.effective_depth(sheet.reading + meniscus, cylinder_area)
+        percent = 100 * gs_correction(gs) * (sheet.reading - applied) / initial_concentration
     elif sheet.instrument == "pipette":
         depth = sheet.depth
         percent = 100 * sheet.reading / initial_concentration
@@ -265,4 +338,32 @@ def standard_reduction(sheet: Sheet, suspension: Suspension, initial_concentrati
         depth = np.full(len(sheet.time), sphere.depth)
         percent = 100 * sphere.solids(sheet.reading * 1e-3, water, gs) / initial_concentration
     diameter = np.array([w.stokes_diameter(z, time) for w, z, time in zip(waters, depth, sheet.time)], float)
-    return diameter, percent
+    return Reduction(sheet.instrument, sheet.time, sheet.reading, applied,
+                     meniscus if sheet.instrument == "hydrometer" else 0.0, temperature, np.asarray(depth, float),
+                     diameter, percent)
+
+
+def read_hydrometer_calibration(path: str | Path) -> tuple[np.ndarray, np.ndarray]:
+    """A hydrometer's calibration (D7928's H_r): CSV ``reading,distance_cm``, the distance from the
+    graduation of each reading [g/L] to the bulb's centre. Returns the readings and the distances [m]."""
+    table = _table(path)
+    path = table.path
+    if not {"reading", "distance_cm"} <= set(table.header):
+        raise SheetError(f"{path}: a hydrometer calibration needs the columns reading,distance_cm (the distance from "
+                         f"the graduation of each reading to the bulb's centre; header: {','.join(table.header)})")
+    lines = [line for line, _ in table.rows]
+    values = {name: np.array(_numbers(table, name)) for name in ("reading", "distance_cm")}
+    if len(lines) < 2:
+        raise SheetError(f"{path}: a calibration needs at least two readings with their distances")
+    _plausible(path, lines, values, "reading", "reading")
+    _plausible(path, lines, values, "distance_cm", "calibration_cm")
+    readings, distances = values["reading"], values["distance_cm"]
+    order = np.argsort(readings, kind="stable")
+    for a, b in zip(order[:-1], order[1:]):
+        if readings[a] == readings[b]:
+            raise SheetError(f"{path}, lines {lines[a]} and {lines[b]}: the reading {readings[a]:g} is calibrated twice")
+        if distances[b] >= distances[a]:
+            raise SheetError(f"{path}, lines {lines[a]} and {lines[b]}: the distance to the bulb's centre does not fall "
+                             f"from reading {readings[a]:g} ({distances[a]:g} cm) to {readings[b]:g} ({distances[b]:g} "
+                             "cm): a higher reading is a graduation lower on the stem, nearer the bulb")
+    return readings[order], distances[order] / 100.0
