@@ -21,16 +21,18 @@ from __future__ import annotations
 import argparse
 import sys
 import time
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
 
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE.parent / "python"))
+from sediment.constants import WATER_20C_DENSITY  # noqa: E402
 from sediment.inverse import LabTest, invert  # noqa: E402
 from sediment.lab import texture  # noqa: E402
 from sediment.lab.psd import read_psd  # noqa: E402
-from sediment.lab.readout import SCHEDULES, BuoyancySphere, Column, Hydrometer, Pipette, Suspension  # noqa: E402
+from sediment.lab.readout import R_FACTOR, SCHEDULES, BuoyancySphere, Column, Hydrometer, Pipette, Suspension  # noqa: E402
 from sediment.lab.sheet import read_sheet  # noqa: E402
 from sediment.sim.layers import read_layers  # noqa: E402
 from sediment.sim.run import run_batch  # noqa: E402
@@ -43,6 +45,7 @@ SOILS = [HERE.parent / "examples" / "inverse" / "soils" / f"{name}.csv"
 SIEVES_MM = (2.0, 0.85, 0.425, 0.25, 0.15, 0.106, 0.075)
 SOIL_MASS = 0.050
 REFERENCE_TEMPERATURE = 20.0
+DISPERSANT = 2.5      # g/L on the 152H's scale: the dispersant's share of the blank (5 g/L of sodium hexametaphosphate)
 # the band "holds" the truth within 0.01 points: a tail's extreme placement reaches 100 % to 1e-4 points (its
 # prior is soft), and no reading resolves 0.01 points
 HELD_TOLERANCE = 0.01
@@ -66,9 +69,14 @@ def synthesise(psd_path: Path, folder: Path, soil: bool = False) -> list[Path]:
     run_batch(folder / "truth" / "in.sedimentation", {"overwrite": "yes"})
     column = Column.from_layers(read_layers(folder / "truth" / "layers.h5"))
     hydro = np.array(SCHEDULES["d7928"], float) * 60
-    readings = Hydrometer.astm_152h().read(column, hydro).reading
-    lines = ["time_min,reading,temperature_C"] + [
-        f"{t / 60:g},{np.round(r / 0.5) * 0.5:g},{np.round(c, 1):g}" for t, r, c in zip(hydro, readings, drift(hydro))]
+    # the 152H floats in the run's water with a dispersant (DISPERSANT g/L on its scale), and the companion
+    # cylinder of that liquid, read beside it, is the blank: both read to 0.5 g/L as a laboratory reads them
+    blank = (column.suspension.fluid_density - WATER_20C_DENSITY) / R_FACTOR + DISPERSANT
+    liquid = replace(column.suspension, fluid_density=WATER_20C_DENSITY + R_FACTOR * blank)
+    readings = Hydrometer.astm_152h().read(replace(column, suspension=liquid), hydro).reading
+    lines = ["time_min,reading,temperature_C,blank"] + [
+        f"{t / 60:g},{np.round(r / 0.5) * 0.5:g},{np.round(c, 1):g},{np.round(blank / 0.5) * 0.5:g}"
+        for t, r, c in zip(hydro, readings, drift(hydro))]
     (folder / "hydrometer.csv").write_text("\n".join(lines) + "\n")
     if soil:
         truth = read_psd(folder / "truth" / "simulated_psd.csv")

@@ -10,6 +10,8 @@ SOIL_PARTICLE_DENSITY = 2650.0    # kg/m3, Gs = 2.65: what the 152H hydrometer i
 D422_CYLINDER_AREA = 27.8e-4      # m2, ASTM D422 cylinder (inner diameter 5.95 cm)
 D422_CYLINDER_HEIGHT = 0.36       # m, the 1000 mL mark
 SUSPENSION_VOLUME = 1e-3          # m3, the sedimentation tests' 1000 mL
+NOMINAL_BULB_LENGTH = 0.140       # m, the 152H of D422
+NOMINAL_BULB_VOLUME = 67.0e-6     # m3
 BRAVO_CYLINDER_WIDTH = 0.0635     # m, Bravo et al. (2015)
 BRAVO_CYLINDER_HEIGHT = 0.457     # m
 

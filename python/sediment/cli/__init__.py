@@ -76,6 +76,7 @@ def _command(argv: list[str] | None) -> int:
     from ..sim.run import RunInterrupted
 
     args = build_parser().parse_args(argv)
+    args.argv = list(sys.argv[1:] if argv is None else argv)    # as given: a batch passes its options on
     try:
         from .. import _core    # noqa: F401  (every command but --help needs it)
     except ImportError:

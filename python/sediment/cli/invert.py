@@ -3,11 +3,13 @@
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 from pathlib import Path
 
-from ..constants import D422_CYLINDER_AREA, SOIL_PARTICLE_DENSITY, SUSPENSION_VOLUME
-from ..lab.readout import NOMINAL_BULB_LENGTH, NOMINAL_BULB_VOLUME
+from ..constants import (D422_CYLINDER_AREA, NOMINAL_BULB_LENGTH, NOMINAL_BULB_VOLUME, SOIL_PARTICLE_DENSITY,
+                         SUSPENSION_VOLUME)
+from ..results import write_text
 from .types import count, quantity, quantity_list
 
 
@@ -15,6 +17,7 @@ EXAMPLES = [
     'sediment invert examples/inverse/soil/hydrometer.csv examples/inverse/soil/sieve.csv --mass 0.05 --out out/soil',
     'sediment invert examples/inverse/hydrometer.csv examples/inverse/pipette.csv --mass 0.06 --out out/invert',
     'sediment invert --design examples/granulometry/psd/sample5.csv --out out/design',
+    'sediment invert --batch examples/inverse/batch --out out/batch',
 ]
 
 
@@ -33,6 +36,15 @@ def add_parser(commands) -> argparse.ArgumentParser:
         "Example: sediment invert examples/inverse/soil/hydrometer.csv examples/inverse/soil/sieve.csv --mass 0.05 "
         "--out out/soil")
     parser.add_argument("sheets", type=Path, nargs="*", help="the sheets of one sample (CSV)")
+    parser.add_argument("--batch", type=Path, metavar="FOLDER",
+                        help="instead of sheets: a laboratory's batch, one sub-folder per sample with its sheets and a "
+                        "sample.json of its own options ({\"mass\": 0.05, \"stirred\": \"09:00\"}); the options "
+                        "given here hold for every sample. Each sample's results go to OUT/SAMPLE, and OUT/summary.csv "
+                        "and summary.png show them all; a sample already inverted with the same sheets and options is "
+                        "not run again")
+    parser.add_argument("--jobs", type=count, default=os.cpu_count() or 1,
+                        help="with --batch: samples inverted at a time (default: the machine's cores)")
+    parser.add_argument("--batch-key", help=argparse.SUPPRESS)    # a batch's record of a sample's inputs
     parser.add_argument("--design", type=Path, metavar="PSD",
                         help="instead of sheets: the PSD a sample is expected to have; compares instruments, reading "
                         "times and sample masses by how well each recovers it (OUT/design.csv, design.png)")
@@ -110,8 +122,11 @@ def run(args: argparse.Namespace) -> int:
     from ..lab.sheet import read_sheet
     from ..plausible import check, sphere_density
 
-    if (args.design is None) == (not args.sheets):
-        raise ValueError("give the sheets of a sample, or --design PSD to plan a test (not both)")
+    if sum([args.design is not None, bool(args.sheets), args.batch is not None]) != 1:
+        raise ValueError("give the sheets of a sample, or --batch FOLDER of samples, or --design PSD to plan a test "
+                         "(one of them)")
+    if args.batch is not None:
+        return _batch(args)
     mass = specimen_mass(args)
     if args.design is None and mass is None:
         raise ValueError("--mass is required: the oven-dry mass of the hydrometer's specimen [kg] (0.05 for 50 g), or "
@@ -219,6 +234,8 @@ def _invert(args: argparse.Namespace, test, sheets) -> int:
         whole, test, split = test.mass, replace(test, mass=test.mass * share), args.washed
     result = invert(readings, test, args.out / "runs", sieve=sieve, split=None if split is None else split * 1e-3,
                     bins=args.bins, particles=args.particles, seed=args.seed, budget_band=band)
+    if args.batch_key is not None:
+        result.inputs["batch_key"] = args.batch_key
     if args.washed is not None:
         result.inputs |= {"washed_mm": args.washed, "whole_specimen_mass": whole}
         result.notes.insert(-1, f"washed through {args.washed:g} mm before the hydrometer: {test.mass * 1e3:.4g} g in "
@@ -235,6 +252,46 @@ def _invert(args: argparse.Namespace, test, sheets) -> int:
     hint = f" (two {' and two '.join(twice)} sheets: of two samples?)" if twice else ""
     print(f"sediment invert: no PSD explains the sheets together{hint} (exit 3): {notes[-1]}", file=sys.stderr)
     return 3
+
+
+def _batch(args: argparse.Namespace) -> int:
+    """Inverts a batch's samples; prints each as it ends and the summary, writes summary.csv, summary.png and the
+    samples' consoles (logs/). Exit 2 where a sample could not be inverted, 3 where one fits no PSD, else 0."""
+    from ..inverse.batch import read_samples, run_batch, summary_figure, summary_table
+
+    samples = read_samples(args.batch)
+    rows = run_batch(samples, _common_options(args.argv), args.final_out, args.out / "logs", args.jobs)
+    table = summary_table(rows)
+    write_text(args.out / "summary.csv", table.csv())
+    summary_figure(args.out / "summary.png", rows)
+    args.publish()
+    print(table.text(), end="")
+    failed = [r["sample"] for r in rows if r["result"] is None]
+    odd = [r["sample"] for r in rows if r["result"] is not None and not r["result"]["consistent"]]
+    if failed:
+        print(f"sediment invert: {len(failed)} of {len(rows)} samples could not be inverted ({', '.join(failed)}): "
+              f"their reasons are in summary.csv and {args.final_out / 'logs'}; the others' results stand (exit 2)",
+              file=sys.stderr)
+        return 2
+    if odd:
+        print(f"sediment invert: no PSD explains the sheets of {', '.join(odd)} (exit 3)", file=sys.stderr)
+        return 3
+    return 0
+
+
+def _common_options(argv: list[str]) -> list[str]:
+    """The batch command's options that hold for every sample: its arguments less the command, the batch's own
+    options (--batch, --jobs, --out) and their values."""
+    own = ("--batch", "--jobs", "--out")
+    out, skip = [], False
+    for token in argv[1:]:    # after the command's name
+        if skip:
+            skip = False
+        elif token in own:
+            skip = True
+        elif not token.startswith(tuple(f"{o}=" for o in own)):
+            out.append(token)
+    return out
 
 
 def _design(args: argparse.Namespace, test) -> int:

@@ -12,7 +12,7 @@ import numpy as np
 from .. import figures
 from ..lab import texture
 from ..lab.psd import NOT_FITTING
-from ..lab.readout import Suspension
+from ..lab.readout import Suspension, gs_correction
 from ..lab.sheet import Reduction, Sheet, SieveSheet, SheetError, check_sheet, standard_reduction
 from ..results import Table, write_text
 from .fit import ROUGHNESS_DECADES, draw_placement, end_placement, fit, penalty
@@ -250,13 +250,17 @@ def invert(sheets: list[Sheet], test: LabTest, folder: Path, *, sieve: SieveShee
         below = np.flatnonzero(reading < -2 * test.noise[sheet.instrument]) if sheet.instrument == "hydrometer" else []
         if len(below):
             k = below[0]
-            raise SheetError(f"{sheet.label}: the reading at {sheet.time[k] / 60:g} min is {reading[k]:.3g} g/L after "
-                             "its composite correction: the correction (blank or --zero-correction) is larger than the "
-                             "reading; check both")
+            raise SheetError(f"{sheet.where(k)}: the reading ({sheet.reading[k]:g} on the sheet) is {reading[k]:.3g} g/L "
+                             "after its composite correction: the correction (blank or --zero-correction) is larger "
+                             "than the reading; check both")
         # the tolerance: twice the reading's noise, and 2 % of the solids' signal for the sampling of a real
         # suspension (a pipette's first samples can draw a little more than the mean)
-        check_sheet(replace(sheet, reading=reading), whole_sample_reading(sheet, test, water),
-                    max(2 * test.noise[sheet.instrument], 0.02 * signal))
+        tolerance = max(2 * test.noise[sheet.instrument], 0.02 * signal)
+        check_sheet(sheet, whole_sample_reading(sheet, test, water), tolerance, reading,
+                    NOISE_OPTIONS[sheet.instrument] + ("" if sheet.instrument == "pipette" else
+                                                       f" (now {test.noise[sheet.instrument]:g} "
+                                                       f"{NOISE_UNITS[sheet.instrument]}; the tolerance is twice it, "
+                                                       "or 2 % of the solids' signal)"))
     sieves = sieve_data(sieve, split, test.noise["sieve"])
     reduction = [standard_reduction(sheet, water, c0, test.hydrometer, test.cylinder_area, test.sphere, test.meniscus,
                                     test.correction(sheet)) for sheet in sheets]
@@ -300,7 +304,8 @@ def invert(sheets: list[Sheet], test: LabTest, folder: Path, *, sieve: SieveShee
             base, jac = model(run, shares)
             shares, chi2, weight = fit(jac, base, shares, data, sigma, grid)
         percent = 100 * np.cumsum(shares)[:-1]
-        if previous is not None and np.max(np.abs(percent - previous)) < CONVERGED:
+        moved = math.inf if previous is None else float(np.max(np.abs(percent - previous)))
+        if moved < CONVERGED:
             converged = True
             break
         previous = percent
@@ -315,12 +320,19 @@ def invert(sheets: list[Sheet], test: LabTest, folder: Path, *, sieve: SieveShee
     rng = np.random.default_rng(seed)
     penalty_rows = len(penalty(grid))
     specimen_draws = []
+    # the composite correction is one reading of the blank cylinder, subtracted from every reading of the
+    # sheet: its error, a reading's, is common to them (as the thermometer's offset is)
+    blank_rows = [rows for sheet, rows in zip(sheets, rows_of) if sheet.instrument == "hydrometer"]
     for _ in range(draws):
         noisy = data + rng.normal(0.0, sigma) - rng.normal(0.0, test.thermometer) * per_degree
+        for rows in blank_rows:
+            noisy[rows] += rng.normal(0.0, test.noise["hydrometer"])
         x, _, _ = fit(jac, base, shares, noisy, sigma, grid, weight * 10 ** -rng.uniform(0, ROUGHNESS_DECADES),
                       rng.normal(0.0, 1.0, penalty_rows),
                       draw_placement(grid, rng))
-        specimen_draws.append(100 * np.cumsum(x) / x.sum())    # the top at 100 % exactly, as the sheet says
+        drawn = 100 * np.cumsum(x) / x.sum()
+        drawn[-1] = 100.0    # the top at 100 % exactly, as the sheet says (the sum leaves 99.99999999999999)
+        specimen_draws.append(drawn)
     # the tails' extreme placements the data allow: each tail's mass in its finest bin, then in its coarsest;
     # the band in a tail covers both
     extremes = []
@@ -350,8 +362,17 @@ def invert(sheets: list[Sheet], test: LabTest, folder: Path, *, sieve: SieveShee
     out = Inversion(*result, whole, rows, chi2, round_number, float(weight), resolution, inputs,
                     None if sieve is None else (sieve.opening, sieve.passing))
     out.notes.append(f"forward model: {resolution}; {round_number} round(s)" + (
-        "" if converged else f", not converged: the last round moved the PSD by more than {CONVERGED:g} points (more "
-                             "--particles steady the runs)"))
+        "" if converged else f", not converged: the last round still moved the PSD by up to {moved:.2g} points "
+                             f"(more than {CONVERGED:g}), as the hindrance of each round's PSD moves the next; the answer "
+                             "stands, but read differences smaller than that as the model's own spread, which the band "
+                             "does not hold: more --particles steady the runs"))
+    unread = [s for s in sheets if s.instrument == "hydrometer" and not len(s.blank) and test.zero_correction == 0]
+    if unread:
+        a = gs_correction(test.particle_density / 1000.0)
+        out.notes.append(f"no composite correction for {', '.join(s.path.name for s in unread)}: its readings are "
+                         "taken as corrected already; a typical blank of 2-7 g/L (dispersant, temperature, meniscus) "
+                         f"would lower percent finer by {100 * a * 2 / c0:.2g}-{100 * a * 7 / c0:.2g} points: give the "
+                         "blank column or --zero-correction")
     in_tails = [f"D{level}" for level in texture.LEVELS if _in_tail(out.diameter, out.percent, out.basis, level)]
     if in_tails:
         out.notes.append(f"{', '.join(in_tails)} lie(s) in a tail, where the data give the mass but not its placement: "
@@ -384,7 +405,9 @@ def _in_tail(diameter: np.ndarray, percent: np.ndarray, basis: np.ndarray, level
 
 
 NOISE_UNITS = {"hydrometer": "g/L", "pipette": "g/L", "buoyancy": "g", "sieve": "points"}
+NOISE_OPTIONS = {"hydrometer": "--hydrometer-noise", "pipette": "--pipette-noise", "buoyancy": "--balance-noise"}
 STEP_WARNING = 15.0        # points between the coarsest cut and the next sieve that deserve a second look
+STEP_STEEPNESS = 50.0      # and per decade of diameter: a soil's silt rises by 20-40 points a decade
 
 
 def _sieves_step(grid: SizeGrid, shares: np.ndarray, sieves: SieveData) -> str | None:
@@ -396,11 +419,14 @@ def _sieves_step(grid: SizeGrid, shares: np.ndarray, sieves: SieveData) -> str |
         return None
     cumulative = 100 * np.cumsum(shares)
     rise = cumulative[above[0]] - cumulative[cut]
-    if rise < STEP_WARNING:
+    # per decade of diameter: a protocol whose last cut is far below the sieves (4 h and 21 h readings, cuts
+    # near 5 um, the 53 um sieve) spans a decade of silt, which rises there by itself
+    steepness = rise / math.log10(grid.edges[above[0]] / grid.edges[cut])
+    if rise < STEP_WARNING or steepness < STEP_STEEPNESS:
         return None
     return (f"check: the curve rises by {rise:.3g} points between the coarsest reading's cut ({grid.edges[cut] * 1e6:.3g} "
-            f"um) and the {grid.edges[above[0]] * 1e3:g} mm sieve: a gap in the grading, or a wrong --mass or a sieve "
-            "sheet of another sample, which a step there absorbs")
+            f"um) and the {grid.edges[above[0]] * 1e3:g} mm sieve ({steepness:.3g} points per decade of diameter): a "
+            "gap in the grading, or a wrong --mass or a sieve sheet of another sample, which a step there absorbs")
 
 
 def _inputs_line(test: LabTest, inputs: dict) -> str:

@@ -16,12 +16,11 @@ import numpy as np
 
 from .. import _core
 from ..results import Table, write_text
-from ..constants import (D422_CYLINDER_AREA, GRAVITY, LAB_TEMPERATURE, SCHEDULES, SOIL_PARTICLE_DENSITY,
+from ..constants import (D422_CYLINDER_AREA, GRAVITY, LAB_TEMPERATURE, NOMINAL_BULB_LENGTH, NOMINAL_BULB_VOLUME,
+                         SCHEDULES, SOIL_PARTICLE_DENSITY,
                          WATER_20C_DENSITY, WATER_20C_VISCOSITY)
 
 R_FACTOR = 1 - 1 / 2.65    # 152H: R = (rho_s - rho_w) / 0.6226 in g/L, calibrated for Gs = 2.65
-NOMINAL_BULB_LENGTH = 0.140    # m, the 152H of D422
-NOMINAL_BULB_VOLUME = 67.0e-6  # m3
 
 @dataclass(frozen=True)
 class Suspension:

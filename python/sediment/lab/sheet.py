@@ -53,6 +53,12 @@ class Sheet:
     temperature: np.ndarray
     depth: np.ndarray = field(default_factory=lambda: np.empty(0))
     blank: np.ndarray = field(default_factory=lambda: np.empty(0))    # 152H composite correction per reading
+    lines: tuple[int, ...] = ()    # each reading's line in the file, for messages
+
+    def where(self, k: int) -> str:
+        """Reading k as a message names it: its line in the file, and its time."""
+        line = f"line {self.lines[k]}, " if self.lines else ""
+        return f"{self.label}, {line}{self.time[k] / 60:g} min"
 
     @property
     def label(self) -> str:
@@ -136,7 +142,7 @@ def read_sheet(path: str | Path, pipette_volume: float = 25e-6, stirred: str | N
     else:
         _plausible(path, lines, values, "apparent_mass_g", "apparent_mass_g")
         reading = values["apparent_mass_g"]
-    return Sheet(kind, path, time, reading, temperature, depth, blank)
+    return Sheet(kind, path, time, reading, temperature, depth, blank, tuple(lines))
 
 
 def clock_minutes(text: str, where: str) -> int:
@@ -267,29 +273,39 @@ def read_temperature_record(path: str | Path, t_end: float | None = None) -> tup
     return record
 
 
-def check_sheet(sheet: Sheet, whole: float, resolution: float) -> None:
+def check_sheet(sheet: Sheet, whole: float, resolution: float, corrected: np.ndarray | None = None,
+                noise_option: str = "") -> None:
     """Refuses what no sedimenting suspension reads: a reading beyond `whole` (what the whole sample in
     suspension reads, in the instrument's unit) or one that moves back towards it with time by more than
     the reading's `resolution` (the solids at a depth only fall as the test goes on; a pipette is held
-    to this between samples at one depth)."""
+    to this between samples at one depth). `corrected`: the readings after their composite correction
+    (the sheet's own are named beside them); `noise_option`: the option that states the reading error."""
+    values = sheet.reading if corrected is None else corrected
+
+    def named(k: int) -> str:
+        after = "" if corrected is None or corrected[k] == sheet.reading[k] else f", {values[k]:g} after its correction"
+        return f"{sheet.reading[k]:g} on the sheet{after}"
     # the solids signal, falling with time: the sphere's apparent mass rises as the suspension thins
-    signal, top = (-sheet.reading, -whole) if sheet.instrument == "buoyancy" else (sheet.reading, whole)
+    signal, top = (-values, -whole) if sheet.instrument == "buoyancy" else (values, whole)
     over = np.flatnonzero(signal > top + resolution)
     if len(over):
         k = over[0]
-        raise SheetError(f"{sheet.label}: the reading at {sheet.time[k] / 60:g} min ({sheet.reading[k]:g}) is beyond what "
-                         f"the whole sample in suspension reads ({whole:.4g}): check the sample mass, the units or the "
-                         "sheet")
-    if sheet.instrument == "pipette" and sheet.reading.max() < 0.005 * whole:
+        raise SheetError(f"{sheet.where(k)}: the reading ({named(k)}) is beyond what the whole sample in suspension "
+                         f"reads ({whole:.4g}): check the sample mass, the units or the sheet")
+    if sheet.instrument == "pipette" and values.max() < 0.005 * whole:
         raise SheetError(f"{sheet.label}: every sample weighs under 0.5 % of what the whole sample in suspension gives "
                          f"({whole:.4g} g): mass_g is in grams (masses in kg?), or the sample mass is wrong")
     same_depth = np.ones(len(signal), bool) if sheet.instrument != "pipette" else np.r_[True, np.diff(sheet.depth) == 0]
     rises = np.flatnonzero((np.diff(signal) > resolution) & same_depth[1:])
     if len(rises):
         k = rises[0] + 1
-        raise SheetError(f"{sheet.label}: the reading at {sheet.time[k] / 60:g} min ({sheet.reading[k]:g}) goes back "
-                         f"towards the initial one by more than the tolerance ({resolution:.3g}): the solids "
-                         "at a depth only fall as the test goes on (a misread, or a flocculating sample)")
+        larger = (f"; if the laboratory reads less finely, state its reading error with {noise_option}"
+                  if noise_option else "")
+        raise SheetError(f"{sheet.where(k)}: the reading ({named(k)}) goes back towards the initial one from the "
+                         f"reading before it ({sheet.where(k - 1).split(', ')[-1]}: {named(k - 1)}) by "
+                         f"{abs(values[k] - values[k - 1]):.3g}, more than the tolerance ({resolution:.3g}): the solids "
+                         "at a depth only fall as the test goes on, so one of the two is misread (or the sample "
+                         f"flocculates){larger}")
 
 
 @dataclass(frozen=True)

@@ -43,6 +43,7 @@ USDA_POLYGONS: dict[str, tuple[tuple[float, float], ...]] = {
     "silty clay": ((40, 40), (40, 60), (60, 40)),
     "clay": ((40, 15), (40, 40), (60, 40), (100, 0), (55, 0)),
 }
+CLOSED = 1e-9                              # points: a curve's end within this of 0 or 100 % is closed
 UNKNOWN = "unknown"                       # the class row of draws (or a curve) whose fractions are not known
 CENTRAL_CLASS = "USDA class (central)"    # texture.csv: the system of the central curve's class row
 DRAWS_CLASS = "USDA class"                # texture.csv: the system of the other classes the draws fall in
@@ -86,8 +87,9 @@ def percent_at(diameter, percent, at) -> np.ndarray:
     k = np.clip(np.searchsorted(x, t, side="right"), 1, x.size - 1)
     w = np.clip((t - x[k - 1]) / (x[k] - x[k - 1]), 0.0, 1.0)
     out = rows[:, k - 1] * (1 - w) + rows[:, k] * w
-    out[:, t < x[0]] = np.where(rows[:, :1] <= 0.0, 0.0, np.nan)
-    out[:, t > x[-1]] = np.where(rows[:, -1:] >= 100.0, 100.0, np.nan)
+    # a closed end within rounding (a draw's 100 * cumsum / sum may end at 99.99999999999999)
+    out[:, t < x[0]] = np.where(rows[:, :1] <= CLOSED, 0.0, np.nan)
+    out[:, t > x[-1]] = np.where(rows[:, -1:] >= 100.0 - CLOSED, 100.0, np.nan)
     return out.reshape(p.shape[:-1] + np.shape(at))
 
 
@@ -314,7 +316,12 @@ class TextureReport:
         name = self.usda or UNKNOWN
         if not self.class_share:
             return f"{name} (no draws)"
-        return f"{name} ({self.class_share.get(name, 0.0):.0f} % of the draws)"
+        unknown = self.class_share.get(UNKNOWN, 0.0)
+        if not unknown or name == UNKNOWN:
+            return f"{name} ({self.class_share.get(name, 0.0):.0f} % of the draws)"
+        # the share among the draws that have a class, and why the others have none
+        return (f"{name} ({100 * self.class_share.get(name, 0.0) / (100 - unknown):.0f} % of the draws with a class; "
+                f"{unknown:.0f} % have none: their curve does not reach 2 mm, so their fine earth is not known)")
 
     def table(self) -> Table:
         """texture.csv's table with the class and the gradation as notes, for a terminal."""
