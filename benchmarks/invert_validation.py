@@ -71,9 +71,10 @@ def synthesise(psd_path: Path, folder: Path, soil: bool = False) -> list[Path]:
     hydro = np.array(SCHEDULES["d7928"], float) * 60
     # the 152H floats in the run's water with a dispersant (DISPERSANT g/L on its scale), and the companion
     # cylinder of that liquid, read beside it, is the blank: both read to 0.5 g/L as a laboratory reads them
+    hydrometer = Hydrometer.astm_152h()
     blank = (column.suspension.fluid_density - WATER_20C_DENSITY) / R_FACTOR + DISPERSANT
-    liquid = replace(column.suspension, fluid_density=WATER_20C_DENSITY + R_FACTOR * blank)
-    readings = Hydrometer.astm_152h().read(replace(column, suspension=liquid), hydro).reading
+    liquid = replace(column.suspension, fluid_density=float(hydrometer.liquid_density(blank)))
+    readings = hydrometer.read(replace(column, suspension=liquid), hydro).reading
     lines = ["time_min,reading,temperature_C,blank"] + [
         f"{t / 60:g},{np.round(r / 0.5) * 0.5:g},{np.round(c, 1):g},{np.round(blank / 0.5) * 0.5:g}"
         for t, r, c in zip(hydro, readings, drift(hydro))]

@@ -47,7 +47,7 @@ def test_readings_no_suspension_gives_are_refused(tmp_path):
     test, water = LabTest(0.050), Suspension()    # whole + 5 within the 152H's scale
     rising = read_sheet(_sheet(tmp_path, HYDROMETER + "1,45,20\n2,40,20\n4,42,20\n"))
     whole = whole_sample_reading(rising, test, water)
-    with pytest.raises(SheetError, match="at 4 min .* goes back towards the initial one"):
+    with pytest.raises(SheetError, match="line 4, 4 min: the reading .* goes back towards the initial one"):
         check_sheet(rising, whole, 0.5)
     above = read_sheet(_sheet(tmp_path, HYDROMETER + f"1,{whole + 5:g},20\n2,40,20\n"))
     with pytest.raises(SheetError, match="beyond what the whole sample in suspension reads"):
@@ -120,7 +120,7 @@ def test_a_cut_is_the_stokes_diameter_in_dilute_water_and_coarser_where_the_susp
     for mass, percent, low, high in [(1e-6, 0.0, 0.995, 1.005), (0.06, 100.0, 1.03, 1.08)]:
         test = LabTest(mass)
         reading = np.full(3, percent / 100 * test.initial_concentration)
-        cuts = cut_diameters([sheet], [reading], [times], test, water)
+        cuts = cut_diameters([replace(sheet, reading=reading)], [times], test, water)
         ratio = cuts / water.stokes_diameter(0.10, times)
         assert np.all((low < ratio) & (ratio < high)), ratio
 

@@ -17,7 +17,8 @@ EXAMPLES = [
     'sediment invert examples/inverse/soil/hydrometer.csv examples/inverse/soil/sieve.csv --mass 0.05 --out out/soil',
     'sediment invert examples/inverse/hydrometer.csv examples/inverse/pipette.csv --mass 0.06 --out out/invert',
     'sediment invert --design examples/granulometry/psd/sample5.csv --out out/design',
-    'sediment invert --batch examples/inverse/batch --out out/batch',
+    'sediment invert --batch examples/inverse/real-lab --hydrometer-calibration examples/inverse/real-lab/hydrometer_1.csv '
+    '--bulb-volume 55e-6 --bulb-length 0.137 --particle-density 2700 --meniscus 1 --out out/real-lab',
 ]
 
 
@@ -141,8 +142,9 @@ def run(args: argparse.Namespace) -> int:
     # each within its range, the two may still make a cylinder no laboratory has (27.8 cm2 typed as 0.0278)
     check(args.cylinder_area * height * 1e3, "suspension_volume",
           f"--cylinder-area {args.cylinder_area:g} m2 x height {height:g} m:")
-    check(height, "suspension_height", f"the suspension's height ({'--volume / ' if args.height is None else ''}"
-          "--cylinder-area):")
+    volume = args.cylinder_area * height
+    check(height, "suspension_height", f"--cylinder-area {args.cylinder_area:g} m2 makes the {volume * 1e3:.4g} L "
+          "suspension's height")
     sphere = sphere_density(args.sphere_mass, args.sphere_diameter)
     if sphere is not None:
         raise ValueError(sphere)

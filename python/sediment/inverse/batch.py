@@ -110,9 +110,9 @@ def run_batch(samples: list[Sample], common: list[str], out: Path, logs: Path, j
             continue
         todo.append((sample, key))
     total = len(samples)
-    for name, row in rows.items():
-        print(f"[{len(rows)}/{total}] {name}: {row['status']}" + (" (done before with the same inputs)" if
-                                                                   row.get("reused") else ""), flush=True)
+    for k, (name, row) in enumerate(rows.items(), 1):
+        print(f"[{k}/{total}] {name}: {row['status']}" + (" (done before with the same inputs)" if
+                                                           row.get("reused") else ""), flush=True)
 
     def invert_one(sample: Sample, key: str) -> dict:
         command = [sys.executable, "-m", "sediment", "invert", *map(str, sample.sheets), *common, *sample.options,

@@ -12,8 +12,7 @@ import numpy as np
 
 from .. import _core
 from ..lab.psd import PSD
-from ..constants import WATER_20C_DENSITY
-from ..lab.readout import R_FACTOR, BuoyancySphere, Column, Hydrometer, Pipette, Suspension, gs_correction
+from ..lab.readout import BuoyancySphere, Column, Hydrometer, Pipette, Suspension, gs_correction
 from ..lab.sheet import Sheet, standard_reduction
 from .grid import SizeGrid
 
@@ -129,7 +128,7 @@ class ForwardRun:
         out = np.empty(len(times))
         for value in np.unique(liquid):
             at = liquid == value
-            density = WATER_20C_DENSITY + R_FACTOR * value    # the 152H's scale: 0.6226 kg/m3 per g/L
+            density = float(self.test.hydrometer.liquid_density(value))
             read = self.test.hydrometer.read(replace(column, suspension=replace(self.water, fluid_density=density)),
                                              times[at], cylinder_area=self.test.cylinder_area).reading
             out[at] = read - value

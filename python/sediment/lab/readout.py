@@ -277,6 +277,12 @@ class Hydrometer:
         below = r[-1] + (distance - h[-1]) * (r[-1] - r[-2]) / (h[-1] - h[-2])
         return np.where(distance > h[0], above, np.where(distance < h[-1], below, inside))
 
+    def liquid_density(self, reading) -> np.ndarray:
+        """The density [kg/m3] of a uniform liquid in which the instrument reads `reading` [g/L]: it floats
+        there with its bulb's centre `centre_distance(reading)` below the surface."""
+        top = self.centre_distance(reading) - self.bulb_length / 2
+        return self.mass / (self.bulb_volume + self.stem_area * top)
+
     def effective_depth(self, reading, cylinder_area: float = D422_CYLINDER_AREA):
         """D7928's H_m [m]: the bulb's centre below the surface at `reading` (corrected for the
         meniscus), less the rise of the surface as the bulb enters, V_B / 2A."""
