@@ -126,6 +126,9 @@ RANGES: dict[str, Range] = {
     "record_time_min": Range("min", 0.0, 10080.0, "a temperature record of a test lasting up to a week",
                              (("s", _times(1 / 60)),)),
     "reading": Range("g/L", -5.0, 60.0, "a 152H's scale runs from -5 to 60 g/L"),
+    "reading_151h": Range("", 0.995, 1.04, "a 151H's scale runs from 0.995 to 1.038 (specific gravity)"),
+    "blank_151h": Range("", 0.99, 1.0125, "a 151H in the control cylinder (water and dispersant) reads about 1.000 "
+                        "to 1.006"),
     "depth_cm": Range("cm", 1.0, 200.0, "a pipette's depth in a settling column", (("m", _times(100.0)), ("mm", _times(0.1)))),
     "calibration_cm": Range("cm", 0.5, 40.0, "a hydrometer's graduation lies a few to 25 cm above its bulb's centre "
                             "(152H: 10-21 cm)", (("mm", _times(0.1)), ("m", _times(100.0)))),

@@ -13,12 +13,13 @@ import pytest
 
 from sediment.cli import main
 from sediment.inverse.model import ForwardRun, LabTest
-from sediment.lab.readout import Column, Hydrometer, Suspension
+from sediment.lab.readout import SCALES, Column, Hydrometer, Suspension
 from sediment.lab.sheet import SheetError, read_hydrometer_calibration, read_sheet, standard_reduction
 
 REPO = Path(__file__).resolve().parents[2]
 REAL = REPO / "examples" / "inverse" / "real-lab"
 SAMPLES = sorted(p for p in REAL.iterdir() if p.is_dir())
+REDUCED = [p for p in SAMPLES if (p / "reference_reduction.csv").exists()]    # the laboratory's own reduction
 CALIBRATION = REAL / "hydrometer_1.csv"
 LAB = ["--hydrometer-calibration", str(CALIBRATION), "--bulb-volume", "55e-6", "--bulb-length", "0.137",
        "--particle-density", "2700", "--meniscus", "1"]
@@ -32,7 +33,7 @@ def _lab_test(sample: Path, meniscus: float) -> tuple[LabTest, Hydrometer]:
     return LabTest(mass, 2700.0, area, 1e-3 / area, hydrometer=hydrometer, meniscus=meniscus), hydrometer
 
 
-@pytest.mark.parametrize("sample", SAMPLES, ids=[p.name for p in SAMPLES])
+@pytest.mark.parametrize("sample", REDUCED, ids=[p.name for p in REDUCED])
 def test_the_standard_reduction_with_the_laboratorys_apparatus_is_the_laboratorys(sample):
     """Percent finer within 0.2 points and diameters within 1.5 % of the laboratory's own reduction at every
     reading, with its calibration, cylinder, air-dry mass and the meniscus as its code applies it (the
@@ -90,6 +91,73 @@ def test_a_calibration_is_read_linear_between_and_beyond_its_rows_both_ways():
     assert h.reading_at(h.centre_distance(readings)) == pytest.approx(readings)
 
 
+def _as_151h(text: str) -> str:
+    """A 152H sheet or calibration as a 151H on the same stem reads it: 1 + 0.6226 R / 1000."""
+    rows = [line.split(",") for line in text.strip().splitlines()]
+    columns = [k for k, name in enumerate(rows[0]) if name in ("reading", "blank")]
+    for row in rows[1:]:
+        for k in columns:
+            row[k] = f"{1 + float(row[k]) * (1 - 1 / 2.65) / 1000:.7f}"
+    return "\n".join(",".join(row) for row in rows) + "\n"
+
+
+def test_a_151h_sheet_reduces_as_d422_says_and_as_the_same_stems_152h(tmp_path):
+    """The 151H reads specific gravity on the 152H's stem (D422 3.2): its sheet reduces to D422's percent
+    finer, 100 000 / W x G / (G - 1) x (R - R_blank), and to the 152H's diameters; the nominal 151H's
+    effective depth is D422's table (16.3 cm at 1.000, 11.0 at 1.020, 8.1 at 1.031, read to 0.1 cm)."""
+    sample = SAMPLES[0]
+    sheet151 = tmp_path / "hydrometer.csv"
+    sheet151.write_text(_as_151h((sample / "hydrometer.csv").read_text()))
+    calibration151 = tmp_path / "calibration.csv"
+    calibration151.write_text(_as_151h(CALIBRATION.read_text()))
+    test, hydrometer = _lab_test(sample, 1.0)
+    water = Suspension.at_temperature(22.0, 2700.0)
+    raw = np.genfromtxt(sheet151, delimiter=",", names=True)
+    reductions = []
+    for sheet, calibration in ((read_sheet(sample / "hydrometer.csv"), CALIBRATION),
+                               (read_sheet(sheet151, scale=SCALES["151H"]), calibration151)):
+        instrument = Hydrometer.calibrated(*read_hydrometer_calibration(calibration, sheet.scale), 55e-6, 0.137)
+        reductions.append(standard_reduction(sheet, water, test.initial_concentration, instrument, test.cylinder_area,
+                                             test.sphere, test.meniscus, test.correction(sheet)))
+    gs = 2.7
+    d422 = 1e5 / (test.mass * 1e3) * gs / (gs - 1) * (raw["reading"] - raw["blank"])
+    assert np.allclose(reductions[1].percent, d422, atol=1e-9)
+    assert np.allclose(reductions[1].percent, reductions[0].percent, atol=1e-3)
+    assert np.allclose(reductions[1].diameter, reductions[0].diameter, rtol=1e-5)
+    nominal = Hydrometer.astm_152h()
+    depth = nominal.effective_depth(SCALES["151H"].grams([1.000, 1.020, 1.031])) * 100
+    assert depth == pytest.approx([16.3, 11.0, 8.1], abs=0.1)
+
+
+def test_a_sheet_on_the_other_hydrometers_scale_is_refused_naming_the_option(tmp_path, capsys):
+    sample = SAMPLES[0]
+    sheet151 = tmp_path / "hydrometer.csv"
+    sheet151.write_text(_as_151h((sample / "hydrometer.csv").read_text()))
+    with pytest.raises(SheetError, match="look like specific gravities: a 151H's sheet needs --hydrometer-type 151H"):
+        read_sheet(sheet151)
+    with pytest.raises(SheetError, match="look like a 152H's g/L, not the specific gravities of a 151H"):
+        read_sheet(sample / "hydrometer.csv", scale=SCALES["151H"])
+    high = tmp_path / "high.csv"
+    high.write_text("time_min,reading,temperature_C\n1,1.045,20\n")
+    with pytest.raises(SheetError, match="line 2: reading 1.045 is not within 0.995-1.04: a 151H's scale"):
+        read_sheet(high, scale=SCALES["151H"])
+    blank = tmp_path / "blank.csv"
+    blank.write_text("time_min,reading,temperature_C,blank\n1,1.02,20,0.004\n")
+    with pytest.raises(SheetError, match="blank 0.004 is not within 0.99-1.0125: a 151H in the control cylinder"):
+        read_sheet(blank, scale=SCALES["151H"])
+    out = ["--mass", "0.025", "--hydrometer-type", "151H", "--out", str(tmp_path / "out")]
+    assert "--meniscus 0.05 (151H) as a 152H's: 80.303 g/L is not within -5 to 5 g/L" in _refusal(
+        capsys, ["invert", str(sheet151), *out, "--meniscus", "0.05"])
+    assert "--hydrometer-noise 0 (151H) as a 152H's: 0 g/L is not within" in _refusal(
+        capsys, ["invert", str(sheet151), *out, "--hydrometer-noise", "0"])
+    # a 151H's rise is quoted as read, with its reading error in its own unit
+    risen = tmp_path / "risen.csv"
+    risen.write_text(sheet151.read_text().replace("598.0,1.0087170", "598.0,1.0098000"))
+    message = _refusal(capsys, ["invert", str(risen), *out])
+    assert "line 8, 598 min: the reading (1.0098 (15.7 g/L of a 152H) on the sheet" in message
+    assert "--hydrometer-noise (now 0.000156 in specific gravity (0.25 g/L of a 152H)" in message
+
+
 def test_clock_times_count_from_the_stirring_and_past_midnight(tmp_path):
     sheet = tmp_path / "h.csv"
     sheet.write_text("clock,reading,temperature_C\n23:51,30,22\n23:55,28,22\n00:10,27,22\n02:00,25,22\n23:40,20,22\n")
@@ -102,6 +170,12 @@ def test_clock_times_count_from_the_stirring_and_past_midnight(tmp_path):
     sheet.write_text("clock,reading,temperature_C\n9:61,30,22\n")
     with pytest.raises(SheetError, match="line 2: '9:61' is not a clock time"):
         read_sheet(sheet, stirred="09:00")
+    # a laboratory's 12-hour clock (Penn State's 2022 sheets), stirred 9:17 AM, read into the next morning
+    sheet.write_text("clock,reading,temperature_C\n9:19 AM,30,22\n12:05 PM,28,22\n7:16 PM,27,22\n10:30 AM,25,22\n")
+    assert read_sheet(sheet, stirred="9:17 AM").time / 60 == pytest.approx([2, 168, 599, 1513])
+    sheet.write_text("clock,reading,temperature_C\n13:19 PM,30,22\n")
+    with pytest.raises(SheetError, match="'13:19 PM' is not a clock time: HH:MM on 24 hours"):
+        read_sheet(sheet, stirred="1:00 PM")
 
 
 def _refusal(capsys, argv) -> str:
@@ -146,11 +220,34 @@ def test_a_two_reading_protocol_fits_without_a_false_alarm_and_its_lab_apparatus
     assert code == 0, printed
     assert "check: the curve rises" not in printed
     assert "suspension 1000 mL in a cylinder of 26.4 cm2" in printed
-    assert "hydrometer calibrated: H_r 20.3 cm at -5 g/L, 8.6 cm at 60 g/L; bulb 55 mL, 13.7 cm" in printed
+    assert "hydrometer 152H: calibrated: H_r 20.3 cm at -5 g/L, 8.6 cm at 60 g/L; bulb 55 mL, 13.7 cm" in printed
     assert "unknown" not in (tmp_path / "out" / "texture.csv").read_text()
     summary = json.loads((tmp_path / "out" / "invert.json").read_text())
     assert summary["inputs"]["mass"] == pytest.approx(options["air-dry-mass"] / (1 + options["water-content"]))
     assert summary["inputs"]["hydrometer"]["calibration"] == [[-5.0, 0.203], [60.0, 0.086]]
+
+
+def _sample_options(sample: Path) -> list[str]:
+    """A sample's sample.json as the options of `sediment invert` (as the batch passes them)."""
+    options = json.loads((sample / "sample.json").read_text())
+    sheets = [str(sample / name) for name in options.pop("sheets")]
+    return sheets + [word for name, value in options.items() for word in (f"--{name}", str(value))]
+
+
+def test_a_sheet_as_kept_with_gravel_in_its_sieves_fits_and_says_what_its_class_is_of(tmp_path, capsys):
+    """Penn State's 2022 sheet of a sandy loam with 14.6 % gravel: a 12-hour clock read into the next day,
+    sieves to 6.73 mm. The USDA class is of the fine earth, its fractions sum to 100; ISO's gravel is the
+    sieves' 100 - P(2 mm); the console says how USDA names a gravel modifier."""
+    sample = REAL / "p24_ryan_shaffer_r1"
+    code = main(["invert", *_sample_options(sample), *LAB, "--particles", "4000", "--out", str(tmp_path / "out")])
+    printed = capsys.readouterr().out
+    assert code == 0, printed
+    report = json.loads((tmp_path / "out" / "invert.json").read_text())["texture"]
+    usda = report["fractions"]["USDA"]
+    assert sum(usda[name]["percent"] for name in ("clay", "silt", "sand")) == pytest.approx(100.0)
+    assert report["fractions"]["ISO 14688-1"]["gravel"]["percent"] == pytest.approx(100 - 85.38, abs=0.01)
+    assert "14.6 % of the sample's mass is gravel, which USDA names by volume" in printed
+    assert "check: the curve rises" not in printed and "unknown" not in (tmp_path / "out" / "texture.csv").read_text()
 
 
 def test_a_batch_inverts_every_sample_names_the_broken_one_and_resumes(tmp_path, capsys):

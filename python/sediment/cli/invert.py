@@ -10,7 +10,7 @@ from pathlib import Path
 from ..constants import (D422_CYLINDER_AREA, NOMINAL_BULB_LENGTH, NOMINAL_BULB_VOLUME, SOIL_PARTICLE_DENSITY,
                          SUSPENSION_VOLUME)
 from ..results import write_text
-from .types import count, quantity, quantity_list
+from .types import count, finite, quantity, quantity_list
 
 
 EXAMPLES = [
@@ -29,7 +29,8 @@ def add_parser(commands) -> argparse.ArgumentParser:
         "texture and gradation out, with bands, the standard reduction beside it and the fit's verdict",
         description="Fits the PSD whose simulated test (the best physics: standard drag curve, Richardson & Zaki's "
         "hindrance, the water at the sheet's temperatures) reads what the sheets read. Sheets are CSV: "
-        "time_min,reading,temperature_C[,blank] (152H, g/L); time_min,depth_cm,mass_g (pipette); "
+        "time_min,reading,temperature_C[,blank] (152H g/L, or 151H specific gravity); time_min,depth_cm,mass_g "
+        "(pipette); "
         "time_min,apparent_mass_g (buoyancy sphere); opening_mm,percent_passing (sieves, of the whole sample). "
         "Writes OUT/psd.csv (diameter_um,percent_finer,low,high,measured,basis), texture.csv, gradation.csv, "
         "reduction.csv, fit.csv, invert.json and the figures invert.png, gradation.png, texture.png. Exit 3: no PSD "
@@ -76,8 +77,12 @@ def add_parser(commands) -> argparse.ArgumentParser:
     parser.add_argument("--height", type=quantity("suspension_height"),
                         help="instead of --volume: the suspension's height [m] (the volume is then --cylinder-area x "
                         "--height)")
+    parser.add_argument("--hydrometer-type", choices=("152H", "151H"), default="152H",
+                        help="the hydrometer's scale: 152H (g/L of soil, the default) or 151H (specific gravity, 0.995 "
+                        "to 1.038); the two have the same dimensions. The sheets' readings and blanks, the "
+                        "calibration's readings, --zero-correction, --meniscus and --hydrometer-noise are in its unit")
     parser.add_argument("--hydrometer-calibration", type=Path, metavar="CSV",
-                        help="the laboratory's calibration of its 152H (D7928): reading,distance_cm, the distance from "
+                        help="the laboratory's calibration of its hydrometer (D7928): reading,distance_cm, the distance from "
                         "the graduation of each reading to the bulb's centre, two rows or more (default: the nominal "
                         "152H of D422)")
     parser.add_argument("--bulb-volume", type=quantity("bulb_volume"), default=NOMINAL_BULB_VOLUME,
@@ -87,17 +92,20 @@ def add_parser(commands) -> argparse.ArgumentParser:
     parser.add_argument("--stirred", metavar="HH:MM",
                         help="when the suspension was stirred, for sheets that give clock times (a clock column, "
                         "HH:MM, instead of time_min)")
-    parser.add_argument("--zero-correction", type=quantity("correction"), default=0.0,
-                        help="152H composite correction [g/L], subtracted from each reading (dispersant, zero)")
-    parser.add_argument("--meniscus", type=quantity("meniscus"),
-                        default=0.0, help="152H meniscus correction [g/L], for the depth")
+    parser.add_argument("--zero-correction", type=finite, default=0.0,
+                        help="composite correction (dispersant, zero), subtracted from each reading [152H g/L; 151H: "
+                        "its reading in the control cylinder less 1]")
+    parser.add_argument("--meniscus", type=finite, default=0.0,
+                        help="meniscus correction, added to each reading for its depth [152H g/L, about 1; 151H: about "
+                        "0.0006]")
     parser.add_argument("--sphere-depth", type=quantity("instrument_depth"),
                         help="buoyancy sphere centre depth [m] (default 0.3 H)")
     parser.add_argument("--sphere-diameter", type=quantity("sphere_diameter"), default=0.025, help="[m]")
     parser.add_argument("--sphere-mass", type=quantity("sphere_mass"), default=0.020, help="[kg]")
     parser.add_argument("--pipette-volume", type=quantity("pipette_volume"), default=25e-6, help="[m3] (default 25 mL)")
-    parser.add_argument("--hydrometer-noise", type=quantity("hydrometer_noise"), default=0.25,
-                        help="standard uncertainty of a 152H reading [g/L] (default 0.25: read to 0.5 g/L)")
+    parser.add_argument("--hydrometer-noise", type=finite,
+                        help="standard uncertainty of a hydrometer reading [152H g/L, default 0.25: read to 0.5 g/L; "
+                        "151H default 0.00016, the same]")
     parser.add_argument("--balance-noise", type=quantity("balance_noise"),
                         default=1e-3, help="of a sphere's apparent mass [g]")
     parser.add_argument("--pipette-noise", type=quantity("pipette_noise"),
@@ -120,6 +128,7 @@ def add_parser(commands) -> argparse.ArgumentParser:
 def run(args: argparse.Namespace) -> int:
     """Reads the sheets, inverts, prints the PSD and the verdict, writes the report."""
     from ..inverse import LabTest
+    from ..lab.readout import SCALES
     from ..lab.sheet import read_sheet
     from ..plausible import check, sphere_density
 
@@ -148,13 +157,17 @@ def run(args: argparse.Namespace) -> int:
     sphere = sphere_density(args.sphere_mass, args.sphere_diameter)
     if sphere is not None:
         raise ValueError(sphere)
-    noise = {"hydrometer": args.hydrometer_noise, "buoyancy": args.balance_noise,
+    scale = SCALES[args.hydrometer_type]
+    hydrometer_noise, zero_correction, meniscus = (
+        hydrometer_step(args, "hydrometer_noise", "hydrometer_noise", 0.25), hydrometer_step(args, "zero_correction"),
+        hydrometer_step(args, "meniscus"))
+    noise = {"hydrometer": hydrometer_noise, "buoyancy": args.balance_noise,
              "pipette": args.pipette_noise / (args.pipette_volume * 1e3), "sieve": args.sieve_noise}
     test = LabTest(0.060 if mass is None else mass, args.particle_density, args.cylinder_area, height,
-                   hydrometer=hydrometer(args), zero_correction=args.zero_correction, meniscus=args.meniscus,
+                   hydrometer=hydrometer(args), zero_correction=zero_correction, meniscus=meniscus,
                    sphere_depth=args.sphere_depth, sphere_diameter=args.sphere_diameter, sphere_mass=args.sphere_mass,
                    noise=noise, thermometer=args.thermometer)
-    sheets = [read_sheet(p, args.pipette_volume, args.stirred) for p in args.sheets]
+    sheets = [read_sheet(p, args.pipette_volume, args.stirred, scale) for p in args.sheets]
     _refuse_repeats(sheets)
     sieves = [s for s in sheets if s.instrument == "sieve"]
     if len(sieves) > 1:
@@ -182,14 +195,30 @@ def specimen_mass(args: argparse.Namespace) -> float | None:
     return args.air_dry_mass / (1 + args.water_content)
 
 
+def hydrometer_step(args: argparse.Namespace, option: str, quantity: str = "", default: float = 0.0) -> float:
+    """An option given in the hydrometer's unit (a correction, the meniscus, the reading error) as the
+    152H's g/L, checked against what a 152H's can plausibly be; `default` [g/L] where it is not given."""
+    from ..lab.readout import SCALES
+    from ..plausible import check
+
+    value = getattr(args, option)
+    if value is None:
+        return default
+    scale = SCALES[args.hydrometer_type]
+    grams = value * scale.per_unit
+    named = f"--{option.replace('_', '-')}" + ("" if scale.name == "152H" else f" {value:g} (151H) as a 152H's:")
+    return check(grams, quantity or option.replace("zero_", ""), named)
+
+
 def hydrometer(args: argparse.Namespace):
-    """The 152H the options describe: the laboratory's calibration, or the nominal one of D422."""
-    from ..lab.readout import Hydrometer
+    """The hydrometer the options describe: the laboratory's calibration, or the nominal one of D422 (the
+    151H's dimensions are the 152H's)."""
+    from ..lab.readout import SCALES, Hydrometer
     from ..lab.sheet import read_hydrometer_calibration
 
     if args.hydrometer_calibration is None:
         return Hydrometer.astm_152h(bulb_length=args.bulb_length, bulb_volume=args.bulb_volume)
-    readings, distances = read_hydrometer_calibration(args.hydrometer_calibration)
+    readings, distances = read_hydrometer_calibration(args.hydrometer_calibration, SCALES[args.hydrometer_type])
     try:
         return Hydrometer.calibrated(readings, distances, args.bulb_volume, args.bulb_length)
     except ValueError as exc:

@@ -12,7 +12,7 @@ import numpy as np
 from .. import figures
 from ..lab import texture
 from ..lab.psd import NOT_FITTING
-from ..lab.readout import Suspension, gs_correction
+from ..lab.readout import SCALES, Suspension, gs_correction
 from ..lab.sheet import Reduction, Sheet, SieveSheet, SheetError, check_sheet, standard_reduction
 from ..results import Table, write_text
 from .fit import ROUGHNESS_DECADES, draw_placement, end_placement, fit, penalty
@@ -86,15 +86,21 @@ class Inversion:
         folder = Path(folder)
         first = "" if self.consistent else f"# {NOT_FITTING}: these files come from a fit that does not explain the " \
                                            "sheets (invert.json, 'notes')\n"
-        reduction = Table(["instrument", "time_min", "reading", "correction", "meniscus", "temperature_C", "depth_cm",
-                           "diameter_um", "percent_finer"],
-                          notes=["152H: depth_cm is D7928's H_m at reading + meniscus (the surface's graduation, from "
-                                 "the hydrometer's calibration, less V_B / 2A); percent_finer is 100 a (reading - "
-                                 "correction) / c0, correction the composite correction (blank) at that reading"])
+        reduction = Table(["instrument", "time_min", "reading", "correction", "meniscus", "unit", "temperature_C",
+                           "depth_cm", "diameter_um", "percent_finer"],
+                          notes=["hydrometer: reading, correction (the composite correction at that reading: the blank) "
+                                 "and meniscus as the instrument reads (152H g/L, 151H specific gravity, as 1000 (R - 1) "
+                                 "/ 0.6226 g/L of a 152H); depth_cm is D7928's H_m at reading + meniscus (the surface's "
+                                 "graduation, from the calibration, less V_B / 2A); percent_finer is 100 a (reading - "
+                                 "correction) / c0 in g/L"])
         for r in self.reduction:
-            for row in zip(r.time / 60, r.reading, r.correction, r.temperature, r.depth * 100, r.diameter * 1e6,
-                           r.percent):
-                reduction.add(r.instrument, *map(float, row[:3]), r.meniscus, *map(float, row[3:]))
+            hydrometer = r.instrument == "hydrometer"
+            reading = r.scale.as_read(r.reading) if hydrometer else r.reading
+            unit = r.scale.unit if hydrometer else NOISE_UNITS[r.instrument]
+            for row in zip(r.time / 60, reading, r.correction / r.scale.per_unit, r.temperature, r.depth * 100,
+                           r.diameter * 1e6, r.percent):
+                reduction.add(r.instrument, *map(float, row[:3]), r.meniscus / r.scale.per_unit, unit,
+                              *map(float, row[3:]))
         fitted = Table(["instrument", "time_min", "opening_mm", "measured", "simulated", "residual_sigma"])
         for name, t, opening, measured, model, sigma in self.fit_rows:
             fitted.add(name, "" if math.isnan(t) else t / 60, "" if math.isnan(opening) else opening * 1e3,
@@ -250,7 +256,8 @@ def invert(sheets: list[Sheet], test: LabTest, folder: Path, *, sieve: SieveShee
         below = np.flatnonzero(reading < -2 * test.noise[sheet.instrument]) if sheet.instrument == "hydrometer" else []
         if len(below):
             k = below[0]
-            raise SheetError(f"{sheet.where(k)}: the reading ({sheet.reading[k]:g} on the sheet) is {reading[k]:.3g} g/L "
+            raise SheetError(f"{sheet.where(k)}: the reading ({sheet.scale.quoted(sheet.reading[k])} on the sheet) is "
+                             f"{reading[k]:.3g} g/L "
                              "after its composite correction: the correction (blank or --zero-correction) is larger "
                              "than the reading; check both")
         # the tolerance: twice the reading's noise, and 2 % of the solids' signal for the sampling of a real
@@ -258,9 +265,8 @@ def invert(sheets: list[Sheet], test: LabTest, folder: Path, *, sieve: SieveShee
         tolerance = max(2 * test.noise[sheet.instrument], 0.02 * signal)
         check_sheet(sheet, whole_sample_reading(sheet, test, water), tolerance, reading,
                     NOISE_OPTIONS[sheet.instrument] + ("" if sheet.instrument == "pipette" else
-                                                       f" (now {test.noise[sheet.instrument]:g} "
-                                                       f"{NOISE_UNITS[sheet.instrument]}; the tolerance is twice it, "
-                                                       "or 2 % of the solids' signal)"))
+                                                       f" (now {noise_text(sheet, test.noise[sheet.instrument])}; the "
+                                                       "tolerance is twice it, or 2 % of the solids' signal)"))
     sieves = sieve_data(sieve, split, test.noise["sieve"])
     reduction = [standard_reduction(sheet, water, c0, test.hydrometer, test.cylinder_area, test.sphere, test.meniscus,
                                     test.correction(sheet)) for sheet in sheets]
@@ -355,6 +361,7 @@ def invert(sheets: list[Sheet], test: LabTest, folder: Path, *, sieve: SieveShee
         "sheets": [str(s.path) for s in sheets] + ([str(sieve.path)] if sieve is not None else []),
         "composite_correction": {str(s.path): ("blank column" if len(s.blank) else test.zero_correction)
                                  for s in sheets if s.instrument == "hydrometer"},
+        "hydrometer_type": next((s.scale.name for s in sheets if s.instrument == "hydrometer"), "152H"),
         "temperatures_C": [float(recorded.min()), float(recorded.max())] if len(recorded) else None,
         "split_mm": None if split is None else split * 1e3, "specimen_share": sieves.share,
         "top_um": sieves.top * 1e6}
@@ -406,6 +413,12 @@ def _in_tail(diameter: np.ndarray, percent: np.ndarray, basis: np.ndarray, level
 
 NOISE_UNITS = {"hydrometer": "g/L", "pipette": "g/L", "buoyancy": "g", "sieve": "points"}
 NOISE_OPTIONS = {"hydrometer": "--hydrometer-noise", "pipette": "--pipette-noise", "buoyancy": "--balance-noise"}
+
+
+def noise_text(sheet: Sheet, noise: float) -> str:
+    """A sheet's reading error as its noise option states it."""
+    return sheet.scale.quoted_step(noise) if sheet.instrument == "hydrometer" else \
+        f"{noise:g} {NOISE_UNITS[sheet.instrument]}"
 STEP_WARNING = 15.0        # points between the coarsest cut and the next sieve that deserve a second look
 STEP_STEEPNESS = 50.0      # and per decade of diameter: a soil's silt rises by 20-40 points a decade
 
@@ -431,18 +444,21 @@ def _sieves_step(grid: SizeGrid, shares: np.ndarray, sieves: SieveData) -> str |
 
 def _inputs_line(test: LabTest, inputs: dict) -> str:
     """The test's values as the inverse used them, for the console."""
-    correction = "; ".join(f"{Path(k).name}: {v if isinstance(v, str) else f'{v:g} g/L'}"
+    scale = SCALES[inputs["hydrometer_type"]]
+    correction = "; ".join(f"{Path(k).name}: {v if isinstance(v, str) else scale.quoted_step(v)}"
                            for k, v in inputs["composite_correction"].items()) or "none"
+    read = "" if scale.name == "152H" else " (its specific gravity R read as 1000 (R - 1) / 0.6226 g/L of a 152H)"
     temperatures = inputs["temperatures_C"]
     return (f"inputs: specimen {test.mass * 1e3:.5g} g (oven-dry), particle density {test.particle_density:g} kg/m3, "
             f"suspension {test.cylinder_area * test.height * 1e6:.4g} mL in a cylinder of {test.cylinder_area * 1e4:.4g} "
-            f"cm2 ({test.height * 100:.4g} cm high), hydrometer {test.hydrometer.describe()}, composite correction "
-            f"{correction}, meniscus {test.meniscus:g} g/L, water " + (f"{temperatures[0]:g}-{temperatures[1]:g} C" if temperatures else
+            f"cm2 ({test.height * 100:.4g} cm high), hydrometer {scale.name}{read}: {test.hydrometer.describe(scale)}, "
+            f"composite correction {correction}, meniscus {scale.quoted_step(test.meniscus)}, water " + (f"{temperatures[0]:g}-{temperatures[1]:g} C" if temperatures else
                                                "20 C (no temperature recorded)")
             + f", the specimen's largest grain {inputs['top_um']:g} um"
             + (f" (the part passing {inputs['split_mm']:g} mm, {100 * inputs['specimen_share']:.4g} % of the sample)"
                if inputs["split_mm"] else "")
-            + "; noise: " + ", ".join(f"{k} {v:g} {NOISE_UNITS[k]}" for k, v in test.noise.items())
+            + "; noise: " + ", ".join(f"{k} {scale.quoted_step(v) if k == 'hydrometer' else f'{v:g} {NOISE_UNITS[k]}'}"
+                                      for k, v in test.noise.items())
             + f", thermometer {test.thermometer:g} C"
             + "; sheets: " + ", ".join(Path(s).name for s in inputs["sheets"]))
 

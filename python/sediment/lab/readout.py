@@ -22,6 +22,43 @@ from ..constants import (D422_CYLINDER_AREA, GRAVITY, LAB_TEMPERATURE, NOMINAL_B
 
 R_FACTOR = 1 - 1 / 2.65    # 152H: R = (rho_s - rho_w) / 0.6226 in g/L, calibrated for Gs = 2.65
 
+
+@dataclass(frozen=True)
+class Scale:
+    """What a hydrometer's stem reads. The 151H and the 152H have the same dimensions and differ only in
+    their scale (D422 3.2): the 152H in g/L of soil of Gs 2.65, the 151H in specific gravity, so that a
+    151H's R is the 152H's 1000 (R - 1) / 0.6226 g/L (which makes D422's two percent-finer formulas
+    agree). Everything after the sheet works on the 152H's g/L."""
+
+    name: str
+    unit: str
+    water: float       # what the scale reads in water at 20 C
+    per_unit: float    # 152H g/L per unit of the scale
+
+    def grams(self, reading):
+        """A reading of this scale as the 152H's g/L."""
+        return (np.asarray(reading, float) - self.water) * self.per_unit
+
+    def as_read(self, grams):
+        """The 152H's g/L as this scale reads it."""
+        return self.water + np.asarray(grams, float) / self.per_unit
+
+    def quoted(self, grams: float) -> str:
+        """A reading [152H g/L] as a message quotes it: on this scale, and in g/L where that differs."""
+        if self.name == "152H":
+            return f"{grams:g}"
+        return f"{float(self.as_read(grams)):.5g} ({grams:.3g} g/L of a 152H)"
+
+    def quoted_step(self, grams: float) -> str:
+        """A difference of readings [152H g/L] (a noise, a correction) as a message quotes it."""
+        if self.name == "152H":
+            return f"{grams:g} g/L"
+        return f"{grams / self.per_unit:.3g} in {self.unit} ({grams:.3g} g/L of a 152H)"
+
+
+SCALES = {"152H": Scale("152H", "g/L", 0.0, 1.0),
+          "151H": Scale("151H", "specific gravity", 1.0, 1000.0 / R_FACTOR)}
+
 @dataclass(frozen=True)
 class Suspension:
     """The water and the solids of a sedimentation test, and Stokes' law between them. The default is
@@ -288,13 +325,15 @@ class Hydrometer:
         meniscus), less the rise of the surface as the bulb enters, V_B / 2A."""
         return self.centre_distance(reading) - self.bulb_volume / (2 * cylinder_area)
 
-    def describe(self) -> str:
-        """The instrument as the console echoes it."""
-        scale = ("calibrated: H_r " + ", ".join(f"{h * 100:g} cm at {r:g} g/L" for r, h in self.calibration)
-                 if self.calibration else
-                 f"nominal 152H of D422: H_r {self.centre_distance(0.0) * 100:.4g} cm at 0 g/L, "
-                 f"{self.centre_distance(50.0) * 100:.4g} cm at 50 g/L")
-        return f"{scale}; bulb {self.bulb_volume * 1e6:.3g} mL, {self.bulb_length * 100:.3g} cm"
+    def describe(self, scale: Scale = SCALES["152H"]) -> str:
+        """The instrument as the console echoes it, its readings on `scale`."""
+        def at(grams: float) -> str:
+            return f"{float(scale.as_read(grams)):.5g}{' g/L' if scale.name == '152H' else ''}"
+        points = self.calibration or ((0.0, float(self.centre_distance(0.0))),
+                                      (50.0, float(self.centre_distance(50.0))))
+        where = "calibrated" if self.calibration else f"nominal {scale.name} of D422"
+        marks = ", ".join(f"{h * 100:.4g} cm at {at(r)}" for r, h in points)
+        return f"{where}: H_r {marks}; bulb {self.bulb_volume * 1e6:.3g} mL, {self.bulb_length * 100:.3g} cm"
 
     def bulb_top_depth(self, column: Column, t: float) -> float:
         """Depth of the bulb top where the hydrostatic force on the immersed stem and bulb equals

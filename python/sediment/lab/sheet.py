@@ -4,14 +4,15 @@ row, and the standard ASTM reduction of it.
 
 A sheet is a CSV a laboratory already keeps, one kind per file, told apart by its header:
 
-- hydrometer (152H, reading in g/L of soil): ``time_min,reading,temperature_C``, ``blank`` optional (the
-  composite correction measured beside each reading, g/L, subtracted from it)
+- hydrometer: ``time_min,reading,temperature_C``, ``blank`` optional (the reading in the control cylinder
+  beside each reading, its composite correction); a 152H's in g/L of soil, a 151H's in specific gravity
+  (read as the 152H's g/L from then on)
 - pipette: ``time_min,depth_cm,mass_g`` (the dry solids of one pipette sample), ``temperature_C`` optional
 - buoyancy sphere: ``time_min,apparent_mass_g`` (what the balance shows), ``temperature_C`` optional
 - sieves: ``opening_mm,percent_passing`` (percent of the whole dry sample passing each sieve)
 
 A sheet that no sedimenting suspension can give is refused with the reason: times out of order,
-missing temperatures, hydrometer readings in g/cm3, readings rising with time or above what the whole
+missing temperatures, readings on the other hydrometer's scale, readings rising with time or above what the whole
 sample in suspension reads.
 """
 from __future__ import annotations
@@ -25,7 +26,7 @@ import numpy as np
 from ..constants import LAB_TEMPERATURE
 from ..csvfile import CsvError, CsvFile, read_csv
 from ..plausible import RANGES, Range, pipette_mass
-from .readout import BuoyancySphere, Hydrometer, Suspension, gs_correction
+from .readout import SCALES, BuoyancySphere, Hydrometer, Scale, Suspension, gs_correction
 
 KINDS = {
     "hydrometer": ("time_min", "reading", "temperature_C"),
@@ -54,6 +55,7 @@ class Sheet:
     depth: np.ndarray = field(default_factory=lambda: np.empty(0))
     blank: np.ndarray = field(default_factory=lambda: np.empty(0))    # 152H composite correction per reading
     lines: tuple[int, ...] = ()    # each reading's line in the file, for messages
+    scale: Scale = SCALES["152H"]    # a hydrometer's scale as read (its readings and blank are the 152H's g/L)
 
     def where(self, k: int) -> str:
         """Reading k as a message names it: its line in the file, and its time."""
@@ -82,9 +84,11 @@ class SieveSheet:
         return f"{self.path.name} (sieve)"
 
 
-def read_sheet(path: str | Path, pipette_volume: float = 25e-6, stirred: str | None = None) -> Sheet | SieveSheet:
-    """Reads and checks one sheet (its kind from its header); a pipette's masses become g/L of the sample.
-    A `clock` column (HH:MM of each reading) stands for `time_min`, counted from `stirred` (HH:MM)."""
+def read_sheet(path: str | Path, pipette_volume: float = 25e-6, stirred: str | None = None,
+               scale: Scale = SCALES["152H"]) -> Sheet | SieveSheet:
+    """Reads and checks one sheet (its kind from its header); a pipette's masses become g/L of the sample,
+    a hydrometer's readings on `scale` the 152H's g/L. A `clock` column (HH:MM of each reading) stands for
+    `time_min`, counted from `stirred` (HH:MM)."""
     table = _table(path)
     if "clock" in table.header:
         table = _clock_to_minutes(table, stirred)
@@ -123,17 +127,21 @@ def read_sheet(path: str | Path, pipette_volume: float = 25e-6, stirred: str | N
     depth, blank = np.empty(0), np.empty(0)
     if kind == "hydrometer":
         reading = values["reading"]
-        if np.all((reading > 0.95) & (reading < 1.15)):
-            raise SheetError(f"{path}: the readings ({reading.min():g}-{reading.max():g}) look like specific gravities "
-                             "(a 151H, g/cm3): the sheet takes a 152H's readings in g/L")
-        _plausible(path, lines, values, "reading", "reading")
+        gravities = bool(np.all((reading > 0.95) & (reading < 1.15)))
+        if gravities != (scale.name == "151H"):
+            raise SheetError(f"{path}: the readings ({reading.min():g}-{reading.max():g}) look like "
+                             + ("specific gravities: a 151H's sheet needs --hydrometer-type 151H" if gravities else
+                                "a 152H's g/L, not the specific gravities of a 151H (--hydrometer-type 151H)"))
+        _plausible(path, lines, values, "reading", "reading" if scale.name == "152H" else "reading_151h")
         if "blank" in values:
             blank = values["blank"]
             if not np.isfinite(blank).all():
                 missing = ", ".join(str(lines[k]) for k in np.flatnonzero(~np.isfinite(blank)))
                 raise SheetError(f"{path}: no blank on line(s) {missing}: give the composite correction beside every "
                                  "reading, or drop the column and give --zero-correction")
-            _plausible(path, lines, values, "blank", "correction")
+            _plausible(path, lines, values, "blank", "correction" if scale.name == "152H" else "blank_151h")
+            blank = scale.grams(blank)
+        reading = scale.grams(reading)
     elif kind == "pipette":
         _plausible(path, lines, values, "depth_cm", "depth_cm")
         _plausible(path, lines, values, "mass_g", pipette_mass(pipette_volume))
@@ -142,19 +150,26 @@ def read_sheet(path: str | Path, pipette_volume: float = 25e-6, stirred: str | N
     else:
         _plausible(path, lines, values, "apparent_mass_g", "apparent_mass_g")
         reading = values["apparent_mass_g"]
-    return Sheet(kind, path, time, reading, temperature, depth, blank, tuple(lines))
+    return Sheet(kind, path, time, reading, temperature, depth, blank, tuple(lines),
+                 scale if kind == "hydrometer" else SCALES["152H"])
 
 
-def clock_minutes(text: str, where: str) -> int:
-    """Minutes after midnight of a clock time HH:MM (or H:MM, HH:MM:SS to the minute's fraction)."""
-    parts = text.strip().split(":")
+def clock_minutes(text: str, where: str) -> float:
+    """Minutes after midnight of a clock time: HH:MM on 24 hours (or H:MM, HH:MM:SS to the minute's
+    fraction), or on 12 hours with AM or PM after it (9:19 AM, 3:18 PM, 12:05 AM just after midnight)."""
+    words = text.strip().upper().replace(".", "").split()
+    half = words.pop() if len(words) == 2 and words[1] in ("AM", "PM") else None
+    parts = words[0].split(":") if len(words) == 1 else []
     try:
         values = [int(p) for p in parts]
     except ValueError:
         values = []
-    if len(values) not in (2, 3) or not (0 <= values[0] < 24 and all(0 <= v < 60 for v in values[1:])):
-        raise SheetError(f"{where}: '{text.strip()}' is not a clock time HH:MM (24-hour, 14:05 for 2:05 pm)")
-    return values[0] * 60 + values[1] + (values[2] / 60 if len(values) == 3 else 0)
+    hours = range(1, 13) if half else range(24)
+    if len(values) not in (2, 3) or values[0] not in hours or not all(0 <= v < 60 for v in values[1:]):
+        raise SheetError(f"{where}: '{text.strip()}' is not a clock time: HH:MM on 24 hours (14:05) or H:MM AM/PM "
+                         "(2:05 PM)")
+    hour = values[0] % 12 + (12 if half == "PM" else 0) if half else values[0]
+    return hour * 60 + values[1] + (values[2] / 60 if len(values) == 3 else 0)
 
 
 NEXT_DAY_AFTER = 120.0    # min: a clock that falls later than this in a test is past midnight, earlier a slip
@@ -283,8 +298,9 @@ def check_sheet(sheet: Sheet, whole: float, resolution: float, corrected: np.nda
     values = sheet.reading if corrected is None else corrected
 
     def named(k: int) -> str:
-        after = "" if corrected is None or corrected[k] == sheet.reading[k] else f", {values[k]:g} after its correction"
-        return f"{sheet.reading[k]:g} on the sheet{after}"
+        after = "" if corrected is None or corrected[k] == sheet.reading[k] else \
+            f", {values[k]:g}{'' if sheet.scale.name == '152H' else ' g/L'} after its correction"
+        return f"{sheet.scale.quoted(sheet.reading[k])} on the sheet{after}"
     # the solids signal, falling with time: the sphere's apparent mass rises as the suspension thins
     signal, top = (-values, -whole) if sheet.instrument == "buoyancy" else (values, whole)
     over = np.flatnonzero(signal > top + resolution)
@@ -324,6 +340,7 @@ class Reduction:
     depth: np.ndarray           # m
     diameter: np.ndarray        # m
     percent: np.ndarray         # of the specimen (the inverse scales it to the whole sample)
+    scale: Scale = SCALES["152H"]    # a hydrometer's scale as read (reading, correction and meniscus are in g/L)
 
     def scaled(self, share: float) -> "Reduction":
         """The same reduction with its percent finer of a sample of which the specimen is `share`."""
@@ -356,12 +373,13 @@ def standard_reduction(sheet: Sheet, suspension: Suspension, initial_concentrati
     diameter = np.array([w.stokes_diameter(z, time) for w, z, time in zip(waters, depth, sheet.time)], float)
     return Reduction(sheet.instrument, sheet.time, sheet.reading, applied,
                      meniscus if sheet.instrument == "hydrometer" else 0.0, temperature, np.asarray(depth, float),
-                     diameter, percent)
+                     diameter, percent, sheet.scale)
 
 
-def read_hydrometer_calibration(path: str | Path) -> tuple[np.ndarray, np.ndarray]:
+def read_hydrometer_calibration(path: str | Path, scale: Scale = SCALES["152H"]) -> tuple[np.ndarray, np.ndarray]:
     """A hydrometer's calibration (D7928's H_r): CSV ``reading,distance_cm``, the distance from the
-    graduation of each reading [g/L] to the bulb's centre. Returns the readings and the distances [m]."""
+    graduation of each reading (on `scale`) to the bulb's centre. Returns the readings [152H g/L] and the
+    distances [m]."""
     table = _table(path)
     path = table.path
     if not {"reading", "distance_cm"} <= set(table.header):
@@ -371,7 +389,7 @@ def read_hydrometer_calibration(path: str | Path) -> tuple[np.ndarray, np.ndarra
     values = {name: np.array(_numbers(table, name)) for name in ("reading", "distance_cm")}
     if len(lines) < 2:
         raise SheetError(f"{path}: a calibration needs at least two readings with their distances")
-    _plausible(path, lines, values, "reading", "reading")
+    _plausible(path, lines, values, "reading", "reading" if scale.name == "152H" else "reading_151h")
     _plausible(path, lines, values, "distance_cm", "calibration_cm")
     readings, distances = values["reading"], values["distance_cm"]
     order = np.argsort(readings, kind="stable")
@@ -382,4 +400,4 @@ def read_hydrometer_calibration(path: str | Path) -> tuple[np.ndarray, np.ndarra
             raise SheetError(f"{path}, lines {lines[a]} and {lines[b]}: the distance to the bulb's centre does not fall "
                              f"from reading {readings[a]:g} ({distances[a]:g} cm) to {readings[b]:g} ({distances[b]:g} "
                              "cm): a higher reading is a graduation lower on the stem, nearer the bulb")
-    return readings[order], distances[order] / 100.0
+    return scale.grams(readings[order]), distances[order] / 100.0

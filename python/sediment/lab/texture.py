@@ -323,14 +323,24 @@ class TextureReport:
         return (f"{name} ({100 * self.class_share.get(name, 0.0) / (100 - unknown):.0f} % of the draws with a class; "
                 f"{unknown:.0f} % have none: their curve does not reach 2 mm, so their fine earth is not known)")
 
+    def gravel_line(self) -> str | None:
+        """Where the sample holds gravel: that USDA's class is of its fine earth, and the modifier's rule."""
+        gravel = self.fractions["ISO 14688-1"].get("gravel", math.nan)
+        if not gravel >= 1.0:    # NaN (the curve stops below 2 mm), or a trace
+            return None
+        return (f"the USDA class is of the fine earth (< 2 mm); {gravel:.3g} % of the sample's mass is gravel, which "
+                "USDA names by volume (gravelly at 15-35 %, very gravelly 35-60 %, extremely gravelly above): "
+                "convert with the gravel's and the fine earth's densities before naming the modifier")
+
     def table(self) -> Table:
         """texture.csv's table with the class and the gradation as notes, for a terminal."""
         table = self.texture_table()
         gradation = self.gradation_table()
         parts = [f"{row[0]} {row[1] or '-'}{'' if row[4] == '-' else ' ' + row[4]} [{row[2] or '-'}, {row[3] or '-'}]"
                  for row in gradation.rows]
-        table.notes = [f"USDA texture class: {self.usda_class_line()}", "gradation: " + "; ".join(parts),
-                       *gradation.notes]
+        gravel = self.gravel_line()
+        table.notes = [f"USDA texture class: {self.usda_class_line()}", *([gravel] if gravel else []),
+                       "gradation: " + "; ".join(parts), *gradation.notes]
         return table
 
     def summary(self) -> dict:
