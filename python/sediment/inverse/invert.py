@@ -15,6 +15,7 @@ from ..lab.psd import NOT_FITTING
 from ..lab.readout import SCALES, Suspension, gs_correction
 from ..lab.sheet import Reduction, Sheet, SieveSheet, SheetError, check_sheet, standard_reduction
 from ..results import Table, write_text
+from .breakdown import Breakdown, breakdown
 from .fit import ROUGHNESS_DECADES, draw_placement, end_placement, fit, penalty
 from .grid import NEAR, TOP, SizeGrid, size_grid
 from .model import LabTest, cut_diameters, effective_times, linearise, psd_of, run_forward, solids_signal, \
@@ -44,6 +45,7 @@ class Inversion:
     inputs: dict
     sieve: tuple[np.ndarray, np.ndarray] | None = None                  # openings [m], percent passing
     notes: list[str] = field(default_factory=list)
+    corrections: Breakdown | None = None    # what moves the answer from the standard reduction, effect by effect
 
     @property
     def measured(self) -> np.ndarray:
@@ -81,8 +83,9 @@ class Inversion:
         return table
 
     def save(self, folder: Path) -> list[Path]:
-        """psd.csv, reduction.csv, fit.csv, texture.csv, gradation.csv, invert.json and the figures
-        invert.png, gradation.png, texture.png. Where the fit fails, every table's first line says so."""
+        """psd.csv, reduction.csv, corrections.csv, fit.csv, texture.csv, gradation.csv, invert.json and the
+        figures invert.png, corrections.png, gradation.png, texture.png. Where the fit fails, every table's
+        first line says so."""
         folder = Path(folder)
         first = "" if self.consistent else f"# {NOT_FITTING}: these files come from a fit that does not explain the " \
                                            "sheets (invert.json, 'notes')\n"
@@ -111,13 +114,17 @@ class Inversion:
                    "psd": {"diameter_um": (self.diameter * 1e6).tolist(), "percent_finer": self.percent.tolist(),
                            "low": self.low.tolist(), "high": self.high.tolist(), "basis": self.basis.tolist()},
                    "texture": report.summary(), "rounds": self.rounds, "smoothness": self.smoothness,
-                   "resolution": self.resolution, "notes": self.notes}
+                   "resolution": self.resolution, "notes": self.notes,
+                   "corrections": None if self.corrections is None else self.corrections.summary()}
         written = [write_text(folder / "psd.csv", first + self.table().csv()),
                    write_text(folder / "reduction.csv", first + reduction.csv()),
                    write_text(folder / "fit.csv", first + fitted.csv())]
         mark = "" if self.consistent else f" ({NOT_FITTING}: no PSD explains the sheets)"
         written += [write_text(path, first + path.read_text()) if first and path.suffix == ".csv" else path
                     for path in report.save(folder, mark)]
+        if self.corrections is not None:
+            written += [write_text(folder / "corrections.csv", first + self.corrections.table().csv()),
+                        self.corrections.plot(folder / "corrections.png")]
         written += [write_text(folder / "invert.json", json.dumps(summary, indent=1) + "\n"), self.plot(folder / "invert.png")]
         points = [(f"standard reduction ({r.instrument})", r.diameter, r.percent) for r in self.reduction]
         written.append(texture.gradation_figure(folder / "gradation.png", self.diameter, self.percent, self.low,
@@ -368,6 +375,9 @@ def invert(sheets: list[Sheet], test: LabTest, folder: Path, *, sieve: SieveShee
     whole = [r.scaled(sieves.share) for r in reduction]
     out = Inversion(*result, whole, rows, chi2, round_number, float(weight), resolution, inputs,
                     None if sieve is None else (sieve.opening, sieve.passing))
+    out.corrections = breakdown(sheets, reduction, times, test, water, grid, data, sigma, sieve_rows, shares,
+                                sieves.share, (out.diameter, out.low, out.high))
+    out.notes.append(out.corrections.line())
     out.notes.append(f"forward model: {resolution}; {round_number} round(s)" + (
         "" if converged else f", not converged: the last round still moved the PSD by up to {moved:.2g} points "
                              f"(more than {CONVERGED:g}), as the hindrance of each round's PSD moves the next; the answer "

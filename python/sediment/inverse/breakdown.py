@@ -1,0 +1,225 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
+"""Why the inverse differs from the standard reduction (docs/inverse.md, the corrections): the same
+sheets fitted again under models that switch the forward model's effects on one at a time, from the
+standard reduction's own assumptions to the full model, each read at the standard reduction's
+diameters, so that the changes add up exactly to the difference.
+
+The stages, in order (each keeps the ones before it):
+
+0. ``fit``: the standard reduction's model itself (each reading is the concentration at the
+   instrument's depth of the grains finer than its Stokes diameter at the reading's own temperature),
+   fitted as the inverse fits (smoothness, sieves, tails): what the fit alone moves;
+1. ``temperature record``: the water's viscosity along the test's temperature record, not the
+   reading's alone;
+2. ``drag curve``: the standard drag curve's terminal speeds instead of Stokes' law;
+3. ``instrument body``: the instrument as a body in the column (the hydrometer floating where the
+   buoyancy of its bulb and stem in the suspension holds it, the sphere's and the pipette's volumes)
+   instead of a point at its depth;
+4. ``hindrance``: the DEM run (Richardson & Zaki's hindrance, and the run's own discreteness): the
+   inverse's answer.
+
+Stages 0-3 settle each bin at constant speeds, exactly (no DEM), so the breakdown costs a few fits.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .. import _core, figures
+from ..lab.readout import Column, Suspension, gs_correction
+from ..lab.sheet import Reduction, Sheet
+from ..planner.screening import terminal_speeds
+from ..results import Table
+from .fit import fit
+from .grid import SizeGrid
+from .model import ForwardRun, LabTest, linearise, psd_of
+
+EFFECTS = ("fit", "temperature record", "drag curve", "instrument body", "hindrance")
+LAYERS = 800              # the analytic columns' layers (0.45 mm in a 36 cm suspension)
+
+
+@dataclass
+class Breakdown:
+    """Per reading: the standard reduction's diameter and percent finer, the change each effect makes (in
+    EFFECTS' order), the inverse's percent finer at that diameter and its band (all of the whole sample)."""
+
+    instrument: list[str]
+    time: np.ndarray          # s
+    diameter: np.ndarray      # m, the standard reduction's
+    standard: np.ndarray      # percent finer
+    changes: np.ndarray       # [readings, effects]
+    low: np.ndarray
+    high: np.ndarray
+
+    @property
+    def inverse(self) -> np.ndarray:
+        """The inverse's percent finer at the standard reduction's diameters: the standard plus every change."""
+        return self.standard + self.changes.sum(axis=1)
+
+    def table(self) -> Table:
+        """corrections.csv."""
+        names = [e.replace(" ", "_") for e in EFFECTS]
+        table = Table(["instrument", "time_min", "diameter_um", "standard_percent", *names, "inverse_percent", "low",
+                       "high"],
+                      notes=["each effect's column: how far switching it on (after those to its left) moves percent "
+                             "finer at the standard reduction's diameter; standard_percent plus them all is "
+                             "inverse_percent, whose band is low-high (sediment.inverse.breakdown)"])
+        for k, name in enumerate(self.instrument):
+            table.add(name, float(self.time[k] / 60), float(self.diameter[k] * 1e6), float(self.standard[k]),
+                      *map(float, self.changes[k]), float(self.inverse[k]), float(self.low[k]), float(self.high[k]))
+        return table
+
+    def summary(self) -> dict:
+        """For invert.json: each effect's mean change and its range over the readings, and the rows."""
+        effects = {name: {"mean": float(self.changes[:, k].mean()), "min": float(self.changes[:, k].min()),
+                          "max": float(self.changes[:, k].max())} for k, name in enumerate(EFFECTS)}
+        total = self.inverse - self.standard
+        return {"effects": effects, "total": {"mean": float(total.mean()), "min": float(total.min()),
+                                              "max": float(total.max())},
+                "rows": [{"instrument": name, "time_min": float(self.time[k] / 60),
+                          "diameter_um": float(self.diameter[k] * 1e6), "standard_percent": float(self.standard[k]),
+                          "changes": dict(zip(EFFECTS, map(float, self.changes[k]))),
+                          "inverse_percent": float(self.inverse[k]), "band": [float(self.low[k]), float(self.high[k])]}
+                         for k, name in enumerate(self.instrument)]}
+
+    def line(self) -> str:
+        """The console's line: how far the inverse is from the standard reduction and what makes it."""
+        total = self.inverse - self.standard
+        parts = ", ".join(f"{name} {self.changes[:, k].mean():+.2f}" for k, name in enumerate(EFFECTS))
+        return (f"against the standard reduction at its diameters: {total.mean():+.2f} points on average ({total.min():+.2f} "
+                f"to {total.max():+.2f} at single readings); by effect (mean): {parts} (corrections.csv)")
+
+    def plot(self, path):
+        """Each reading's change, effect after effect, against its diameter (one line per instrument and
+        stage), with the inverse's band."""
+        plt = figures.pyplot()
+        fig, ax = plt.subplots(figsize=(8, 4.5))
+        names = np.array(self.instrument)
+        for m, instrument in enumerate(dict.fromkeys(self.instrument)):
+            rows = np.flatnonzero(names == instrument)
+            rows = rows[np.argsort(self.diameter[rows])]
+            d = self.diameter[rows] * 1e6
+            ax.fill_between(d, (self.low - self.standard)[rows], (self.high - self.standard)[rows], color="0.5",
+                            alpha=0.18, lw=0, label="the inverse's band" if m == 0 else None)
+            cumulative = np.cumsum(self.changes[rows], axis=1)
+            for k, name in enumerate(EFFECTS):
+                label = f"+ {name} (mean {self.changes[:, k].mean():+.2f})" if m == 0 else None
+                ax.plot(d, cumulative[:, k], "-" + "osD^v"[m % 5], ms=3.5, color=f"C{k}", label=label)
+            ax.plot([], [], "k" + "osD^v"[m % 5], ms=4, ls="", label=instrument)
+        ax.axhline(0.0, color="k", lw=0.8)
+        ax.set(xscale="log", xlabel="standard reduction's diameter [um]",
+               ylabel="inverse - standard reduction [points]",
+               title="what moves the inverse from the standard reduction, effect after effect")
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=7)
+        return figures.save(fig, path)
+
+
+def breakdown(sheets: list[Sheet], reduction: list[Reduction], times: list[np.ndarray], test: LabTest,
+              water: Suspension, grid: SizeGrid, data: np.ndarray, sigma: np.ndarray, sieve_rows: np.ndarray,
+              shares: np.ndarray, share: float, band: tuple[np.ndarray, np.ndarray, np.ndarray]) -> Breakdown:
+    """The inverse's answer (the final `shares` of the specimen, `share` of the sample) taken apart
+    effect by effect (module docstring). `data`, `sigma` and `sieve_rows` as the inverse fitted them;
+    `reduction` unscaled (of the specimen); `band`: the inverse's diameters, low and high."""
+    depth = np.concatenate([r.depth for r in reduction])
+    effective = np.concatenate(times)
+    diameters = [np.concatenate([r.diameter for r in reduction]),
+                 np.asarray(water.stokes_diameter(depth, effective), float),
+                 drag_curve_diameters(water, depth, effective)]
+
+    def solve(model) -> np.ndarray:
+        x = shares
+        for _ in range(2):    # the body's readings are nearly linear in the shares: two Gauss-Newton steps
+            base, jac = model(x)
+            x, _, _ = fit(np.vstack([jac, sieve_rows]), np.concatenate([base, sieve_rows @ x]), x, data, sigma, grid)
+        return x
+
+    stages = [solve(lambda x, d=d: point_readings(x, d, sheets, reduction, test, grid)) for d in diameters]
+    body = AnalyticRun.of(grid, test, water, np.unique(np.concatenate([[0.0], effective])))
+    stages.append(solve(lambda x: linearise(body, x, sheets, times)))
+    stages.append(shares)
+    at = diameters[0]
+    standard = np.concatenate([r.percent for r in reduction]) * share
+    percent = np.array([psd_of(x, grid).at(at) * share for x in stages])
+    changes = np.diff(np.vstack([standard, percent]), axis=0).T
+    low = np.interp(np.log(at), np.log(band[0]), band[1])
+    high = np.interp(np.log(at), np.log(band[0]), band[2])
+    instruments = [s.instrument for s in sheets for _ in s.time]
+    return Breakdown(instruments, np.concatenate([s.time for s in sheets]), at, standard, changes, low, high)
+
+
+def drag_curve_diameters(water: Suspension, depth: np.ndarray, time: np.ndarray) -> np.ndarray:
+    """The diameters whose terminal speed on the standard drag curve (no hindrance) is depth / time."""
+    out = []
+    for z, t in zip(depth, time):
+        stokes = float(water.stokes_diameter(z, t))
+        low, high = np.log(0.5 * stokes), np.log(2.0 * stokes)
+        for _ in range(40):    # bisection in log d: the speed rises with the diameter
+            middle = 0.5 * (low + high)
+            fast = terminal_speeds(water, np.array([np.exp(middle)]))[0] > z / t
+            low, high = (low, middle) if fast else (middle, high)
+        out.append(np.exp(0.5 * (low + high)))
+    return np.array(out)
+
+
+def finer_in_bins(grid: SizeGrid, diameter: np.ndarray) -> np.ndarray:
+    """[readings, bins]: the part of each bin (its mass even in log d) finer than each diameter."""
+    lower, upper = np.log(grid.lower), np.log(grid.edges)
+    return np.clip((np.log(diameter)[:, None] - lower) / (upper - lower), 0.0, 1.0)
+
+
+def point_readings(shares: np.ndarray, diameter: np.ndarray, sheets: list[Sheet], reduction: list[Reduction],
+                   test: LabTest, grid: SizeGrid) -> tuple[np.ndarray, np.ndarray]:
+    """The readings of instruments that read the concentration at their depth of the grains finer than
+    `diameter` (one per reading), as the standard reduction reads them back, and their derivatives by
+    the shares (exact: the readings are linear in them)."""
+    finer = finer_in_bins(grid, diameter)
+    # reading = offset + slope x percent finer, as each instrument's standard reduction inverts it
+    offset, slope = [], []
+    c0 = test.initial_concentration
+    gs = test.particle_density / 1000.0
+    for sheet, r in zip(sheets, reduction):
+        n = len(sheet.time)
+        if sheet.instrument == "hydrometer":
+            offset.append(np.zeros(n))
+            slope.append(np.full(n, c0 / (100 * gs_correction(gs))))
+        elif sheet.instrument == "pipette":
+            offset.append(np.zeros(n))
+            slope.append(np.full(n, c0 / 100))
+        else:
+            sphere = test.sphere
+            fluid = np.array([_core.water_density(t) for t in r.temperature])
+            offset.append((sphere.mass - fluid * sphere.volume) * 1e3)
+            slope.append(np.full(n, -c0 / 100 * sphere.volume * (gs - 1) / gs * 1e3))
+    offset, slope = np.concatenate(offset), np.concatenate(slope)
+    jac = slope[:, None] * 100 * finer
+    return offset + jac @ shares, jac
+
+
+@dataclass
+class AnalyticRun(ForwardRun):
+    """A forward run without the DEM: each bin (its mass even in log d) settles at the standard drag curve's
+    terminal speeds with no hindrance, in a column of LAYERS layers with a frame at each reading."""
+
+    edges: np.ndarray = None
+    times: np.ndarray = None
+
+    @classmethod
+    def of(cls, grid: SizeGrid, test: LabTest, water: Suspension, times: np.ndarray) -> "AnalyticRun":
+        """Each bin's fraction [bins, frames, layers] of the test's column at `times` [s]."""
+        edges = np.linspace(0.0, test.height, LAYERS + 1)
+        phi0 = test.initial_concentration / test.particle_density
+        bins = np.empty((grid.bins, len(times), LAYERS))
+        for k, (a, b) in enumerate(zip(grid.lower, grid.edges)):
+            sizes = np.geomspace(a, b, 17)
+            sizes = np.sqrt(sizes[1:] * sizes[:-1])    # 16 classes of even mass in log d
+            speed = terminal_speeds(water, sizes)
+            for f, t in enumerate(times):
+                front = np.minimum(speed * t, test.height)[:, None]
+                covered = np.clip(edges[1:] - np.maximum(edges[:-1], front), 0.0, None) / np.diff(edges)
+                bins[k, f] = phi0 * covered.mean(axis=0)
+        return cls(None, bins, np.ones(grid.bins), water, test, edges, np.asarray(times, float))
+
+    def column(self, shares: np.ndarray) -> Column:
+        return Column(self.edges, self.times, np.tensordot(shares, self.bins, axes=1), self.water)
