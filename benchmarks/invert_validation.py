@@ -9,12 +9,17 @@ al.'s times, in the water of the moment), inverted, and the recovered PSD compar
 reported diameters: those the readings resolve and those between them, with how often the band holds
 the truth; the standard reduction of the same sheets beside it.
 
+With --fines-152h, the fines' 152H sheet alone (a D7928 laboratory's), inverted without a sieve sheet and
+with the fact that all of it passes 75 um, against the truth at every reading's cut and reported diameter,
+with the band's reach at 75 um (100 %: the answer with no sand is one the band allows).
+
 With --soils, real soils instead (examples/inverse/soils: sand to 0.6-1 mm, clay to 50 %): 50 g, the 152H at
 the D7928 times and the sieve sheet of the same sample (ASTM openings from 2 mm to 75 um, percent passing to
 0.1), each inverted with and without the sieves; the table adds the sieves, the tails and the USDA
 fractions against the truth's.
 
-    /usr/bin/python3 benchmarks/invert_validation.py [--out out/invert-validation] [--reuse-truth] [--soils] [PSD.csv ...]
+    /usr/bin/python3 benchmarks/invert_validation.py [--out out/invert-validation] [--reuse-truth]
+        [--soils | --fines-152h] [PSD.csv ...]
 """
 from __future__ import annotations
 
@@ -39,7 +44,8 @@ from sediment.sim.run import run_batch  # noqa: E402
 from sediment.sim.scene import plan, write  # noqa: E402
 
 PSDS = [HERE.parent / "examples" / "granulometry" / "psd" / f"sample{k}.csv" for k in range(1, 6)] + \
-       [HERE.parent / "examples" / "inverse" / "psd" / f"{name}.csv" for name in ("gap_graded", "bimodal", "narrow")]
+       [HERE.parent / "examples" / "inverse" / "psd" / f"{name}.csv"
+        for name in ("gap_graded", "bimodal", "narrow", "steep_top", "steep_bottom")]
 SOILS = [HERE.parent / "examples" / "inverse" / "soils" / f"{name}.csv"
          for name in ("sandy_clay", "clay", "clay_loam", "silt_loam")]
 SIEVES_MM = (2.0, 0.85, 0.425, 0.25, 0.15, 0.106, 0.075)
@@ -111,12 +117,17 @@ def main() -> None:
     parser.add_argument("--out", type=Path, default=Path("out/invert-validation"))
     parser.add_argument("--bins", type=int, default=24)
     parser.add_argument("--soils", action="store_true", help="the soils with sand and clay, 152H and sieve sheets")
+    parser.add_argument("--fines-152h", action="store_true",
+                        help="the fines' 152H sheet alone, without and with '100 %% passes 75 um'")
     parser.add_argument("--reuse-truth", action="store_true",
                         help="invert the sheets an earlier run of this script left in --out (no new truth runs)")
     args = parser.parse_args()
     psds = args.psds or (SOILS if args.soils else PSDS)
     if args.soils:
         soils(psds, args)
+        return
+    if args.fines_152h:
+        fines_152h(psds, args)
         return
     print("| PSD | readings | at the readings' diameters: mean / worst error, band holds | between them: mean / worst, "
           "band holds | all reported: band holds | standard reduction: mean / worst | chi2 per reading | time |")
@@ -141,6 +152,39 @@ def main() -> None:
         print(f"| {psd_path.stem} | {len(result.fit_rows)} | {cells[0]} | {cells[1]} | {held[reported].mean():.0%} of "
               f"{reported.sum()} | {standard.mean():.2f} / "
               f"{standard.max():.2f} | {result.reduced_chi2:.2f} | {seconds:.0f} s |", flush=True)
+
+
+def fines_152h(psds: list[Path], args: argparse.Namespace) -> None:
+    """The fines' 152H sheets alone: no sieve sheet, then a sieve sheet saying that 100 % passes 75 um."""
+    print("| PSD | sheets | readings' cuts: mean / worst, held | all reported: held | coarsest cut: inverse [band] "
+          "against truth | band's top at 75 um | mean band width | chi2 | time |")
+    print("|---|---|---|---|---|---|---|---|---|")
+    for psd_path in psds:
+        folder = args.out / psd_path.stem
+        hydrometer = folder / "hydrometer.csv" if args.reuse_truth else synthesise(psd_path, folder)[0]
+        passing = folder / "sieve_75um.csv"
+        passing.write_text("opening_mm,percent_passing\n0.075,100\n")
+        truth_psd = read_psd(folder / "truth" / "simulated_psd.csv")
+        try:
+            sheet = read_sheet(hydrometer)
+        except ValueError as exc:    # a reading off the 152H's scale: no laboratory could read this test
+            print(f"| {psd_path.stem} | 152H | refused: {exc} | | | | | | |", flush=True)
+            continue
+        for label, sieve in (("152H", None), ("152H, 100 % passes 75 um", read_sheet(passing))):
+            start = time.perf_counter()
+            result = invert([sheet], LabTest(0.060), folder / "runs-152h", sieve=sieve, bins=args.bins)
+            seconds = time.perf_counter() - start
+            truth = truth_psd.at(result.diameter)
+            error = np.abs(result.percent - truth)
+            held = (result.low - HELD_TOLERANCE <= truth) & (truth <= result.high + HELD_TOLERANCE)
+            cut, reported = result.basis == "reading", ~np.isin(result.basis, ("floor", "top"))
+            k = np.flatnonzero(cut)[-1]
+            top = np.interp(np.log(75e-6), np.log(result.diameter), result.high)
+            print(f"| {psd_path.stem} | {label} | {error[cut].mean():.2f} / {error[cut].max():.2f}, {held[cut].mean():.0%} | "
+                  f"{held[reported].mean():.0%} | {result.diameter[k] * 1e6:.1f} um: {result.percent[k]:.1f} "
+                  f"[{result.low[k]:.1f}, {result.high[k]:.1f}] against {truth[k]:.1f} | {top:.1f} | "
+                  f"{np.mean(result.high[reported] - result.low[reported]):.1f} | {result.reduced_chi2:.2f} | "
+                  f"{seconds:.0f} s |", flush=True)
 
 
 def soils(psds: list[Path], args: argparse.Namespace) -> None:

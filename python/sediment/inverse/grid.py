@@ -30,6 +30,7 @@ FLOOR = 10.0              # the finest bin reaches down this many times below th
 CLASS_LIMITS = (2e-6, 50e-6, 63e-6)
 # ASTM sieve openings [m]: the coarse tail's edges where no sieve sheet gives them
 SIEVE_SERIES = (75e-6, 106e-6, 150e-6, 250e-6, 425e-6, 850e-6)
+EDGE_STEPS = (1.12, 1.25)   # the tails' first edges beyond the extreme cuts, as ratios to them
 
 
 @dataclass(frozen=True)
@@ -121,6 +122,11 @@ def size_grid(cuts: np.ndarray, bins: int, sieves: np.ndarray = np.empty(0), top
         extra += [(d, "between") for d in SIEVE_SERIES if d < top / NEAR]
     # the fine tail in two bins at least: where below the finest cut its mass lies is for the data to say
     extra.append((min(kept[0], CLASS_LIMITS[0]) / 2, "between"))
+    # narrow bins just outside the extreme cuts: a hydrometer's bulb spans cuts from about 0.8 to 1.25 times
+    # its reading's, so how the tails' mass lies there moves the extreme readings, and a steep mode just
+    # beyond a cut must be a placement the band can reach
+    extra += [(kept[-1] * f, "between") for f in EDGE_STEPS if kept[-1] * f < top / NEAR]
+    extra += [(kept[0] / f, "between") for f in EDGE_STEPS]
     for d, kind in sorted(extra, key=lambda e: (e[1] != "sieve", e[0])):    # sieves first: they pin
         near = np.abs(np.log(np.array(edges) / d)) < math.log(NEAR)
         if near.any():

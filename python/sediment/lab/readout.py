@@ -230,10 +230,14 @@ class Readings:
 
 @dataclass(frozen=True)
 class Hydrometer:
-    """A hydrometer as a cylindrical bulb under a cylindrical stem, with its scale on the stem:
-    the surface crosses the stem at distance `scale_zero - scale_step R` above the bulb top. A
-    laboratory's `calibration` (D7928's H_r: rows of reading [g/L] and the distance [m] from that
-    graduation to the bulb's centre) places the scale instead, linear between and beyond its rows."""
+    """A hydrometer as a cylindrical bulb under a cylindrical stem, with its scale on the stem. It reads
+    as its marks are made, by where it floats: the 152H's R is (rho - rho_w) / 0.6226 of the uniform
+    liquid that floats it there (water at 20 C, soil of Gs 2.65), so its marks crowd down the stem as
+    1 / rho does. Where the marks are, as the depth of the bulb's centre below a reading's graduation
+    (D7928's H_r), is linear in R, as laboratories calibrate it: the surface crosses the stem at
+    `scale_zero - scale_step R` above the bulb top, or, with a laboratory's `calibration` (rows of
+    reading [g/L] and H_r [m]), linear between and beyond its rows. The two differ by 0.06 cm at most
+    on the 152H, a depth; a reading taken from the linear marks would be up to 0.4 g/L off."""
 
     bulb_length: float      # L2 [m]
     bulb_volume: float      # VB [m3]
@@ -314,11 +318,21 @@ class Hydrometer:
         below = r[-1] + (distance - h[-1]) * (r[-1] - r[-2]) / (h[-1] - h[-2])
         return np.where(distance > h[0], above, np.where(distance < h[-1], below, inside))
 
-    def liquid_density(self, reading) -> np.ndarray:
-        """The density [kg/m3] of a uniform liquid in which the instrument reads `reading` [g/L]: it floats
-        there with its bulb's centre `centre_distance(reading)` below the surface."""
-        top = self.centre_distance(reading) - self.bulb_length / 2
-        return self.mass / (self.bulb_volume + self.stem_area * top)
+    @staticmethod
+    def liquid_density(reading) -> np.ndarray:
+        """The density [kg/m3] of the uniform liquid in which a 152H reads `reading` [g/L]."""
+        return WATER_20C_DENSITY + R_FACTOR * np.asarray(reading, float)
+
+    def reading_floating(self, top) -> np.ndarray:
+        """What the stem reads with the bulb's top `top` [m] below the surface. The marks are where the
+        instrument the maker had in mind floats in the liquid of each reading: a distance alpha / rho -
+        beta from the bulb's top, through the R = 0 and R = 50 marks of the scale (for an instrument made
+        as the marks say, the reading of the uniform liquid that floats it there)."""
+        light, heavy = self.liquid_density(0.0), self.liquid_density(50.0)
+        alpha = self.scale_step * 50.0 / (1.0 / light - 1.0 / heavy)
+        beta = alpha / light - self.scale_zero
+        density = alpha / (np.asarray(top, float) + beta)
+        return (density - WATER_20C_DENSITY) / R_FACTOR
 
     def effective_depth(self, reading, cylinder_area: float = D422_CYLINDER_AREA):
         """D7928's H_m [m]: the bulb's centre below the surface at `reading` (corrected for the
@@ -335,17 +349,24 @@ class Hydrometer:
         marks = ", ".join(f"{h * 100:.4g} cm at {at(r)}" for r, h in points)
         return f"{where}: H_r {marks}; bulb {self.bulb_volume * 1e6:.3g} mL, {self.bulb_length * 100:.3g} cm"
 
-    def bulb_top_depth(self, column: Column, t: float) -> float:
-        """Depth of the bulb top where the hydrostatic force on the immersed stem and bulb equals
-        the weight. The force is linear in the depth between the layer edges and the edges one bulb
-        length up: the first of those points where it reaches the weight brackets the root exactly."""
+    def bulb_top_depth(self, column: Column, t: float, cylinder_area: float = D422_CYLINDER_AREA) -> float:
+        """Depth of the bulb top where the hydrostatic force on the immersed stem and bulb equals the
+        weight, in the column as the instrument leaves it: the suspension beside each level is lifted by
+        the instrument's volume below it, so that at depth s it is the column's from s - V(s) / A, V(s)
+        the instrument's volume above s (at the bulb's centre V_B / 2 A shallower: D7928's H_m). The
+        force is linear in the depth between the points where either end of the bulb meets a layer
+        edge: the first of those where it reaches the weight brackets the root exactly."""
         bulb_area = self.bulb_volume / self.bulb_length
+        stem_share, bulb_share = self.stem_area / cylinder_area, bulb_area / cylinder_area
+        lifted_bulb = self.bulb_length * (1.0 - bulb_share)    # the bulb's span in the column's own depths
         above = column.mass_profile(t)
 
         def excess(y):
-            return self.stem_area * above(y) + bulb_area * (above(y + self.bulb_length) - above(y)) - self.mass
-        points = np.unique(np.clip(np.concatenate([column.depth_edges, column.depth_edges - self.bulb_length]),
-                                   0.0, column.height))
+            origin = y * (1.0 - stem_share)    # the column's depth of the suspension now at the bulb's top
+            return (self.stem_area * above(origin) / (1.0 - stem_share)
+                    + bulb_area * (above(origin + lifted_bulb) - above(origin)) / (1.0 - bulb_share) - self.mass)
+        points = np.unique(np.clip(np.concatenate([column.depth_edges, column.depth_edges - lifted_bulb])
+                                   / (1.0 - stem_share), 0.0, column.height))
         force = excess(points)
         if force[0] > 0:
             raise ValueError("the hydrometer would float with its bulb out of the suspension")
@@ -374,8 +395,8 @@ class Hydrometer:
         a = gs_correction(suspension.specific_gravity)
         rows = []
         for t in times_s:
-            top = self.bulb_top_depth(column, t)
-            reading = float(self.reading_at(top + self.bulb_length / 2))
+            top = self.bulb_top_depth(column, t, cylinder_area)
+            reading = float(self.reading_floating(top))
             depth = self.stokes_depth(top, cylinder_area, level_rise)
             rows.append((t, depth, reading, suspension.stokes_diameter(depth, t), _percent(reading * a, c0)))
         return _readings("hydrometer", rows)
