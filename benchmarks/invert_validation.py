@@ -157,8 +157,9 @@ def main() -> None:
 def fines_152h(psds: list[Path], args: argparse.Namespace) -> None:
     """The fines' 152H sheets alone: no sieve sheet, then a sieve sheet saying that 100 % passes 75 um."""
     print("| PSD | sheets | readings' cuts: mean / worst, held | all reported: held | coarsest cut: inverse [band] "
-          "against truth | band's top at 75 um | mean band width | chi2 | time |")
-    print("|---|---|---|---|---|---|---|---|---|")
+          "against truth | cuts whose band is under 3 points: worst error | band's top at 75 um | mean band width | "
+          "chi2 | time |")
+    print("|---|---|---|---|---|---|---|---|---|---|")
     for psd_path in psds:
         folder = args.out / psd_path.stem
         hydrometer = folder / "hydrometer.csv" if args.reuse_truth else synthesise(psd_path, folder)[0]
@@ -168,7 +169,7 @@ def fines_152h(psds: list[Path], args: argparse.Namespace) -> None:
         try:
             sheet = read_sheet(hydrometer)
         except ValueError as exc:    # a reading off the 152H's scale: no laboratory could read this test
-            print(f"| {psd_path.stem} | 152H | refused: {exc} | | | | | | |", flush=True)
+            print(f"| {psd_path.stem} | 152H | refused: {exc} | | | | | | | |", flush=True)
             continue
         for label, sieve in (("152H", None), ("152H, 100 % passes 75 um", read_sheet(passing))):
             start = time.perf_counter()
@@ -180,9 +181,11 @@ def fines_152h(psds: list[Path], args: argparse.Namespace) -> None:
             cut, reported = result.basis == "reading", ~np.isin(result.basis, ("floor", "top"))
             k = np.flatnonzero(cut)[-1]
             top = np.interp(np.log(75e-6), np.log(result.diameter), result.high)
+            narrow = cut & (result.high - result.low < 3.0)
+            narrow_error = f"{error[narrow].max():.2f} of {narrow.sum()}" if narrow.any() else "none"
             print(f"| {psd_path.stem} | {label} | {error[cut].mean():.2f} / {error[cut].max():.2f}, {held[cut].mean():.0%} | "
                   f"{held[reported].mean():.0%} | {result.diameter[k] * 1e6:.1f} um: {result.percent[k]:.1f} "
-                  f"[{result.low[k]:.1f}, {result.high[k]:.1f}] against {truth[k]:.1f} | {top:.1f} | "
+                  f"[{result.low[k]:.1f}, {result.high[k]:.1f}] against {truth[k]:.1f} | {narrow_error} | {top:.1f} | "
                   f"{np.mean(result.high[reported] - result.low[reported]):.1f} | {result.reduced_chi2:.2f} | "
                   f"{seconds:.0f} s |", flush=True)
 

@@ -62,9 +62,14 @@ def placement_rows(grid: SizeGrid, weights: dict[str, np.ndarray], strength: flo
 
 def draw_placement(grid: SizeGrid, rng: np.random.Generator) -> dict[str, np.ndarray]:
     """A draw of each tail's placement for the band: mostly near one bin or another, so that the band
-    covers every placement the data allow."""
-    return {which: rng.dirichlet(np.full(len(grid.tail(which)), TAIL_CONCENTRATION)) if len(grid.tail(which)) > 1
-            else np.ones(len(grid.tail(which))) for which in ("fine", "coarse")}
+    covers every placement the data allow; even in log d on average, so that narrow bins (those just
+    beyond the extreme cuts) are drawn as often as their width says, not as often as a wide one."""
+    out = {}
+    for which in ("fine", "coarse"):
+        tail = grid.tail(which)
+        concentration = TAIL_CONCENTRATION * len(tail) * even_placement(grid, tail)
+        out[which] = rng.dirichlet(concentration) if len(tail) > 1 else np.ones(len(tail))
+    return out
 
 
 def end_placement(grid: SizeGrid, end: int) -> dict[str, np.ndarray]:

@@ -476,8 +476,8 @@ def _inputs_line(test: LabTest, inputs: dict) -> str:
 def _whole_sample(grid: SizeGrid, specimen: np.ndarray, draws: np.ndarray, extremes: np.ndarray, sieves: SieveData,
                   budget_band: float, rng: np.random.Generator):
     """The curve of the whole sample from the floor (the finest bin's lower end, 0 % by assumption) up: the
-    specimen's scaled by its share, the sieves above the split; the band the draws' central 95 % (in the
-    tails also the extreme placements), widened by the physics' budget."""
+    specimen's scaled by its share, the sieves above the split; the band the draws' central 95 % and the
+    tails' extreme placements, widened by the physics' budget."""
     diameter, basis = np.concatenate([[grid.floor], grid.edges]), np.concatenate([["floor"], grid.basis])
     percent = np.concatenate([[0.0], specimen]) * sieves.share
     # each draw's share of the specimen in the sample, from the split sieve's own noise
@@ -494,9 +494,11 @@ def _whole_sample(grid: SizeGrid, specimen: np.ndarray, draws: np.ndarray, extre
         drawn = whole.passing[above] + rng.normal(0.0, sieves.noise, (len(draws), above.sum()))
         draws = np.concatenate([draws, np.clip(np.maximum(drawn, draws[:, -1:]), 0.0, 100.0)], axis=1)
     low, high = np.percentile(draws, [2.5, 97.5], axis=0) if len(draws) > 1 else (percent.copy(), percent.copy())
-    tails = np.flatnonzero(np.isin(basis, ("fine tail", "coarse tail")))
-    low[tails] = np.minimum(low[tails], extremes[:, tails].min(axis=0))
-    high[tails] = np.maximum(high[tails], extremes[:, tails].max(axis=0))
+    # the tails' extreme placements are PSDs the data allow: where a tail's mass lies moves the readings
+    # next to it, so they bound the band at the cuts as well as in the tails
+    spanned = np.arange(extremes.shape[1])
+    low[spanned] = np.minimum(low[spanned], extremes.min(axis=0))
+    high[spanned] = np.maximum(high[spanned], extremes.max(axis=0))
     below = np.sqrt(np.maximum(percent - low, 0.0) ** 2 + budget_band ** 2)
     above_band = np.sqrt(np.maximum(high - percent, 0.0) ** 2 + budget_band ** 2)
     low, high = np.clip(percent - below, 0, 100), np.clip(percent + above_band, 0, 100)
