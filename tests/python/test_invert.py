@@ -428,3 +428,16 @@ def test_a_fines_only_sheet_without_sieves_has_a_band_that_allows_no_sand(tmp_pa
     held = (rows["low"] - 0.01 <= truth) & (truth <= rows["high"] + 0.01)
     assert held[cut].all(), list(zip(rows["diameter_um"][cut], rows["low"][cut], truth[cut], rows["high"][cut]))
     assert np.interp(np.log(75.0), np.log(rows["diameter_um"]), rows["high"]) == pytest.approx(100.0, abs=0.01)
+
+
+def test_a_split_that_the_specimen_did_not_pass_is_noted(tmp_path, capsys):
+    """The clay loam's specimen passed 2 mm, its readings' coarsest cut is 45 um and 74 % of it passes 75
+    um: `--split 0.075` says the specimen was the part passing 75 um, and the fit makes up the difference
+    with a 32-point step between the cut and the split sieve, which the note names (it skipped the split
+    sieve before). Without the wrong split, no note."""
+    soil = EXAMPLE / "soil"
+    argv = ["invert", str(soil / "hydrometer.csv"), str(soil / "sieve.csv"), "--mass", "0.05", "--particles", "4000"]
+    assert cli.main(argv + ["--split", "0.075", "--out", str(tmp_path / "split")]) == 0
+    assert "check: the curve rises by" in capsys.readouterr().out
+    assert cli.main(argv + ["--out", str(tmp_path / "plain")]) == 0
+    assert "check: the curve rises" not in capsys.readouterr().out

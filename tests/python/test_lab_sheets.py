@@ -148,6 +148,8 @@ def test_a_sheet_on_the_other_hydrometers_scale_is_refused_naming_the_option(tmp
     out = ["--mass", "0.025", "--hydrometer-type", "151H", "--out", str(tmp_path / "out")]
     assert "--meniscus 0.05 (151H) as a 152H's: 80.303 g/L is not within -5 to 5 g/L" in _refusal(
         capsys, ["invert", str(sheet151), *out, "--meniscus", "0.05"])
+    assert "written in a 152H's g/L? with --hydrometer-type 151H give it in specific gravity: 0.000623" in _refusal(
+        capsys, ["invert", str(sheet151), *out, "--meniscus", "1"])
     assert "--hydrometer-noise 0 (151H) as a 152H's: 0 g/L is not within" in _refusal(
         capsys, ["invert", str(sheet151), *out, "--hydrometer-noise", "0"])
     # a 151H's rise is quoted as read, with its reading error in its own unit

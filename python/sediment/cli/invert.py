@@ -199,7 +199,7 @@ def hydrometer_step(args: argparse.Namespace, option: str, quantity: str = "", d
     """An option given in the hydrometer's unit (a correction, the meniscus, the reading error) as the
     152H's g/L, checked against what a 152H's can plausibly be; `default` [g/L] where it is not given."""
     from ..lab.readout import SCALES
-    from ..plausible import check
+    from ..plausible import check, refusal
 
     value = getattr(args, option)
     if value is None:
@@ -207,7 +207,11 @@ def hydrometer_step(args: argparse.Namespace, option: str, quantity: str = "", d
     scale = SCALES[args.hydrometer_type]
     grams = value * scale.per_unit
     named = f"--{option.replace('_', '-')}" + ("" if scale.name == "152H" else f" {value:g} (151H) as a 152H's:")
-    return check(grams, quantity or option.replace("zero_", ""), named)
+    quantity = quantity or option.replace("zero_", "")
+    if scale.name != "152H" and refusal(grams, quantity) is not None and refusal(value, quantity) is None:
+        raise ValueError(f"{named} {refusal(grams, quantity)}; written in a 152H's g/L? with --hydrometer-type 151H "
+                         f"give it in specific gravity: {value / scale.per_unit:.3g}")
+    return check(grams, quantity, named)
 
 
 def hydrometer(args: argparse.Namespace):

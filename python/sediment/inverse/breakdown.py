@@ -33,7 +33,7 @@ from ..planner.screening import terminal_speeds
 from ..results import Table
 from .fit import fit
 from .grid import SizeGrid
-from .model import ForwardRun, LabTest, linearise, psd_of
+from .model import ForwardRun, LabTest, linearise, psd_of, settling_diameter
 
 EFFECTS = ("fit", "temperature record", "drag curve", "instrument body", "hindrance")
 LAYERS = 800              # the analytic columns' layers (0.45 mm in a 36 cm suspension)
@@ -151,16 +151,7 @@ def breakdown(sheets: list[Sheet], reduction: list[Reduction], times: list[np.nd
 
 def drag_curve_diameters(water: Suspension, depth: np.ndarray, time: np.ndarray) -> np.ndarray:
     """The diameters whose terminal speed on the standard drag curve (no hindrance) is depth / time."""
-    out = []
-    for z, t in zip(depth, time):
-        stokes = float(water.stokes_diameter(z, t))
-        low, high = np.log(0.5 * stokes), np.log(2.0 * stokes)
-        for _ in range(40):    # bisection in log d: the speed rises with the diameter
-            middle = 0.5 * (low + high)
-            fast = terminal_speeds(water, np.array([np.exp(middle)]))[0] > z / t
-            low, high = (low, middle) if fast else (middle, high)
-        out.append(np.exp(0.5 * (low + high)))
-    return np.array(out)
+    return np.array([settling_diameter(water, z / t, float(water.stokes_diameter(z, t))) for z, t in zip(depth, time)])
 
 
 def finer_in_bins(grid: SizeGrid, diameter: np.ndarray) -> np.ndarray:

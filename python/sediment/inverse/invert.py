@@ -437,7 +437,9 @@ def _sieves_step(grid: SizeGrid, shares: np.ndarray, sieves: SieveData) -> str |
     """A note where the readings and the sieves meet with a step: a real gap in the grading, or a wrong
     --mass or another sample's sieve sheet, which such a step can absorb and still fit."""
     cut = np.flatnonzero(grid.basis == "reading")[-1]
-    above = np.flatnonzero((grid.basis == "sieve") & (np.arange(grid.bins) > cut))
+    # the top is a sieve too where a sieve sheet says so (the split's, or the largest the specimen passes)
+    sieved = (grid.basis == "sieve") | ((grid.basis == "top") & (sieves.whole is not None))
+    above = np.flatnonzero(sieved & (np.arange(grid.bins) > cut))
     if not len(above):
         return None
     cumulative = 100 * np.cumsum(shares)

@@ -207,20 +207,27 @@ def cut_diameters(sheets: list[Sheet], times: list[np.ndarray], test: LabTest, w
     standard drag curve, Richardson & Zaki at the solids finer than them, the reading's own percent
     finer) takes them past the instrument's depth by the reading's time in the run's water. The
     standard reduction's Stokes diameter at the effective time gives that speed."""
-    from ..planner.screening import terminal_speeds
-
     out = []
     for sheet, t in zip(sheets, times):
         run_sheet = replace(sheet, time=t, temperature=np.full(len(t), np.nan))
         reduced = standard_reduction(run_sheet, water, test.initial_concentration, test.hydrometer,
                                      test.cylinder_area, test.sphere, test.meniscus, test.correction(sheet))
         for d_stokes, p in zip(reduced.diameter, np.clip(reduced.percent, 0.0, 100.0)):
-            speed = water.stokes_speed(d_stokes)
             voidage = 1.0 - test.initial_concentration / test.particle_density * p / 100.0
-            low, high = math.log(0.5 * d_stokes), math.log(2.0 * d_stokes)
-            for _ in range(40):    # bisection in log d: the hindered speed rises with the diameter
-                middle = 0.5 * (low + high)
-                moving = terminal_speeds(water, np.array([math.exp(middle)]), "standard", voidage, "richardson-zaki")[0]
-                low, high = (middle, high) if moving < speed else (low, middle)
-            out.append(math.exp(0.5 * (low + high)))
+            out.append(settling_diameter(water, float(water.stokes_speed(d_stokes)), d_stokes, voidage,
+                                         "richardson-zaki"))
     return np.array(out)
+
+
+def settling_diameter(water: Suspension, speed: float, stokes: float, voidage: float = 1.0,
+                      hindrance: str = "none") -> float:
+    """The diameter whose terminal speed on the standard drag curve (hindered at `voidage`) is `speed`,
+    found within a factor of two of its Stokes diameter `stokes`."""
+    from ..planner.screening import terminal_speeds
+
+    low, high = math.log(0.5 * stokes), math.log(2.0 * stokes)
+    for _ in range(40):    # bisection in log d: the speed rises with the diameter
+        middle = 0.5 * (low + high)
+        moving = terminal_speeds(water, np.array([math.exp(middle)]), "standard", voidage, hindrance)[0]
+        low, high = (middle, high) if moving < speed else (low, middle)
+    return math.exp(0.5 * (low + high))
