@@ -52,7 +52,8 @@ def test_readings_no_suspension_gives_are_refused(tmp_path):
     above = read_sheet(_sheet(tmp_path, HYDROMETER + f"1,{whole + 5:g},20\n2,40,20\n"))
     with pytest.raises(SheetError, match="beyond what the whole sample in suspension reads"):
         check_sheet(above, whole, 0.5)
-    check_sheet(read_sheet(EXAMPLE / "hydrometer.csv"), whole, 0.5)    # a real sheet passes
+    real = read_sheet(EXAMPLE / "hydrometer.csv")
+    check_sheet(real, whole, 0.5, real.reading - real.blank)    # a real sheet passes, after its blank
 
 
 def test_an_inversion_needs_two_cuts_and_a_few_bins(tmp_path):
@@ -82,13 +83,15 @@ def test_the_bins_have_an_edge_at_each_readings_cut_and_sieve_and_tails_above_an
     between = (grid.edges >= at_cuts[0]) & (grid.edges <= at_cuts[-1])
     assert np.all(np.diff(np.log(grid.edges[between])) <= np.log(ratio) + 1e-12)    # no gap wider than the grid's
     # the clay limit below the finest cut is a fine-tail edge, and half of it; the sand up to 2 mm is the coarse
-    # tail, at the ASTM series and the texture limits
-    assert list(grid.basis[grid.edges < at_cuts[0]]) == ["fine tail"] * 2
-    assert np.allclose(grid.edges[:2], [1e-6, 2e-6])
+    # tail, at the ASTM series and the texture limits; each tail's first edges 1.12 and 1.25 times beyond its cut
+    assert list(grid.basis[grid.edges < at_cuts[0]]) == ["fine tail"] * 4
+    assert np.allclose(grid.edges[:4], [1e-6, 2e-6, at_cuts[0] / 1.25, at_cuts[0] / 1.12])
     coarse = grid.edges[grid.basis == "coarse tail"]
+    assert np.allclose(coarse[:2], at_cuts[-1] * np.array([1.12, 1.25]))
     assert set(SIEVE_SERIES) <= set(coarse) and {50e-6, 63e-6} <= set(coarse)
     assert grid.edges[-1] == 2e-3 and grid.basis[-1] == "top" and grid.floor == pytest.approx(1e-7)
-    assert list(grid.tail("fine")) == [0, 1, 2] and grid.tail("coarse")[0] == np.flatnonzero(grid.edges == at_cuts[-1])[0] + 1
+    assert list(grid.tail("fine")) == [0, 1, 2, 3, 4]
+    assert grid.tail("coarse")[0] == np.flatnonzero(grid.edges == at_cuts[-1])[0] + 1
     # with a sieve sheet the sieves pin the coarse end: no series, no tail but the top bin
     sieves = np.array([75e-6, 150e-6, 425e-6])
     pinned = size_grid(cuts, 5, sieves, top=850e-6)

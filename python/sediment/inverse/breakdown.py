@@ -213,4 +213,5 @@ class AnalyticRun(ForwardRun):
         return cls(None, bins, np.ones(grid.bins), water, test, edges, np.asarray(times, float))
 
     def column(self, shares: np.ndarray) -> Column:
+        """The column of a split of the sample's mass among the bins."""
         return Column(self.edges, self.times, np.tensordot(shares, self.bins, axes=1), self.water)
