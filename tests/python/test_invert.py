@@ -444,3 +444,16 @@ def test_a_split_that_the_specimen_did_not_pass_is_noted(tmp_path, capsys):
     assert "check: the curve rises by" in capsys.readouterr().out
     assert cli.main(argv + ["--out", str(tmp_path / "plain")]) == 0
     assert "check: the curve rises" not in capsys.readouterr().out
+
+
+@pytest.mark.parametrize("totals, message", [
+    ({"pipette": 0.5}, "no physical total for the hydrometer (it has pipette)"),
+    ({"hydrometer": 1e300}, "are not points of percent finer"),
+])
+def test_a_budget_that_is_not_this_tests_is_refused_before_the_inversion(tmp_path, capsys, totals, message):
+    budget = tmp_path / "budget.json"
+    budget.write_text(json.dumps([{"sample": "other", "physical_total_pp": totals}]))
+    assert cli.main(["invert", str(EXAMPLE / "soil" / "hydrometer.csv"), "--mass", "0.05", "--budget", str(budget),
+                     "--out", str(tmp_path / "out")]) == 2
+    assert message in capsys.readouterr().err
+    assert not (tmp_path / "out").exists()

@@ -249,11 +249,17 @@ def _invert(args: argparse.Namespace, test, sheets) -> int:
     """Inverts the sheets; prints the PSD and the verdict, writes the report (exit 3: no PSD fits)."""
     from ..inverse import invert
 
-    band = 0.0
+    band, budget = 0.0, None
     if args.budget is not None:
         from ..studies.budget import band_of
 
-        band = max(band_of(args.budget, args.budget_sample)[s.instrument] for s in sheets if s.instrument != "sieve")
+        totals = band_of(args.budget, args.budget_sample)
+        missing = sorted({s.instrument for s in sheets if s.instrument != "sieve"} - set(totals))
+        if missing:
+            raise ValueError(f"--budget {args.budget}: no physical total for the {' and '.join(missing)} (it has "
+                             f"{', '.join(sorted(totals))}): give the budget of this test's instruments")
+        band = max(totals[s.instrument] for s in sheets if s.instrument != "sieve")
+        budget = {"file": str(args.budget), "sample": args.budget_sample, "physical_total_pp": totals, "band_pp": band}
     readings = [s for s in sheets if s.instrument != "sieve"]
     sieve = next((s for s in sheets if s.instrument == "sieve"), None)
     split = args.split
@@ -271,6 +277,7 @@ def _invert(args: argparse.Namespace, test, sheets) -> int:
                     bins=args.bins, particles=args.particles, seed=args.seed, budget_band=band)
     if args.batch_key is not None:
         result.inputs["batch_key"] = args.batch_key
+    result.inputs["budget"] = budget
     if args.washed is not None:
         result.inputs |= {"washed_mm": args.washed, "whole_specimen_mass": whole}
         result.notes.insert(-1, f"washed through {args.washed:g} mm before the hydrometer: {test.mass * 1e3:.4g} g in "

@@ -301,6 +301,7 @@ def band_of(budget_file: Path, sample: str | None = None) -> dict[str, float]:
         band = {k: float(v) for k, v in chosen["physical_total_pp"].items()}
     except (TypeError, ValueError):
         band = {}
-    if not band or not all(math.isfinite(v) and v >= 0 for v in band.values()):
-        raise ValueError(f"{what}: the physical totals of '{chosen['sample']}' are not numbers >= 0")
+    if not band or not all(math.isfinite(v) and 0 <= v <= 100 for v in band.values()):
+        raise ValueError(f"{what}: the physical totals of '{chosen['sample']}' are not points of percent finer "
+                         "(numbers from 0 to 100)")
     return band
