@@ -276,3 +276,21 @@ def test_a_batch_inverts_every_sample_names_the_broken_one_and_resumes(tmp_path,
     printed = capsys.readouterr().out
     assert f"{SAMPLES[0].name}: fits" in printed and "(done before with the same inputs)" in printed
     assert printed.count("(done before with the same inputs)") == 1
+
+
+def test_one_misread_row_is_named_as_such_not_as_a_unit(tmp_path, capsys):
+    """A 41 C among 19-21 C rows is a misreading of that row, not a sheet in Fahrenheit (41 F is 5 C); a
+    sphere whose own mass is off makes every reading 'beyond the whole sample', and the message names it."""
+    sheet = tmp_path / "h.csv"
+    sheet.write_text("time_min,reading,temperature_C\n1,30,19\n2,28,41\n4,27,21\n")
+    with pytest.raises(SheetError, match="line 3: temperature_C 41 C is not within 0-40 C: .*the column's other rows "
+                                         "read 19 to 21 C: check this one") as refused:
+        read_sheet(sheet)
+    assert "written in F" not in str(refused.value)
+    sheet.write_text("time_min,reading,temperature_C\n1,30,68\n2,28,70\n")
+    with pytest.raises(SheetError, match="written in F\\? that is 20 C"):
+        read_sheet(sheet)
+    buoyancy = REPO / "examples" / "inverse" / "buoyancy.csv"
+    message = _refusal(capsys, ["invert", str(buoyancy), "--mass", "0.06", "--sphere-mass", "0.021",
+                                "--out", str(tmp_path / "out")])
+    assert "--sphere-mass, --sphere-diameter" in message

@@ -208,12 +208,20 @@ def _clock_to_minutes(table: CsvFile, stirred: str | None) -> CsvFile:
 def _plausible(path: Path, lines: list[int], values: dict[str, np.ndarray], column: str,
                quantity: str | Range) -> None:
     """Refuses the first value of a column outside its quantity's plausible range (blank cells aside),
-    naming the line and the likely unit slip."""
+    naming the line and the likely unit slip; where the column's other values are plausible, one value is
+    a slip of its own, and the message gives theirs instead of a unit."""
     bounds = RANGES[quantity] if isinstance(quantity, str) else quantity
-    for line, value in zip(lines, values[column]):
+    column_values = values[column]
+    fine = np.array([math.isfinite(v) and bounds.refusal(v) is None for v in column_values])
+    for k, (line, value) in enumerate(zip(lines, column_values)):
         reason = bounds.refusal(value) if math.isfinite(value) else None
-        if reason is not None:
-            raise SheetError(f"{path}, line {line}: {column} {reason}")
+        if reason is None:
+            continue
+        if fine.sum() >= 2:    # the others read as the column's unit: this one is a misreading, not a unit
+            others = column_values[fine]
+            reason = (replace(bounds, slips=()).refusal(value) + f"; the column's other rows read {others.min():g} to "
+                      f"{others.max():g}{' ' + bounds.unit if bounds.unit else ''}: check this one")
+        raise SheetError(f"{path}, line {line}: {column} {reason}")
 
 
 def _sieve_sheet(path: Path, opening_mm: np.ndarray, passing: np.ndarray) -> SieveSheet:
@@ -306,8 +314,10 @@ def check_sheet(sheet: Sheet, whole: float, resolution: float, corrected: np.nda
     over = np.flatnonzero(signal > top + resolution)
     if len(over):
         k = over[0]
+        sphere = (", the sphere's own mass and diameter (--sphere-mass, --sphere-diameter: what it reads in clear "
+                  "water follows from them)" if sheet.instrument == "buoyancy" else "")
         raise SheetError(f"{sheet.where(k)}: the reading ({named(k)}) is beyond what the whole sample in suspension "
-                         f"reads ({whole:.4g}): check the sample mass, the units or the sheet")
+                         f"reads ({whole:.4g}): check the sample mass{sphere}, the units or the sheet")
     if sheet.instrument == "pipette" and values.max() < 0.005 * whole:
         raise SheetError(f"{sheet.label}: every sample weighs under 0.5 % of what the whole sample in suspension gives "
                          f"({whole:.4g} g): mass_g is in grams (masses in kg?), or the sample mass is wrong")
