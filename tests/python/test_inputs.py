@@ -172,7 +172,8 @@ def test_what_cannot_be_read_is_refused_in_one_line_naming_the_file_and_line(tmp
 
 @pytest.mark.parametrize("rows, message", [
     ("1,45,20\n2,40,20\n86400,5,20\n", "line 4: time_min 86400 min is not within 0.05-10080 min: a sedimentation test "
-                                       "is read from seconds after the start to a week; written in s? that is 1440 min"),
+                                       "is read from seconds after the start to a week; the column's other rows read 1 "
+                                       "to 2 min: check this one (or written in s? that is 1440 min"),
     ("1,45,68\n2,40,68\n", "line 2: temperature_C 68 C is not within 0-40 C: the water correlations' range; written in "
                            "F? that is 20 C: give 20"),
     ("1,45,20\n2,450,20\n", "line 3: reading 450 g/L is not within -5 to 60 g/L: a 152H's scale runs from -5 to 60 g/L"),

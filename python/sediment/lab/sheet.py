@@ -208,8 +208,8 @@ def _clock_to_minutes(table: CsvFile, stirred: str | None) -> CsvFile:
 def _plausible(path: Path, lines: list[int], values: dict[str, np.ndarray], column: str,
                quantity: str | Range) -> None:
     """Refuses the first value of a column outside its quantity's plausible range (blank cells aside),
-    naming the line and the likely unit slip; where the column's other values are plausible, one value is
-    a slip of its own, and the message gives theirs instead of a unit."""
+    naming the line and the likely unit slip; where the column's other values are plausible, the value
+    may be misread rather than in another unit, and the message gives theirs first."""
     bounds = RANGES[quantity] if isinstance(quantity, str) else quantity
     column_values = values[column]
     fine = np.array([math.isfinite(v) and bounds.refusal(v) is None for v in column_values])
@@ -217,10 +217,12 @@ def _plausible(path: Path, lines: list[int], values: dict[str, np.ndarray], colu
         reason = bounds.refusal(value) if math.isfinite(value) else None
         if reason is None:
             continue
-        if fine.sum() >= 2:    # the others read as the column's unit: this one is a misreading, not a unit
+        if fine.sum() >= 2:    # the others read as the column's unit: this one may be misread
             others = column_values[fine]
-            reason = (replace(bounds, slips=()).refusal(value) + f"; the column's other rows read {others.min():g} to "
-                      f"{others.max():g}{' ' + bounds.unit if bounds.unit else ''}: check this one")
+            plain = replace(bounds, slips=()).refusal(value)
+            slip = reason[len(plain):]
+            reason = (f"{plain}; the column's other rows read {others.min():g} to {others.max():g}"
+                      f"{' ' + bounds.unit if bounds.unit else ''}: check this one" + (f" (or{slip[1:]})" if slip else ""))
         raise SheetError(f"{path}, line {line}: {column} {reason}")
 
 
