@@ -89,6 +89,7 @@ class OutputSet:
         self.published = False
         self._foreign: list[str] = []
         self.removed_sets: list[tuple[str, Path]] = []    # sets (name, folder) removed with what they were made from
+        self.dropped: list[str] = []    # the previous set's entries this one did not write again, removed with it
         self._created = [p for p in (self.folder, *self.folder.parents) if not p.exists()]
         self._lock = folder_lock(self.folder, "write")
 
@@ -147,8 +148,9 @@ class OutputSet:
         sets = {k: v for k, v in sets.items() if v["files"] or k == self.name}
         manifest["sets"] = sets
         (self.stage / MANIFEST).write_text(json.dumps(manifest) + "\n")
+        self.dropped = sorted(touched - set(entries))
         journal = {"set": self.name, "stage": self.stage.name, "move": entries,
-                   "remove": sorted(touched - set(entries)) + self._foreign}
+                   "remove": self.dropped + self._foreign}
         (self.stage / JOURNAL).write_text(json.dumps(journal) + "\n")
         with signals_held():    # Ctrl-C waits until every file is in place
             os.rename(self.stage / JOURNAL, self.folder / JOURNAL)

@@ -43,6 +43,20 @@ def test_a_set_replaces_its_own_files_and_keeps_everyone_elses(tmp_path):
     assert contents(tmp_path) == {"fit.csv": "f1", "hydrometer.csv": "h2", "notes.txt": "mine", "runs/b/y": "r2"}
     assert set(read_manifest(tmp_path)["sets"]) == {"readout", "invert"}
     assert not list(tmp_path.glob(".sediment-stage-*")) and not (tmp_path / JOURNAL).exists()
+    with OutputSet(tmp_path, "readout") as outputs:    # what it removes of its previous files, it says
+        (outputs.stage / "hydrometer.csv").write_text("h3")
+        outputs.publish()
+        assert outputs.dropped == ["runs"]
+
+
+def test_a_design_never_replaces_an_inversion_in_its_folder(tmp_path, capsys):
+    """`invert --design` and an inversion are different sets: a design into a finished inversion's folder is
+    refused, naming the inversion's files, which stay as they were (it removed them before)."""
+    out = tmp_path / "out"
+    publish(out, "invert", {"psd.csv": "psd", "runs/round1/x": "r"})
+    code = cli.main(["invert", "--design", str(SAMPLE5), "--masses", "0.05", "--particles", "2000", "--out", str(out)])
+    assert code == 2 and "written by sediment invert" in capsys.readouterr().err
+    assert contents(out) == {"psd.csv": "psd", "runs/round1/x": "r"}
 
 
 @pytest.mark.parametrize("meddle, why", [

@@ -127,14 +127,19 @@ def _publish(outputs) -> None:
         print(f"wrote {outputs.folder}: " + ", ".join(p.name + ("/" if p.is_dir() else "") for p in written))
     else:
         print(f"wrote nothing into {outputs.folder}: this {outputs.name} writes no file")
+    if outputs.dropped:
+        print(f"removed {len(outputs.dropped)} file(s) of this {outputs.name}'s previous results that it did not write "
+              f"again: {', '.join(outputs.dropped)}")
     for name, folder in outputs.removed_sets:
         print(f"removed the results of sediment {name} in {folder}: they were made from files this "
               f"{outputs.name} removed")
 
 
 def result_set(args: argparse.Namespace) -> str:
-    """The name of the set of files a command writes: the command, and its study or test."""
-    return " ".join([args.command] + [getattr(args, k) for k in ("study", "test") if getattr(args, k, None)])
+    """The name of the set of files a command writes: the command, and its study or test (`invert --design`'s
+    set is not an inversion's: one does not replace the other's files)."""
+    design = ["design"] if getattr(args, "design", None) is not None else []
+    return " ".join([args.command] + design + [getattr(args, k) for k in ("study", "test") if getattr(args, k, None)])
 
 
 def inputs_of(args: argparse.Namespace) -> list[Path]:
