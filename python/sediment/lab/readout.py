@@ -307,17 +307,6 @@ class Hydrometer:
         above = h[-1] + (reading - r[-1]) * (h[-1] - h[-2]) / (r[-1] - r[-2])
         return np.where(reading < r[0], below, np.where(reading > r[-1], above, inside))
 
-    def reading_at(self, distance):
-        """The reading [g/L] whose graduation lies `distance` [m] above the bulb's centre."""
-        distance = np.asarray(distance, float)
-        if not self.calibration:
-            return (self.scale_zero + self.bulb_length / 2 - distance) / self.scale_step
-        r, h = np.array(self.calibration).T
-        inside = np.interp(distance, h[::-1], r[::-1])
-        above = r[0] + (distance - h[0]) * (r[1] - r[0]) / (h[1] - h[0])
-        below = r[-1] + (distance - h[-1]) * (r[-1] - r[-2]) / (h[-1] - h[-2])
-        return np.where(distance > h[0], above, np.where(distance < h[-1], below, inside))
-
     @staticmethod
     def liquid_density(reading) -> np.ndarray:
         """The density [kg/m3] of the uniform liquid in which a 152H reads `reading` [g/L]."""
