@@ -22,7 +22,7 @@ Stages 0-3 settle each bin at constant speeds, exactly (no DEM), so the breakdow
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -36,6 +36,9 @@ from .grid import SizeGrid
 from .model import ForwardRun, LabTest, linearise, psd_of, settling_diameter
 
 EFFECTS = ("fit", "temperature record", "drag curve", "instrument body", "hindrance")
+# the mean settling speed of dilute polydisperse spheres of one density falls as 1 + S phi, S = -5.3 +- 1.1 (90 %
+# confidence) measured at phi 0.13-2.5 % (X-ray attenuation, J. Fluid Mech.; docs/inverse.md)
+MEASURED_HINDRANCE = (-5.3 - 1.1, -5.3 + 1.1)
 LAYERS = 800              # the analytic columns' layers (0.45 mm in a 36 cm suspension)
 
 
@@ -82,6 +85,20 @@ class Breakdown:
                           "changes": dict(zip(EFFECTS, map(float, self.changes[k]))),
                           "inverse_percent": float(self.inverse[k]), "band": [float(self.low[k]), float(self.high[k])]}
                          for k, name in enumerate(self.instrument)]}
+
+    def hindrance_band(self, water: Suspension, diameter: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """How far below and above the answer the measured hindrance's spread puts it at each diameter
+        [points]: the hindrance's change scaled by the measured slopes over the model's (Richardson & Zaki
+        at a dilute 1 %), taken between the readings' diameters (the nearest reading's beyond them)."""
+        dilute = 0.01
+        free, hindered = (terminal_speeds(water, np.array([1e-5]), "standard", 1.0 - phi, "richardson-zaki")[0]
+                          for phi in (0.0, dilute))
+        model = (hindered / free - 1.0) / dilute
+        order = np.argsort(self.diameter)
+        change = np.interp(np.log(diameter), np.log(self.diameter[order]),
+                           self.changes[order, EFFECTS.index("hindrance")])
+        shifts = np.array([(slope / model - 1.0) * change for slope in MEASURED_HINDRANCE])
+        return np.maximum(-shifts.min(axis=0), 0.0), np.maximum(shifts.max(axis=0), 0.0)
 
     def line(self) -> str:
         """The console's line: how far the inverse is from the standard reduction and what makes it."""
@@ -143,10 +160,15 @@ def breakdown(sheets: list[Sheet], reduction: list[Reduction], times: list[np.nd
     standard = np.concatenate([r.percent for r in reduction]) * share
     percent = np.array([psd_of(x, grid).at(at) * share for x in stages])
     changes = np.diff(np.vstack([standard, percent]), axis=0).T
-    low = np.interp(np.log(at), np.log(band[0]), band[1])
-    high = np.interp(np.log(at), np.log(band[0]), band[2])
     instruments = [s.instrument for s in sheets for _ in s.time]
-    return Breakdown(instruments, np.concatenate([s.time for s in sheets]), at, standard, changes, low, high)
+    result = Breakdown(instruments, np.concatenate([s.time for s in sheets]), at, standard, changes, at, at)
+    return breakdown_band(result, *band)
+
+
+def breakdown_band(result: Breakdown, diameter: np.ndarray, low: np.ndarray, high: np.ndarray) -> Breakdown:
+    """The breakdown with the inverse's band (`low`, `high` at `diameter`) read at its readings' diameters."""
+    at = np.log(result.diameter)
+    return replace(result, low=np.interp(at, np.log(diameter), low), high=np.interp(at, np.log(diameter), high))
 
 
 def drag_curve_diameters(water: Suspension, depth: np.ndarray, time: np.ndarray) -> np.ndarray:

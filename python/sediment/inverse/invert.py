@@ -15,7 +15,7 @@ from ..lab.psd import NOT_FITTING
 from ..lab.readout import SCALES, Suspension, gs_correction
 from ..lab.sheet import Reduction, Sheet, SieveSheet, SheetError, check_sheet, standard_reduction
 from ..results import Table, write_text
-from .breakdown import Breakdown, breakdown
+from .breakdown import Breakdown, breakdown, breakdown_band
 from .fit import ROUGHNESS_DECADES, draw_placement, end_placement, fit, penalty
 from .grid import NEAR, TOP, SizeGrid, size_grid
 from .model import LabTest, cut_diameters, effective_times, linearise, psd_of, run_forward, solids_signal, \
@@ -377,6 +377,12 @@ def invert(sheets: list[Sheet], test: LabTest, folder: Path, *, sieve: SieveShee
                     None if sieve is None else (sieve.opening, sieve.passing))
     out.corrections = breakdown(sheets, reduction, times, test, water, grid, data, sigma, sieve_rows, shares,
                                 sieves.share, (out.diameter, out.low, out.high))
+    # the hindrance is physical at its size, within the measured spread of its slope: that spread widens the band
+    below, above = out.corrections.hindrance_band(water, out.diameter)
+    measured = ~np.isin(out.basis, ("floor", "top"))
+    out.low[measured] = np.clip(out.percent - np.hypot(out.percent - out.low, below), 0.0, 100.0)[measured]
+    out.high[measured] = np.clip(out.percent + np.hypot(out.high - out.percent, above), 0.0, 100.0)[measured]
+    out.corrections = breakdown_band(out.corrections, out.diameter, out.low, out.high)
     out.notes.append(out.corrections.line())
     out.notes.append(f"forward model: {resolution}; {round_number} round(s)" + (
         "" if converged else f", not converged: the last round still moved the PSD by up to {moved:.2g} points "
