@@ -23,17 +23,22 @@ class Range:
     why: str
     slips: tuple[tuple[str, Callable[[float], float]], ...] = ()
 
-    def refusal(self, value: float) -> str | None:
-        """Why `value` is implausible, naming the slip that would explain it; None if it is plausible."""
+    def refusal(self, value: float, slips: bool = True) -> str | None:
+        """Why `value` is implausible, naming the slip that would explain it (with `slips`); None if it is
+        plausible."""
         if self.low <= value <= self.high:
             return None
         unit = f" {self.unit}" if self.unit else ""
         span = f"{self.low:g} to {self.high:g}" if self.low < 0 else f"{self.low:g}-{self.high:g}"
-        message = f"{value:g}{unit} is not within {span}{unit}: {self.why}"
-        # every slip that would explain the value: where two do, the user knows which unit they used
+        return f"{value:g}{unit} is not within {span}{unit}: {self.why}" + (self.slip(value) if slips else "")
+
+    def slip(self, value: float) -> str:
+        """Every unit slip that would explain `value` (where two do, the user knows which unit they used),
+        each as '; written in ...? that is ...: give ...', or ''."""
+        unit = f" {self.unit}" if self.unit else ""
         meant = [(name, convert(value)) for name, convert in self.slips]
-        return "".join([message] + [f"; written in {name}? that is {v:.6g}{unit}: give {v:.6g}" for name, v in meant
-                                    if self.low <= v <= self.high])
+        return "".join(f"; written in {name}? that is {v:.6g}{unit}: give {v:.6g}" for name, v in meant
+                       if self.low <= v <= self.high)
 
 
 def _times(factor: float) -> Callable[[float], float]:

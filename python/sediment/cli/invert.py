@@ -208,8 +208,9 @@ def hydrometer_step(args: argparse.Namespace, option: str, quantity: str = "", d
     grams = value * scale.per_unit
     named = f"--{option.replace('_', '-')}" + ("" if scale.name == "152H" else f" {value:g} (151H) as a 152H's:")
     quantity = quantity or option.replace("zero_", "")
-    if scale.name != "152H" and refusal(grams, quantity) is not None and refusal(value, quantity) is None:
-        raise ValueError(f"{named} {refusal(grams, quantity)}; written in a 152H's g/L? with --hydrometer-type 151H "
+    reason = refusal(grams, quantity)
+    if scale.name != "152H" and reason is not None and refusal(value, quantity) is None:
+        raise ValueError(f"{named} {reason}; written in a 152H's g/L? with --hydrometer-type 151H "
                          f"give it in specific gravity: {value / scale.per_unit:.3g}")
     return check(grams, quantity, named)
 

@@ -27,8 +27,10 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from .. import _core, figures
+from ..lab.psd import PSD
 from ..lab.readout import Column, Suspension, gs_correction
 from ..lab.sheet import Reduction, Sheet
+from ..lab.synthetic import settling_column
 from ..planner.screening import terminal_speeds
 from ..results import Table
 from .fit import fit
@@ -221,18 +223,12 @@ class AnalyticRun(ForwardRun):
     @classmethod
     def of(cls, grid: SizeGrid, test: LabTest, water: Suspension, times: np.ndarray) -> "AnalyticRun":
         """Each bin's fraction [bins, frames, layers] of the test's column at `times` [s]."""
-        edges = np.linspace(0.0, test.height, LAYERS + 1)
-        phi0 = test.initial_concentration / test.particle_density
-        bins = np.empty((grid.bins, len(times), LAYERS))
-        for k, (a, b) in enumerate(zip(grid.lower, grid.edges)):
-            sizes = np.geomspace(a, b, 17)
-            sizes = np.sqrt(sizes[1:] * sizes[:-1])    # 16 classes of even mass in log d
-            speed = terminal_speeds(water, sizes)
-            for f, t in enumerate(times):
-                front = np.minimum(speed * t, test.height)[:, None]
-                covered = np.clip(edges[1:] - np.maximum(edges[:-1], front), 0.0, None) / np.diff(edges)
-                bins[k, f] = phi0 * covered.mean(axis=0)
-        return cls(None, bins, np.ones(grid.bins), water, test, edges, np.asarray(times, float))
+        columns = [settling_column(PSD(np.array([a, b]), np.array([0.0, 100.0])), test.height, times,
+                                   test.initial_concentration, water, layers=LAYERS, classes=16,
+                                   speed=lambda d: terminal_speeds(water, d))
+                   for a, b in zip(grid.lower, grid.edges)]
+        bins = np.stack([c.fraction for c in columns])
+        return cls(None, bins, np.ones(grid.bins), water, test, columns[0].depth_edges, np.asarray(times, float))
 
     def column(self, shares: np.ndarray) -> Column:
         """The column of a split of the sample's mass among the bins."""

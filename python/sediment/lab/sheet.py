@@ -213,16 +213,15 @@ def _plausible(path: Path, lines: list[int], values: dict[str, np.ndarray], colu
     bounds = RANGES[quantity] if isinstance(quantity, str) else quantity
     column_values = values[column]
     fine = np.array([math.isfinite(v) and bounds.refusal(v) is None for v in column_values])
-    for k, (line, value) in enumerate(zip(lines, column_values)):
+    for line, value in zip(lines, column_values):
         reason = bounds.refusal(value) if math.isfinite(value) else None
         if reason is None:
             continue
         if fine.sum() >= 2:    # the others read as the column's unit: this one may be misread
-            others = column_values[fine]
-            plain = replace(bounds, slips=()).refusal(value)
-            slip = reason[len(plain):]
-            reason = (f"{plain}; the column's other rows read {others.min():g} to {others.max():g}"
-                      f"{' ' + bounds.unit if bounds.unit else ''}: check this one" + (f" (or{slip[1:]})" if slip else ""))
+            others, slip = column_values[fine], bounds.slip(value)
+            reason = (f"{bounds.refusal(value, slips=False)}; the column's other rows read {others.min():g} to "
+                      f"{others.max():g}{' ' + bounds.unit if bounds.unit else ''}: check this one"
+                      + (f" (or{slip[1:]})" if slip else ""))
         raise SheetError(f"{path}, line {line}: {column} {reason}")
 
 
