@@ -12,7 +12,7 @@ import numpy as np
 from .. import figures
 from ..lab import texture
 from ..lab.psd import NOT_FITTING
-from ..lab.readout import SCALES, Suspension, gs_correction
+from ..lab.readout import SCALES, Scale, Suspension, gs_correction
 from ..lab.sheet import Reduction, Sheet, SieveSheet, SheetError, check_sheet, standard_reduction
 from ..results import Table, write_text
 from .breakdown import Breakdown, breakdown, breakdown_band
@@ -269,11 +269,12 @@ def invert(sheets: list[Sheet], test: LabTest, folder: Path, *, sieve: SieveShee
                              "than the reading; check both")
         # the tolerance: twice the reading's noise, and 2 % of the solids' signal for the sampling of a real
         # suspension (a pipette's first samples can draw a little more than the mean)
-        tolerance = max(2 * test.noise[sheet.instrument], 0.02 * signal)
+        noise = test.noise[sheet.instrument]
+        tolerance = max(2 * noise, 0.02 * signal)
+        stated = "" if sheet.instrument == "pipette" else \
+            f" (now {noise_text(sheet.instrument, noise, sheet.scale)}; the tolerance is twice it, or 2 % of the solids' signal)"
         check_sheet(sheet, whole_sample_reading(sheet, test, water), tolerance, reading,
-                    NOISE_OPTIONS[sheet.instrument] + ("" if sheet.instrument == "pipette" else
-                                                       f" (now {noise_text(sheet, test.noise[sheet.instrument])}; the "
-                                                       "tolerance is twice it, or 2 % of the solids' signal)"))
+                    NOISE_OPTIONS[sheet.instrument] + stated)
     sieves = sieve_data(sieve, split, test.noise["sieve"])
     reduction = [standard_reduction(sheet, water, c0, test.hydrometer, test.cylinder_area, test.sphere, test.meniscus,
                                     test.correction(sheet)) for sheet in sheets]
@@ -431,10 +432,11 @@ NOISE_UNITS = {"hydrometer": "g/L", "pipette": "g/L", "buoyancy": "g", "sieve": 
 NOISE_OPTIONS = {"hydrometer": "--hydrometer-noise", "pipette": "--pipette-noise", "buoyancy": "--balance-noise"}
 
 
-def noise_text(sheet: Sheet, noise: float) -> str:
-    """A sheet's reading error as its noise option states it."""
-    return sheet.scale.quoted_step(noise) if sheet.instrument == "hydrometer" else \
-        f"{noise:g} {NOISE_UNITS[sheet.instrument]}"
+def noise_text(instrument: str, noise: float, scale: Scale) -> str:
+    """An instrument's reading error as its noise option states it (a hydrometer's on its `scale`)."""
+    return scale.quoted_step(noise) if instrument == "hydrometer" else f"{noise:g} {NOISE_UNITS[instrument]}"
+
+
 STEP_WARNING = 15.0        # points between the coarsest cut and the next sieve that deserve a second look
 STEP_STEEPNESS = 50.0      # and per decade of diameter: a soil's silt rises by 20-40 points a decade
 
@@ -475,8 +477,7 @@ def _inputs_line(test: LabTest, inputs: dict) -> str:
             + f", the specimen's largest grain {inputs['top_um']:g} um"
             + (f" (the part passing {inputs['split_mm']:g} mm, {100 * inputs['specimen_share']:.4g} % of the sample)"
                if inputs["split_mm"] else "")
-            + "; noise: " + ", ".join(f"{k} {scale.quoted_step(v) if k == 'hydrometer' else f'{v:g} {NOISE_UNITS[k]}'}"
-                                      for k, v in test.noise.items())
+            + "; noise: " + ", ".join(f"{k} {noise_text(k, v, scale)}" for k, v in test.noise.items())
             + f", thermometer {test.thermometer:g} C"
             + "; sheets: " + ", ".join(Path(s).name for s in inputs["sheets"]))
 
