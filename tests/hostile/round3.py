@@ -450,6 +450,10 @@ OPTIONS = {
         ("--cylinder-area", "27.8", [("area",), ("27.8", "cm2", "m2")], "cm2 for m2"),
         ("--height", "36", [("height",), ("36",)], "cm for m"),
         ("--split", "2000", [("split", "opening"), ("2000", "mm")], "um for mm"),
+        ("--volume", "1000", [("volume",), ("1000", "mL")], "mL for m3"),
+        ("--bulb-volume", "67", [("bulb", "volume"), ("67", "mL", "cm3")], "cm3 for m3"),
+        ("--bulb-length", "14", [("bulb", "length"), ("14", "cm")], "cm for m"),
+        ("--hydrometer-type", "151H", [("151H", "hydrometer-type"), ("specific gravit",)], "a 152H sheet as a 151H"),
     ]),
     "invert-plain": (["invert", INV / "hydrometer.csv", "--mass", "0.06", *INVERT_SMALL, "--out", OUT], [
         ("--zero-correction", "2500", [("correction",), ("2500", "2.45e+03")], "implausible"),
