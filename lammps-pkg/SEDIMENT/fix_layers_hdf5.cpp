@@ -148,8 +148,15 @@ void create_frames(hid_t where, const char *name, hid_t type, int rank, const hs
              std::string("dataset ") + name);
 }
 
-// The frame datasets, in the order of FixLayersHDF5::frame_sets.
-constexpr const char *FRAME_SETS[3] = {"time", "step", "fraction"};
+// The frame datasets, in the order of FixLayersHDF5::frame_sets; the last, the fluid's density and
+// viscosity per frame, only in the files of a fix with a fluid.
+constexpr const char *FRAME_SETS[4] = {"time", "step", "fraction", "fluid"};
+constexpr int FLUID_SET = 3;
+
+bool has_dataset(hid_t handle, const char *name)
+{
+  return H5Lexists(handle, name, H5P_DEFAULT) > 0;
+}
 
 // Resizes an open frame dataset to `frames` and writes its last `count` frames from `data`.
 void put_frames(hid_t set, const char *name, hid_t type, hsize_t frames, hsize_t count, const void *data)
@@ -204,7 +211,7 @@ long long frames_before(hid_t handle, LAMMPS_NS::bigint step)
 // killed between them may leave them uneven). Throws saying what does not read back.
 void read_back(hid_t handle, bool equal)
 {
-  hsize_t centres = 0, counts[3] = {0, 0, 0};
+  hsize_t centres = 0, counts[4] = {0, 0, 0, 0};
   {
     Handle set(H5Dopen2(handle, "layer_centre", H5P_DEFAULT), H5Dclose, "dataset layer_centre");
     Handle space(H5Dget_space(set), H5Sclose, "dataspace");
@@ -212,17 +219,21 @@ void read_back(hid_t handle, bool equal)
   }
   const std::string columns = read_string_attribute(handle, "columns");
   const hsize_t column_count = columns.empty() ? 0 : 1 + std::count(columns.begin(), columns.end(), ',');
-  for (int k = 0; k < 3; ++k) {
+  const int sets = has_dataset(handle, FRAME_SETS[FLUID_SET]) ? 4 : 3;
+  for (int k = 0; k < sets; ++k) {
     const char *name = FRAME_SETS[k];
+    const int expected_rank = k == 2 ? 3 : k == FLUID_SET ? 2 : 1;
     Handle set(H5Dopen2(handle, name, H5P_DEFAULT), H5Dclose, std::string("dataset ") + name);
     Handle space(H5Dget_space(set), H5Sclose, "dataspace");
     const int rank = H5Sget_simple_extent_ndims(space);
     hsize_t dims[3] = {0, 1, 1};
-    if (rank != (k == 2 ? 3 : 1) || H5Sget_simple_extent_dims(space, dims, nullptr) < 0)
+    if (rank != expected_rank || H5Sget_simple_extent_dims(space, dims, nullptr) < 0)
       throw std::runtime_error(fmt::format("dataset {} has {} dimensions", name, rank));
     if (k == 2 && (dims[1] != centres || dims[2] != column_count))
       throw std::runtime_error(fmt::format("dataset fraction has {} layers x {} columns, the file names {} x {}",
                                            dims[1], dims[2], centres, column_count));
+    if (k == FLUID_SET && dims[1] != 2)
+      throw std::runtime_error(fmt::format("dataset fluid has {} values per frame, not 2", dims[1]));
     counts[k] = dims[0];
     const hsize_t block[3] = {k == 2 ? 1 : dims[0], dims[1], dims[2]};
     if (dims[0] == 0) continue;
@@ -237,9 +248,10 @@ void read_back(hid_t handle, bool equal)
                                         : fmt::format("dataset {} does not read back (damaged: its checksum fails)", name));
     }
   }
-  if (equal && (counts[0] != counts[1] || counts[1] != counts[2]))
-    throw std::runtime_error(fmt::format("the frame datasets hold {} times, {} steps and {} fractions", counts[0],
-                                         counts[1], counts[2]));
+  if (equal && (counts[0] != counts[1] || counts[1] != counts[2] || (sets == 4 && counts[3] != counts[0])))
+    throw std::runtime_error(fmt::format("the frame datasets hold {} times, {} steps and {} fractions{}", counts[0],
+                                         counts[1], counts[2],
+                                         sets == 4 ? fmt::format(" and {} fluids", counts[3]) : std::string()));
 }
 
 // CRC-32 (IEEE 802.3, as zlib's crc32 and Python's zlib.crc32) and size of a file; false if it cannot be read.
@@ -290,8 +302,8 @@ void copy_file(const std::string &from, const std::string &to)
 }    // namespace
 
 FixLayersHDF5::FixLayersHDF5(LAMMPS *lmp, int narg, char **arg) :
-    Fix(lmp, narg, arg), compute_id(nullptr), particle_density(0.0), grid(nullptr), file(-1),
-    frame_sets{-1, -1, -1}, is_open(false), frames(0), last_write(0.0),
+    Fix(lmp, narg, arg), compute_id(nullptr), particle_density(0.0), grid(nullptr),
+    fluid_now{0.0, 0.0}, fluid_run{0.0, 0.0}, file(-1), frame_sets{-1, -1, -1, -1}, is_open(false), frames(0), last_write(0.0),
     overwrite(false), end_time(-1.0), resumed_frames(-1), last_frame_step(-1), summed_restart(-1)
 {
   if (narg < 6)
@@ -305,7 +317,6 @@ FixLayersHDF5::FixLayersHDF5(LAMMPS *lmp, int narg, char **arg) :
     error->all(FLERR, "Fix layers/hdf5: expected a compute reference c_ID, not '{}'", arg[5]);
   compute_id = utils::strdup(arg[5] + 2);
   StyleArgs args(lmp, FLERR, "Fix layers/hdf5", narg, arg, 6);
-  std::string fluid_id;
   while (args.more()) {
     args.need(1, "a value");
     if (args.is("fluid")) {
@@ -326,6 +337,8 @@ FixLayersHDF5::FixLayersHDF5(LAMMPS *lmp, int narg, char **arg) :
         FixFluid::find(lmp, fluid_id.c_str(), "Fix layers/hdf5 (define the fluid before it)")->properties();
     water = {{"fluid_density", fluid.density}, {"fluid_viscosity", fluid.viscosity},
              {"fluid_yield_stress", fluid.yield_stress}};
+    fluid_now[0] = fluid_run[0] = fluid.density;
+    fluid_now[1] = fluid_run[1] = fluid.viscosity;
   }
   scalar_flag = 1;
   global_freq = 1;
@@ -384,6 +397,12 @@ template <typename Action> void FixLayersHDF5::on_rank0(Action action)
 
 void FixLayersHDF5::init()
 {
+  if (!fluid_id.empty()) {    // the fluid of this run (a deck may re-issue it between runs), from its first step
+    const sediment::Fluid &fluid =
+        FixFluid::find(lmp, fluid_id.c_str(), "Fix layers/hdf5 (its fluid was deleted?)")->properties();
+    fluid_run[0] = fluid.density;
+    fluid_run[1] = fluid.viscosity;
+  }
   Compute *compute = sediment_find_compute(lmp, compute_id, "Fix layers/hdf5");
   grid = dynamic_cast<ComputeConcentrationGrid *>(compute);
   if (!grid)
@@ -396,7 +415,10 @@ void FixLayersHDF5::init()
 void FixLayersHDF5::setup(int /*vflag*/)
 {
   if (!is_open) open_file();
+  // a frame at a run's start is the state the previous run's water left (the first: the fluid's when
+  // this fix was defined); this run's steps are in its own
   if (update->ntimestep % nevery == 0) take_frame(true);
+  std::copy(fluid_run, fluid_run + 2, fluid_now);
 }
 
 void FixLayersHDF5::end_of_step()
@@ -461,7 +483,8 @@ void FixLayersHDF5::open_file()
       if (file < 0) throw std::runtime_error("cannot be opened for writing");
       frames = frames_before(file, step_now);
       open_frame_sets();
-      for (int k = 0; k < 3; ++k) put_frames(frame_sets[k], FRAME_SETS[k], H5T_NATIVE_DOUBLE, frames, 0, nullptr);
+      for (int k = 0; k < 4; ++k)
+        if (frame_sets[k] >= 0) put_frames(frame_sets[k], FRAME_SETS[k], H5T_NATIVE_DOUBLE, frames, 0, nullptr);
       set_attribute(file, "complete", 0.0);
       check(H5Fflush(file, H5F_SCOPE_GLOBAL), "flush");
       return;
@@ -493,6 +516,8 @@ void FixLayersHDF5::open_file()
     create_frames(file, "time", H5T_NATIVE_DOUBLE, 1, nullptr);
     create_frames(file, "step", H5T_NATIVE_LLONG, 1, nullptr);
     create_frames(file, "fraction", H5T_NATIVE_DOUBLE, 3, shape);
+    const hsize_t fluid_values[1] = {2};
+    if (!fluid_id.empty()) create_frames(file, FRAME_SETS[FLUID_SET], H5T_NATIVE_DOUBLE, 2, fluid_values);
     open_frame_sets();
     check(H5Fflush(file, H5F_SCOPE_GLOBAL), "flush");
   });
@@ -516,6 +541,7 @@ void FixLayersHDF5::take_frame(bool write_now)
       for (int c = 0; c < cols; ++c) pending_values.push_back(array[k][c + 1]);
     pending_time.push_back(update->atime + (step - update->atimestep) * update->dt);
     pending_step.push_back(step);
+    if (!fluid_id.empty()) pending_fluid.insert(pending_fluid.end(), fluid_now, fluid_now + 2);
     last_frame_step = step;
     ++frames;
     if (write_now || MPI_Wtime() - last_write >= WRITE_INTERVAL ||
@@ -534,7 +560,10 @@ void FixLayersHDF5::write_pending()
   put_frames(frame_sets[0], FRAME_SETS[0], H5T_NATIVE_DOUBLE, frames, count, pending_time.data());
   put_frames(frame_sets[1], FRAME_SETS[1], H5T_NATIVE_LLONG, frames, count, pending_step.data());
   put_frames(frame_sets[2], FRAME_SETS[2], H5T_NATIVE_DOUBLE, frames, count, pending_values.data());
+  if (frame_sets[FLUID_SET] >= 0)
+    put_frames(frame_sets[FLUID_SET], FRAME_SETS[FLUID_SET], H5T_NATIVE_DOUBLE, frames, count, pending_fluid.data());
   check(H5Fflush(file, H5F_SCOPE_GLOBAL), "writing the frames (disk full?)");
+  pending_fluid.clear();
   pending_time.clear();
   pending_step.clear();
   pending_values.clear();
@@ -587,6 +616,9 @@ std::string FixLayersHDF5::choose_file(bigint step_now, size_t layers, size_t co
       H5Sget_simple_extent_dims(space, dims, nullptr);
       if (dims[1] != layers || dims[2] != columns)
         differs = fmt::format("{} layers x {} columns, the compute gives {} x {}", dims[1], dims[2], layers, columns);
+      if (differs.empty() && has_dataset(old, FRAME_SETS[FLUID_SET]) != !fluid_id.empty())
+        differs = fluid_id.empty() ? "the fluid of each frame, this run names no fluid"
+                                   : "no fluid per frame (an earlier version's file), this run records it";
       for (const auto &[name, value] : identity) {
         const double held = H5Aexists(old, name) > 0 ? read_double_attribute(old, name) : 0.0;
         if (differs.empty() && held != value) differs = fmt::format("{} {}, this run has {}", name, held, value);
@@ -666,7 +698,8 @@ std::string FixLayersHDF5::incomplete_reason(long long file_id) const
 
 void FixLayersHDF5::open_frame_sets()
 {
-  for (int k = 0; k < 3; ++k) {
+  for (int k = 0; k < 4; ++k) {
+    if (k == FLUID_SET && fluid_id.empty()) continue;
     frame_sets[k] = H5Dopen2(file, FRAME_SETS[k], H5P_DEFAULT);
     if (frame_sets[k] < 0) throw std::runtime_error(std::string("dataset ") + FRAME_SETS[k] + " cannot be opened");
   }

@@ -45,14 +45,20 @@ class FixLayersHDF5 : public Fix {
   // (a deck may re-issue the fluid between runs as a temperature record goes), which a resumed run
   // must have too.
   std::vector<std::pair<const char *, double>> water;
+  // The fluid fix (empty: none); the density and viscosity of the water the steps before the next
+  // frame ran in, which each frame records (a reading of the frames then takes the water as it was),
+  // and those of the current run (init).
+  std::string fluid_id;
+  double fluid_now[2], fluid_run[2];
   long long file;       // hid_t of the open file (rank 0), -1 when closed
-  // hid_t of its frame datasets time, step and fraction (rank 0), open while the file is: opening
-  // and closing them for each frame was three quarters of the cost of writing it.
-  long long frame_sets[3];
+  // hid_t of its frame datasets time, step, fraction and, with a fluid, fluid (rank 0; -1: absent),
+  // open while the file is: opening and closing them for each frame was three quarters of the cost
+  // of writing it.
+  long long frame_sets[4];
   bool is_open;         // the same on every rank (file is only meaningful on rank 0)
   long long frames;     // frames taken: in the file and waiting to be written (rank 0)
   // Frames taken but not yet in the file (rank 0), row by row, and when the file was last written.
-  std::vector<double> pending_time, pending_values;
+  std::vector<double> pending_time, pending_values, pending_fluid;
   std::vector<long long> pending_step;
   double last_write;
   static constexpr double WRITE_INTERVAL = 1.0;             // seconds a frame waits at most

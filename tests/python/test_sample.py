@@ -113,6 +113,25 @@ def test_the_water_follows_its_temperature_record(tmp_path):
     # solids left in the upper half at the end: fewer in the warmed water
     upper = plain.centres > 0.5 * plain.centres.max()
     assert warmed.total[-1, upper].sum() < 0.95 * plain.total[-1, upper].sum()
+    # each frame records the water its steps ran in (the fluid re-issued at 1800 s), and a readout takes
+    # each reading's grains through the water as it changed: the 2 min reading in water at 20 C, the
+    # 60 min one half in each (Stokes' speed goes as (rho_p - rho_f) / mu)
+    cold, warm = Suspension.at_temperature(20.0), Suspension.at_temperature(35.0)
+    assert plain.fluid is not None and np.allclose(plain.fluid, [cold.fluid_density, cold.viscosity], rtol=1e-11)
+    assert np.allclose(warmed.fluid[before], [cold.fluid_density, cold.viscosity], rtol=1e-11)
+    assert np.allclose(warmed.fluid[~before], [warm.fluid_density, warm.viscosity], rtol=1e-11)
+    from sediment.lab.readout import Column, Hydrometer
+    column = Column.from_layers(warmed)
+    assert "changed over the test" in column.water_text() and Column.from_layers(plain).water is None
+    readings = Hydrometer.astm_152h().read(column, [120.0, 3600.0])
+    (early, late), (d_early, d_late) = readings.depth, readings.diameter
+    assert d_early == pytest.approx(cold.stokes_diameter(early, 120.0), rel=1e-9)
+    rate = [(f.particle_density - f.fluid_density) / f.viscosity for f in (cold, warm)]
+    exact = math.sqrt(18 * late / (cold.gravity * 1800.0 * sum(rate)))
+    # (the water goes from cold to warm between the frame at 1800 s and the next, linear between them)
+    gap = np.min(warmed.time[~before]) - 1800.0
+    assert d_late == pytest.approx(exact, rel=gap / 3600.0)
+    assert abs(d_late / cold.stokes_diameter(late, 3600.0) - 1) > 0.05 < abs(d_late / warm.stokes_diameter(late, 3600.0) - 1)
 
 
 def test_contacts_without_a_floor_hold_the_grains_meetings():

@@ -100,9 +100,10 @@ def run(args: argparse.Namespace) -> int:
             raise ValueError("--temperature sets the viscosity: give one of --temperature and --viscosity")
         if args.temperature is not None:    # the lab's record, which may differ from the simulation's water
             water = Suspension.at_temperature(args.temperature, column.suspension.particle_density)
-            column = replace(column, suspension=water)
+            column = replace(column, suspension=water, water=None)
         if args.viscosity is not None:
-            column = replace(column, suspension=replace(column.suspension, viscosity=args.viscosity, temperature=None))
+            column = replace(column, suspension=replace(column.suspension, viscosity=args.viscosity, temperature=None),
+                             water=None)
         title = f"{args.layers.parent.name}/{args.layers.name}: simulated sedimentation test"
         made_by = " by " + layers.identity["code_version"] if "code_version" in layers.identity else ""
         frames_of = f"frames of run {layers.identity.get('run_id') or '(unnamed)'}{made_by}: {args.layers}"

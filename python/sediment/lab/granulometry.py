@@ -51,6 +51,10 @@ def read_all(column: Column, instruments: list[str], schedule: str = "d422", sph
     f = column.suspension
     notes = [f"readout inputs: Gs = {f.specific_gravity:.4g}, water {f.fluid_density:.6g} kg/m3, viscosity "
              f"{f.viscosity:.4g} Pa s, c0 = {column.initial_concentration():.4g} kg/m3, column {column.height:.4g} m"]
+    if column.water_text():
+        notes.append(column.water_text())
+    # a reading time at the last frame's to the digits a sum of time steps keeps is read at that frame
+    last = column.time[-1]
     results = []
     for name in instruments:
         if name == "hydrometer":
@@ -62,6 +66,7 @@ def read_all(column: Column, instruments: list[str], schedule: str = "d422", sph
         else:
             pipette = Pipette(pipette_depth, pipette_volume)
             read, times = pipette.read, pipette.default_times(column.suspension)
+        times = np.where(np.abs(times - last) <= 1e-9 * last, last, times)
         early, late = int(np.sum(times <= column.time[0])), int(np.sum(times > column.time[-1]))
         covered = times[(times > column.time[0]) & (times <= column.time[-1])]
         if early:
@@ -69,7 +74,7 @@ def read_all(column: Column, instruments: list[str], schedule: str = "d422", sph
                          f"(at {column.time[min(1, len(column.time) - 1)] / 60:.3g} min)")
         if late:
             notes.append(f"{name}: {late} of {len(times)} reading times come after the last frame (at "
-                         f"{column.time[-1] / 60:.3g} min)")
+                         f"{column.time[-1] / 60:.6g} min)")
         # A reading is interpolated between the frames around it: frames farther apart than the
         # reading's own time would make it a guess.
         index = np.clip(np.searchsorted(column.time, covered), 1, len(column.time) - 1)

@@ -9,7 +9,7 @@ the solid volume fraction per layer. Each instrument turns it into a `Readings` 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
@@ -117,6 +117,9 @@ class Column:
     fraction: np.ndarray        # [frames, layers]
     suspension: Suspension = field(default_factory=Suspension)
     slab_thickness: float = 0.0  # > 0 for a 2d slab (the pipette samples a circle)
+    # [frames, 2] the water's density and viscosity per frame where it changed over the test (a
+    # temperature record); None: `suspension`'s water throughout
+    water: np.ndarray | None = None
 
     def __post_init__(self) -> None:
         if self.fraction.shape != (len(self.time), len(self.depth_edges) - 1):
@@ -124,6 +127,8 @@ class Column:
                              f"({len(self.time)}, {len(self.depth_edges) - 1})")
         if np.any(np.diff(self.time) <= 0):
             raise ValueError("frame times must increase")
+        if self.water is not None and np.asarray(self.water).shape != (len(self.time), 2):
+            raise ValueError(f"water has shape {np.asarray(self.water).shape}, expected ({len(self.time)}, 2)")
 
     @classmethod
     def from_layers(cls, layers, surface: float | None = None, fraction: np.ndarray | None = None) -> "Column":
@@ -146,7 +151,37 @@ class Column:
         fraction = (layers.total if fraction is None else fraction)[:, ::-1][:, keep]
         suspension = Suspension(attrs["fluid_density"], attrs["fluid_viscosity"], attrs["particle_density"],
                                 temperature=None)
-        return cls(edges, np.asarray(layers.time, float), fraction, suspension, attrs.get("slab_thickness", 0.0))
+        water = getattr(layers, "fluid", None)
+        if water is not None and np.all(water == water[0]):
+            water = None    # one water throughout: the attributes say it
+        return cls(edges, np.asarray(layers.time, float), fraction, suspension, attrs.get("slab_thickness", 0.0), water)
+
+    def suspension_at(self, t: float) -> Suspension:
+        """The suspension at time t: its water as the frames recorded it (linear between frames), with
+        the viscosity that gives Stokes' law the fall of a grain over 0..t in the water as it changed
+        (its speed goes as (rho_p - rho_f) / mu: the mean of that ratio over the time, weighted exactly),
+        so that `stokes_diameter(depth, t)` is the grain that fell `depth` by then."""
+        if self.water is None:
+            return self.suspension
+        density, viscosity = self.water[:, 0], self.water[:, 1]
+        excess = self.suspension.particle_density - density
+        rate = excess / viscosity    # the grains' speed over D^2 g / 18, frame by frame
+        # its time integral, the trapezoid between frames (the water is linear between them)
+        fallen = np.concatenate([[0.0], np.cumsum(0.5 * (rate[1:] + rate[:-1]) * np.diff(self.time))])
+        here = float(np.interp(t, self.time, density))
+        since = float(np.interp(t, self.time, fallen)) + self.time[0] * rate[0]    # before the first frame too
+        mean_rate = since / t if t > 0 else float(rate[0])
+        return replace(self.suspension, fluid_density=here,
+                       viscosity=(self.suspension.particle_density - here) / mean_rate, temperature=None)
+
+    def water_text(self) -> str | None:
+        """How the water changed over the frames, for a report; None where it did not."""
+        if self.water is None:
+            return None
+        mu = self.water[:, 1]
+        return (f"the water changed over the test (viscosity {mu.min():.4g}-{mu.max():.4g} Pa s, density "
+                f"{self.water[:, 0].min():.6g}-{self.water[:, 0].max():.6g} kg/m3, as the run's frames record it): "
+                "each reading is reduced at the water of its time, as a laboratory reads its thermometer")
 
     @property
     def height(self) -> float:
@@ -170,7 +205,7 @@ class Column:
 
     def density(self, t: float) -> np.ndarray:
         """Suspension density rho_f + (rho_p - rho_f) phi per layer [kg/m3]."""
-        return self.suspension.mixture_density(self.at(t))
+        return self.suspension_at(t).mixture_density(self.at(t))
 
     def mass_profile(self, t: float):
         """The integral of the suspension density from the surface to a depth [kg/m2] at time t, as a
@@ -181,7 +216,8 @@ class Column:
         def above(depth):
             depth = np.asarray(depth, float)
             inside = np.interp(depth, self.depth_edges, cumulative)
-            return inside + np.maximum(depth - self.height, 0.0) * self.suspension.fluid_density
+            return inside + np.maximum(depth - self.height, 0.0) * fluid_density
+        fluid_density = self.suspension_at(t).fluid_density
         return above
 
     def weighted_mean(self, t: float, centre: float, radius: float, disc: bool = False) -> float:
@@ -323,6 +359,12 @@ class Hydrometer:
         density = alpha / (np.asarray(top, float) + beta)
         return (density - WATER_20C_DENSITY) / R_FACTOR
 
+    def blank(self, fluid_density: float) -> float:
+        """What the stem reads floating in clear water of `fluid_density` (the companion cylinder's reading,
+        D7928's composite correction without a dispersant): 0 in water at 20 C, where the marks are made."""
+        top = (self.mass / fluid_density - self.bulb_volume) / self.stem_area
+        return float(self.reading_floating(top))
+
     def effective_depth(self, reading, cylinder_area: float = D422_CYLINDER_AREA):
         """D7928's H_m [m]: the bulb's centre below the surface at `reading` (corrected for the
         meniscus), less the rise of the surface as the bulb enters, V_B / 2A."""
@@ -379,15 +421,18 @@ class Hydrometer:
         if not cylinder_area > bulb_area:
             raise ValueError(f"a cylinder of {cylinder_area * 1e4:.3g} cm2 is no wider than the hydrometer's bulb "
                              f"({bulb_area * 1e4:.3g} cm2)")
-        suspension = column.suspension
         c0 = column.initial_concentration()
-        a = gs_correction(suspension.specific_gravity)
+        a = gs_correction(column.suspension.specific_gravity)
         rows = []
         for t in times_s:
+            water = column.suspension_at(t)
             top = self.bulb_top_depth(column, t, cylinder_area)
             reading = float(self.reading_floating(top))
             depth = self.stokes_depth(top, cylinder_area, level_rise)
-            rows.append((t, depth, reading, suspension.stokes_diameter(depth, t), _percent(reading * a, c0)))
+            # the percent finer from the reading less the blank of the water at its time, as a laboratory
+            # takes it less its companion cylinder's
+            rows.append((t, depth, reading, water.stokes_diameter(depth, t),
+                         _percent((reading - self.blank(water.fluid_density)) * a, c0)))
         return _readings("hydrometer", rows)
 
 
@@ -414,11 +459,11 @@ class BuoyancySphere:
     def read(self, column: Column, times_s) -> Readings:
         """Apparent mass [g] of the sphere at each time, with the diameter and percent finer it gives."""
         _fits(column, self.depth, self.diameter / 2, "buoyancy sphere")
-        suspension = column.suspension
         volume = self.volume
         c0 = column.initial_concentration()
         rows = []
         for t in times_s:
+            suspension = column.suspension_at(t)
             phi = column.weighted_mean(t, self.depth, self.diameter / 2)
             rho = suspension.mixture_density(phi)
             apparent = self.mass - rho * volume
@@ -438,13 +483,13 @@ class Pipette:
 
     def read(self, column: Column, times_s) -> Readings:
         """Solids concentration [g/L] drawn at each time, with the diameter and percent finer it gives."""
-        suspension = column.suspension
         disc = column.slab_thickness > 0
         radius = (3 * self.volume / (4 * np.pi)) ** (1 / 3)
         _fits(column, self.depth, radius, f"{self.volume * 1e6:.3g} mL pipette sample")
         c0 = column.initial_concentration()
         rows = []
         for t in times_s:
+            suspension = column.suspension_at(t)
             concentration = suspension.particle_density * column.weighted_mean(t, self.depth, radius, disc=disc)
             rows.append((t, self.depth, concentration, suspension.stokes_diameter(self.depth, t),
                          _percent(concentration, c0)))

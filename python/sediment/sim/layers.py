@@ -6,7 +6,9 @@ Schema (version 1; lammps-pkg/SEDIMENT/doc/fix_layers_hdf5.rst): root attributes
 `layer_lo`, `layer_thickness`, `columns` (comma-separated), optional `slab_thickness`,
 `particle_density`, `fluid_density`, `fluid_viscosity`, `fluid_yield_stress`; datasets
 `layer_centre` [layers], `class_edges` [classes - 1], and per frame `time` [frames],
-`step` [frames], `fraction` [frames, layers, columns] (solid volume fractions).
+`step` [frames], `fraction` [frames, layers, columns] (solid volume fractions) and, in the files of a
+fix with a fluid, `fluid` [frames, 2] (the fluid's density and viscosity when each frame was taken: a
+deck re-issues the fluid as a temperature record goes).
 """
 from __future__ import annotations
 
@@ -52,6 +54,7 @@ class LayerFile:
     attributes: dict[str, float] = field(default_factory=dict)    # fluid/particle properties
     complete: bool = True           # False: the run writing it did not finish (killed, failed, still running)
     identity: dict[str, str] = field(default_factory=dict)         # run_id, code_version, run_start
+    fluid: np.ndarray | None = None  # [frames, 2] the fluid's density and viscosity per frame; None: not recorded
 
     def column(self, name: str) -> np.ndarray:
         """Solid fraction of one column, [frames, layers]."""
@@ -95,7 +98,17 @@ def read_layers(path: str | Path) -> LayerFile:
         try:
             # A run killed between the datasets of a frame leaves them of different lengths:
             # the frames present in all three are the complete ones.
-            frames = min(len(f["time"]), len(f["step"]), len(f["fraction"]))
+            frames = min(len(f["time"]), len(f["step"]), len(f["fraction"]), *([len(f["fluid"])] if "fluid" in f else []))
+            fluid = np.asarray(f["fluid"][:frames], float) if "fluid" in f else None
+            complete = f.attrs.get("complete", 0) == 1
+            if fluid is not None and fluid.shape == (frames, 2) and not complete:
+                # the fluid is written last of a frame's datasets: a frame whose write a full disk or a
+                # kill cut short holds HDF5's fill value (0) there, and is not one of the frames
+                whole = np.isfinite(fluid).all(axis=1) & (fluid > 0).all(axis=1)
+                frames = int(np.argmin(whole)) if not whole.all() else frames
+                fluid = fluid[:frames]
+            if frames == 0:
+                raise LayerFileError(f"{path}: no frames (the run wrote none before it stopped)")
             columns = _text(f.attrs["columns"]).split(",")
             fraction = np.asarray(f["fraction"][:frames])
             if fraction.shape[1:] != (len(f["layer_centre"]), len(columns)):
@@ -106,8 +119,6 @@ def read_layers(path: str | Path) -> LayerFile:
             bad = [k for k, v in extra.items() if not (np.isfinite(v) and v >= 0)]
             if bad:
                 raise LayerFileError(f"{path}: attribute {bad[0]} is {extra[bad[0]]}, not a physical value (corrupt file?)")
-            if frames == 0:
-                raise LayerFileError(f"{path}: no frames (the run wrote none before it stopped)")
             # (a layer on a floor without a bed can hold more than its volume of parcels: no upper bound)
             if not np.all(np.isfinite(fraction)) or fraction.min() < 0:
                 raise LayerFileError(f"{path}: negative or non-numeric solid fractions (corrupt frame data: "
@@ -115,6 +126,9 @@ def read_layers(path: str | Path) -> LayerFile:
             time = np.asarray(f["time"][:frames])
             if not np.all(np.isfinite(time)) or np.any(np.diff(time) <= 0):
                 raise LayerFileError(f"{path}: frame times are not increasing (frames of two runs spliced, or corrupt)")
+            if fluid is not None and (fluid.shape != (frames, 2) or not np.all(np.isfinite(fluid)) or fluid.min() <= 0):
+                raise LayerFileError(f"{path}: the fluid of its frames is not a density and a viscosity > 0 per frame "
+                                     "(corrupt frame data)")
             identity = {k: _text(f.attrs[k]) for k in ("run_id", "code_version", "run_start") if k in f.attrs}
             return LayerFile(path=path, units=_text(f.attrs["units"]), axis=_text(f.attrs["axis"]),
                              dimension=int(f.attrs["dimension"]), cross_section=float(f.attrs["cross_section"]),
@@ -122,7 +136,7 @@ def read_layers(path: str | Path) -> LayerFile:
                              centres=np.asarray(f["layer_centre"]), columns=columns,
                              class_edges=np.asarray(f["class_edges"]), time=time,
                              step=np.asarray(f["step"][:frames]), fraction=fraction, attributes=extra,
-                             complete=f.attrs.get("complete", 0) == 1, identity=identity)
+                             complete=complete, identity=identity, fluid=fluid)
         except KeyError as exc:    # h5py's message names the attribute in one file format, not in the other
             missing = ([f"the attribute {k}" for k in ATTRIBUTES if k not in f.attrs]
                        + [f"the dataset {k}" for k in DATASETS if k not in f])
