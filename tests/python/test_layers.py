@@ -49,12 +49,49 @@ def test_frame_cut_short_by_a_killed_run_is_left_out(tmp_path):
 
 @pytest.mark.parametrize("kwargs, message", [
     ({"version": 2}, "layer schema version 2; this reader understands version 1"),
-    ({"schema": "something-else"}, "not a SEDIMENT layer file"),
+    ({"schema": "sedimemt-layers"}, "damaged: it holds a layer file's datasets, but its schema attribute reads "
+     "'sedimemt-layers'"),
 ])
 def test_other_schemas_are_refused(tmp_path, kwargs, message):
     write_layer_file(tmp_path / "other.h5", **kwargs)
     with pytest.raises(LayerFileError, match=message):
         read_layers(tmp_path / "other.h5")
+
+
+def test_a_foreign_hdf5_file_is_not_a_layer_file(tmp_path):
+    with h5py.File(tmp_path / "foreign.h5", "w") as f:
+        f.attrs["schema"] = "someone-elses"
+        f["data"] = np.arange(3.0)
+    with pytest.raises(LayerFileError, match="not a SEDIMENT layer file"):
+        read_layers(tmp_path / "foreign.h5")
+
+
+def _changed(path: Path, change) -> Path:
+    write_layer_file(path)
+    with h5py.File(path, "r+") as f:
+        change(f)
+    return path
+
+
+@pytest.mark.parametrize("change, message", [
+    (lambda f: f["fraction"].__setitem__(slice(None), 0.0), "its first frame holds no solids"),
+    (lambda f: f.attrs.__setitem__("particle_density", 500.0), "its particle_density is 500 kg/m3, which no particle "
+     "density is"),
+    (lambda f: f.attrs.__setitem__("fluid_viscosity", 1e6), "its fluid_viscosity is 1e+06 Pa s"),
+    (lambda f: f.attrs.__setitem__("fluid_density", 3000.0), "not denser than its fluid"),
+    (lambda f: f.attrs.__setitem__("columns", "tota,class_0,class_1"), "its columns attribute reads 'tota,class_0"),
+    (lambda f: f.attrs.__setitem__("columns", "total,class_0,total"), "its columns attribute reads"),
+    (lambda f: f.attrs.__setitem__("units", "furlongs"), "units 'furlongs'"),
+    (lambda f: f.attrs.__setitem__("layer_thickness", 2e-3), "are not those of its layer_centre dataset"),
+    (lambda f: f["fraction"].__setitem__((1, 4, 2), 0.5), "do not add up to the total in frame 1"),
+    (lambda f: f["step"].__setitem__(2, 10), "do not run forward"),
+])
+def test_a_layer_file_is_judged_by_its_content(tmp_path, change, message):
+    """Wherever the file lies (no run record beside it), content no run writes is refused by name."""
+    path = _changed(tmp_path / "copied.h5", change)
+    with pytest.raises(LayerFileError, match=message.replace("(", r"\(").replace("+", r"\+")) as refused:
+        read_layers(path)
+    assert "damaged, or not written by fix layers/hdf5" in str(refused.value)
 
 
 def test_truncated_and_foreign_files_give_clear_errors(tmp_path):

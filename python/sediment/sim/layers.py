@@ -86,10 +86,16 @@ def read_layers(path: str | Path) -> LayerFile:
     try:
         handle = h5py.File(path, "r")
     except OSError as exc:
+        if "lock" in str(exc).lower():    # HDF5 locks a file it writes: a run writing its frames now
+            raise LayerFileError(f"{path}: another process holds it open for writing (a run still writing its "
+                                 "frames?): read it once that run has ended") from None
         raise LayerFileError(f"{path}: not a readable HDF5 file (truncated or corrupt?): {exc}") from None
     with handle as f:
         schema = _text(f.attrs.get("schema", ""))
         if schema != SCHEMA:
+            if all(k in f for k in ("time", "fraction")) and "columns" in f.attrs:
+                raise LayerFileError(f"{path}: damaged: it holds a layer file's datasets, but its schema attribute "
+                                     f"reads '{schema[:40]}', not '{SCHEMA}'")
             raise LayerFileError(f"{path}: not a SEDIMENT layer file (schema '{schema}', expected '{SCHEMA}')")
         version = int(f.attrs.get("schema_version", -1))
         if version != SCHEMA_VERSION:
@@ -130,13 +136,15 @@ def read_layers(path: str | Path) -> LayerFile:
                 raise LayerFileError(f"{path}: the fluid of its frames is not a density and a viscosity > 0 per frame "
                                      "(corrupt frame data)")
             identity = {k: _text(f.attrs[k]) for k in ("run_id", "code_version", "run_start") if k in f.attrs}
-            return LayerFile(path=path, units=_text(f.attrs["units"]), axis=_text(f.attrs["axis"]),
+            layers = LayerFile(path=path, units=_text(f.attrs["units"]), axis=_text(f.attrs["axis"]),
                              dimension=int(f.attrs["dimension"]), cross_section=float(f.attrs["cross_section"]),
                              layer_lo=float(f.attrs["layer_lo"]), layer_thickness=float(f.attrs["layer_thickness"]),
                              centres=np.asarray(f["layer_centre"]), columns=columns,
                              class_edges=np.asarray(f["class_edges"]), time=time,
                              step=np.asarray(f["step"][:frames]), fraction=fraction, attributes=extra,
                              complete=complete, identity=identity, fluid=fluid)
+            check_content(layers)
+            return layers
         except KeyError as exc:    # h5py's message names the attribute in one file format, not in the other
             missing = ([f"the attribute {k}" for k in ATTRIBUTES if k not in f.attrs]
                        + [f"the dataset {k}" for k in DATASETS if k not in f])
@@ -145,6 +153,65 @@ def read_layers(path: str | Path) -> LayerFile:
                                  "layers/hdf5)") from None
         except OSError as exc:
             raise LayerFileError(f"{path}: unreadable layer data (truncated or corrupt?): {exc}") from None
+
+
+UNIT_STYLES = ("si", "cgs", "micro", "nano", "real", "metal", "lj", "electron")    # LAMMPS's
+# (attribute, quantity of sediment.plausible) of the physical attributes, checked in SI units
+PHYSICAL = (("particle_density", "particle_density"), ("fluid_density", "fluid_density"),
+            ("fluid_viscosity", "viscosity"), ("fluid_yield_stress", "yield_stress"))
+
+
+def check_content(layers: LayerFile) -> None:
+    """Refuses (LayerFileError) frames whose content cannot be a run's, wherever the file lies: names,
+    shapes and geometry that disagree, physical attributes no grain or fluid has, size classes that do
+    not add up to the total, a first frame without solids. (HDF5 checks each frame chunk's checksum as
+    it reads it.)"""
+    from ..plausible import RANGES
+
+    path = layers.path
+
+    def refuse(why: str) -> None:
+        raise LayerFileError(f"{path}: {why}: damaged, or not written by fix layers/hdf5")
+    names = layers.columns
+    kinds = [n.split("_")[0] for n in names]
+    if not names or names[0] != "total" or len(set(names)) != len(names) or not all(
+            n == "total" or (k in ("class", "type") and n.split("_", 1)[1].isdigit()) for n, k in zip(names, kinds)):
+        refuse(f"its columns attribute reads '{','.join(names)[:80]}', not 'total' then class_K and type_T columns")
+    if layers.units not in UNIT_STYLES or layers.axis not in ("x", "y", "z") or layers.dimension not in (2, 3):
+        refuse(f"units '{layers.units[:20]}', axis '{layers.axis[:5]}', dimension {layers.dimension}: not LAMMPS's")
+    centres = layers.layer_lo + layers.layer_thickness * (np.arange(len(layers.centres)) + 0.5)
+    if not (layers.layer_thickness > 0 and layers.cross_section > 0 and len(centres)
+            and np.allclose(layers.centres, centres, rtol=1e-9, atol=1e-12 * abs(layers.layer_thickness))):
+        refuse(f"its layers (layer_lo {layers.layer_lo:g}, layer_thickness {layers.layer_thickness:g}, cross_section "
+               f"{layers.cross_section:g}) are not those of its layer_centre dataset")
+    edges = np.asarray(layers.class_edges, float)
+    classes = [k for k, kind in enumerate(kinds) if kind == "class"]
+    if np.any(~np.isfinite(edges)) or np.any(edges <= 0) or np.any(np.diff(edges) <= 0) or (
+            classes and len(classes) != len(edges) + 1):
+        refuse(f"its {len(edges) + 1} size classes (class_edges) are not increasing diameters for its "
+               f"{len(classes)} class columns")
+    total = layers.fraction[:, :, 0]
+    if classes:
+        parts = layers.fraction[:, :, classes].sum(axis=2)
+        off = np.abs(parts - total) > 1e-9 * np.maximum(total, 1e-12) + 1e-15
+        if off.any():
+            frame = int(np.argmax(off.any(axis=1)))
+            refuse(f"the size classes' fractions do not add up to the total in frame {frame} (at {layers.time[frame]:g})")
+    if not total[0].sum() > 0:
+        refuse("its first frame holds no solids (every fraction 0)")
+    steps = np.asarray(layers.step)
+    if layers.time[0] < 0 or np.any(np.diff(steps) <= 0) or steps[0] < 0:
+        refuse("its frames' times or steps do not run forward from the start")
+    if layers.units == "si":
+        for name, quantity in PHYSICAL:
+            value = layers.attributes.get(name)
+            limits = RANGES[quantity]
+            if value is not None and not (limits.low <= value <= limits.high or (name == "fluid_yield_stress" and value == 0)):
+                refuse(f"its {name} is {value:g} {limits.unit}, which no {quantity.replace('_', ' ')} is ({limits.low:g}-"
+                       f"{limits.high:g} {limits.unit}: {limits.why})")
+        rho_p, rho_f = (layers.attributes.get(k) for k in ("particle_density", "fluid_density"))
+        if rho_p is not None and rho_f is not None and not rho_p > rho_f:
+            refuse(f"its grains ({rho_p:g} kg/m3) are not denser than its fluid ({rho_f:g} kg/m3)")
 
 
 _SIGNATURE = b"\x89HDF\r\n\x1a\n"
