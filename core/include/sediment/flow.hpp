@@ -1,0 +1,68 @@
+// SPDX-License-Identifier: GPL-2.0-or-later
+// The flow that the spheres drive (two-way coupling, docs/physics.md section 9): each sphere's force
+// on the fluid is spread onto a regular grid with a Gaussian kernel, the incompressible Stokes (or
+// Brinkman) equations are solved mode by mode in Fourier space, and the velocity is read back at the
+// spheres with the same kernel. No FFT here: the caller transforms (LAMMPS's FFT3d in fix
+// fluid/flow, a plain DFT in the tests) and calls these per mode and per sphere.
+#pragma once
+
+namespace sediment {
+
+// Whether n is a grid size the FFTs take: n >= 1 with no prime factor other than 2, 3 and 5 (LAMMPS's
+// KISS FFT and PPPM's own rule; FFTW takes these fastest).
+bool fft_friendly(int n);
+
+// The wavenumber of index m of an n-point periodic grid of length L: 2 pi m' / L with m' = m for
+// m <= n / 2, else m - n (the Nyquist mode of an even n is taken as +n/2; the operator below is even in k).
+double grid_wavenumber(int m, int n, double length);
+
+// Stokes (brinkman = 0) or Brinkman: mu lap u - brinkman u - grad p + f = 0, div u = 0. In Fourier
+// space u(k) = (I - k k / k^2) f(k) / (mu k^2 + brinkman): the pressure takes the longitudinal part
+// of the force. The k = 0 mode is set to zero: the mean force is held by the mean pressure gradient
+// of a closed column (or the periodic box's frame), so the net volume flux is zero (the return flow).
+struct StokesOperator {
+  double viscosity = 1.0;
+  double brinkman = 0.0;    // 0: Stokes; > 0: the resistance per unit volume of a Brinkman medium
+  // u(k) from f(k), one mode, complex values as (re, im) pairs: f[2 c] + i f[2 c + 1], c = 0, 1, 2.
+  // `scale` multiplies the result (1 / N for an unscaled inverse transform). u may be f.
+  void apply(const double k[3], const double *f, double *u, double scale = 1.0) const;
+};
+
+// Applies the operator to a brick of a periodic grid in Fourier space, in place: three complex fields
+// (x, y, z components), each (re, im) interleaved, index ((k - klo) * nj + (j - jlo)) * ni + (i - ilo)
+// with i fastest, over [ilo, ihi] x [jlo, jhi] x [klo, khi] of the global n[0] x n[1] x n[2] grid of
+// lengths length[3]; scale as above.
+void stokes_apply_brick(const StokesOperator &op, const int n[3], const double length[3], const int lo[3],
+                        const int hi[3], double *fx, double *fy, double *fz, double scale);
+
+// The spreading and interpolation kernel: a Gaussian of standard deviation `width` grid spacings,
+// cut at `cutoff` widths and normalised so that its weights sum to 1 on every axis (the spread force
+// is the sphere's force exactly: momentum is conserved to round-off). Nodes sit at integer positions
+// (a cell-centred grid: node k at lo + (k + 1/2) h has position k).
+struct FlowKernel {
+  static constexpr int max_nodes = 16;    // per axis
+  double width = 1.0;
+  double cutoff = 3.5;
+  // Nodes first, ..., first + count - 1 (unwrapped: the caller wraps them onto a periodic axis) and
+  // their weights for a point at `position` (in grid spacings); returns count.
+  int weights(double position, int &first, double *w) const;
+  // The largest count weights() returns for this width and cutoff.
+  int max_count() const;
+};
+
+// The velocity a sphere's own spread force gives it back in unbounded fluid, per unit force: a
+// Gaussian force blob of standard deviation sigma read with the same Gaussian moves as a sphere of
+// radius sigma sqrt(pi) (Maxey & Patel's force-coupling result): 1 / (6 pi mu sigma sqrt(pi)). A
+// sphere's drag is taken relative to the velocity the others (and its periodic or mirror images)
+// give it, so this is subtracted from what it reads on the grid.
+double gaussian_self_mobility(double viscosity, double sigma);
+
+// Nitsche & Batchelor (1997): a cloud of n spheres of radius a, terminal speed us alone, within a
+// sphere of radius r settles for n a / r >> 1 as a drop of the same viscosity, u = us (1 + 6/5 n a / r).
+double cloud_speed(double us, int n, double a, double r);
+// The leading correction to a body's mobility in a cubic periodic box of side L with no net flux
+// (Hasimoto 1959): -2.837297 / (6 pi mu L), the same for a sphere, a drop or a cloud of any size
+// to this order (the next term is O(volume fraction of the body in the box)).
+double hasimoto_mobility_correction(double viscosity, double box);
+
+}    // namespace sediment

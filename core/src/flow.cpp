@@ -1,0 +1,110 @@
+// SPDX-License-Identifier: GPL-2.0-or-later
+// The spectral Stokes operator and the spreading kernel of two-way coupling (sediment/flow.hpp).
+#include "sediment/flow.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace sediment {
+
+namespace {
+constexpr double pi = 3.14159265358979323846;
+}
+
+bool fft_friendly(int n)
+{
+  if (n < 1) return false;
+  for (const int p : {2, 3, 5})
+    while (n % p == 0) n /= p;
+  return n == 1;
+}
+
+double grid_wavenumber(int m, int n, double length)
+{
+  const int folded = m <= n / 2 ? m : m - n;
+  return 2.0 * pi * folded / length;
+}
+
+void StokesOperator::apply(const double k[3], const double *f, double *u, double scale) const
+{
+  const double k2 = k[0] * k[0] + k[1] * k[1] + k[2] * k[2];
+  if (!(k2 > 0.0)) {    // the mean: no net flux
+    for (int c = 0; c < 6; ++c) u[c] = 0.0;
+    return;
+  }
+  const double per = scale / (viscosity * k2 + brinkman);
+  // the longitudinal part k (k . f) / k^2, real and imaginary parts apart
+  const double kf_re = (k[0] * f[0] + k[1] * f[2] + k[2] * f[4]) / k2;
+  const double kf_im = (k[0] * f[1] + k[1] * f[3] + k[2] * f[5]) / k2;
+  for (int c = 0; c < 3; ++c) {
+    const double re = f[2 * c] - k[c] * kf_re;
+    const double im = f[2 * c + 1] - k[c] * kf_im;
+    u[2 * c] = per * re;
+    u[2 * c + 1] = per * im;
+  }
+}
+
+void stokes_apply_brick(const StokesOperator &op, const int n[3], const double length[3], const int lo[3],
+                        const int hi[3], double *fx, double *fy, double *fz, double scale)
+{
+  const int ni = hi[0] - lo[0] + 1, nj = hi[1] - lo[1] + 1;
+  for (int kk = lo[2]; kk <= hi[2]; ++kk) {
+    const double kz = grid_wavenumber(kk, n[2], length[2]);
+    for (int j = lo[1]; j <= hi[1]; ++j) {
+      const double ky = grid_wavenumber(j, n[1], length[1]);
+      for (int i = lo[0]; i <= hi[0]; ++i) {
+        const double k[3] = {grid_wavenumber(i, n[0], length[0]), ky, kz};
+        const long at = 2L * ((static_cast<long>(kk - lo[2]) * nj + (j - lo[1])) * ni + (i - lo[0]));
+        double f[6] = {fx[at], fx[at + 1], fy[at], fy[at + 1], fz[at], fz[at + 1]};
+        double u[6];
+        op.apply(k, f, u, scale);
+        fx[at] = u[0];
+        fx[at + 1] = u[1];
+        fy[at] = u[2];
+        fy[at + 1] = u[3];
+        fz[at] = u[4];
+        fz[at + 1] = u[5];
+      }
+    }
+  }
+}
+
+int FlowKernel::weights(double position, int &first, double *w) const
+{
+  const double reach = cutoff * width;
+  first = static_cast<int>(std::ceil(position - reach));
+  const int last = static_cast<int>(std::floor(position + reach));
+  const int count = std::min(last - first + 1, max_nodes);
+  const double per = 1.0 / (2.0 * width * width);
+  double sum = 0.0;
+  for (int m = 0; m < count; ++m) {
+    const double r = first + m - position;
+    w[m] = std::exp(-r * r * per);
+    sum += w[m];
+  }
+  const double norm = 1.0 / sum;
+  for (int m = 0; m < count; ++m) w[m] *= norm;
+  return count;
+}
+
+int FlowKernel::max_count() const
+{
+  return std::min(static_cast<int>(std::floor(2.0 * cutoff * width)) + 1, max_nodes);
+}
+
+double gaussian_self_mobility(double viscosity, double sigma)
+{
+  return 1.0 / (6.0 * pi * viscosity * sigma * std::sqrt(pi));
+}
+
+double cloud_speed(double us, int n, double a, double r)
+{
+  return us * (1.0 + 1.2 * n * a / r);
+}
+
+double hasimoto_mobility_correction(double viscosity, double box)
+{
+  return -2.837297 / (6.0 * pi * viscosity * box);
+}
+
+}    // namespace sediment
