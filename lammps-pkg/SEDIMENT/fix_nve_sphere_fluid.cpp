@@ -188,6 +188,7 @@ void FixNVESphereFluid::init()
 
 void FixNVESphereFluid::setup(int /*vflag*/)
 {
+  if (floor_axis >= 0) check_floor();
   // After every fix's init(): the drag fixes know their fluid only then.
   uniform = drags.size() == 1 && drags.front()->uniform() ? drags.front() : nullptr;
   // Linear only with a uniform drag: its spheres are wholly immersed, so F = c d w.
@@ -207,6 +208,30 @@ void FixNVESphereFluid::setup(int /*vflag*/)
     utils::logmesg(lmp, "fix nve/sphere/fluid: nonlinear drag stepped in blocks, {} vectors\n",
                    sediment::batch_math_name(sediment::batch_math_kind()));
   reported_vectors |= nonlinear;
+}
+
+// A sphere whose centre lies below the floor would be lifted onto it at its first step, through the
+// grains above it (and a shrink-wrapped box grown to it): a floor above the grains is a mistake in the
+// deck, refused here with the lowest such sphere. One that only reaches into it (created at random near
+// the bottom) is set on it at its first step, by less than its radius.
+void FixNVESphereFluid::check_floor()
+{
+  double **x = atom->x;
+  int *mask = atom->mask;
+  const double none = std::numeric_limits<double>::max();
+  double lowest[2] = {none, 0.0};    // the lowest centre below the floor, and its atom's ID
+  for (int i = 0; i < atom->nlocal; ++i)
+    if ((mask[i] & groupbit) && x[i][floor_axis] < floor_level && x[i][floor_axis] < lowest[0]) {
+      lowest[0] = x[i][floor_axis];
+      lowest[1] = static_cast<double>(atom->tag[i]);
+    }
+  double all[2];
+  MPI_Allreduce(lowest, all, 1, MPI_2DOUBLE_PRECISION, MPI_MINLOC, world);
+  if (all[0] < none)
+    error->all(FLERR, "Fix nve/sphere/fluid: floor {} {} lies above atom {}, whose centre is at {} {} (box {} to {}): "
+               "give a floor at or below the grains (the bottom of the column), not inside them",
+               "xyz"[floor_axis], floor_level, static_cast<tagint>(all[1]), "xyz"[floor_axis], all[0],
+               domain->boxlo[floor_axis], domain->boxhi[floor_axis]);
 }
 
 // A perfectly inelastic floor without a bed: a sphere reaching it stops with its lowest point on

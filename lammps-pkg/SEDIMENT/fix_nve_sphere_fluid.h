@@ -97,6 +97,7 @@ class FixNVESphereFluid : public Fix {
   // first_half of the uniform drag of a smooth law: every sphere of its group is wholly immersed, and
   // the block takes it through its whole first half (sediment::DragBlock::step_spheres).
   template <bool on_floor> void first_half_immersed();
+  void check_floor();    // every sphere of the group at or above the floor, or an error
 
   int floor_axis;         // -1: no floor
   double floor_level;     // spheres stop with their lowest point here
