@@ -4,6 +4,7 @@
 ------------------------------------------------------------------------- */
 
 #include "fix_fluid.h"
+#include "fix_fluid_flow.h"
 #include "sediment_args.h"
 
 #include "domain.h"
@@ -22,7 +23,7 @@ using namespace LAMMPS_NS;
 using namespace FixConst;
 
 FixFluid::FixFluid(LAMMPS *lmp, int narg, char **arg) :
-    Fix(lmp, narg, arg), has_surface(0), surface_offset(0.0), surface_variable(nullptr), surface_ivar(-1),
+    Fix(lmp, narg, arg), atom_flow(nullptr), has_surface(0), surface_offset(0.0), surface_variable(nullptr), surface_ivar(-1),
     centre_crossing(false), prepared_step(-1), region_id(nullptr), region(nullptr)
 {
   flow[0] = flow[1] = flow[2] = 0.0;
@@ -132,6 +133,15 @@ void FixFluid::init()
     if (!region) error->all(FLERR, "Fix fluid: region '{}' does not exist", region_id);
   }
   prepared_step = -1;    // a new run may start at the step of the last one, with other positions
+  // The fix fluid/flow that gives this fluid its velocity, if any (looked up at every init: it may
+  // have been unfixed since the last run).
+  atom_flow = nullptr;
+  for (Fix *fix : sediment_fixes_of_style(lmp, "fluid/flow")) {
+    auto flow_fix = static_cast<FixFluidFlow *>(fix);
+    if (strcmp(flow_fix->fluid_name(), id) != 0) continue;
+    if (atom_flow) error->all(FLERR, "Fix fluid: two fix fluid/flow give fluid '{}' its velocity", id);
+    atom_flow = flow_fix->velocity_rows();
+  }
   if (surface_variable) {
     surface_ivar = input->variable->find(surface_variable);
     if (surface_ivar < 0)

@@ -41,6 +41,11 @@ class FixFluid : public Fix {
   const sediment::Fluid &properties() const { return fluid; }
   bool is_bingham() const { return fluid.yield_stress > 0.0; }
   const double *velocity() const { return flow; }
+  // The fluid velocity at local atom i: the uniform one, or where a fix fluid/flow gives the fluid its
+  // own velocity, the one it solved for atom i (the styles' general per-atom paths read this; their
+  // uniform paths, taken only without a fix fluid/flow, read velocity()).
+  const double *velocity_at(int i) const { return atom_flow ? (*atom_flow)[i] : flow; }
+  bool has_atom_flow() const { return atom_flow != nullptr; }
   // Whether every sphere is wholly immersed (no free surface, no region).
   bool fills_space() const { return !has_surface && !region_id; }
 
@@ -51,6 +56,7 @@ class FixFluid : public Fix {
  private:
   sediment::Fluid fluid;
   double flow[3];
+  double **const *atom_flow;    // a fix fluid/flow's per-atom velocity rows (nullptr: none), set in init()
   int has_surface;
   double surface_normal[3];    // unit normal pointing out of the fluid
   double surface_offset;       // surface is {x : x . normal = offset}

@@ -178,19 +178,19 @@ double FixFluidDrag::rotation_rate(int i, const sediment::SphereDrag &drag) cons
 
 bool FixFluidDrag::uniform() const
 {
-  return fluid->fills_space() && !rotation;
+  return fluid->fills_space() && !rotation && !fluid->has_atom_flow();
 }
 
 template <class Visit> void FixFluidDrag::for_each_explicit(Visit visit)
 {
   double **v = atom->v;
   const int *mask = atom->mask;
-  const double *u = fluid->velocity();
   const bool everywhere = fluid->fills_space();    // tested once, not per atom
   prepare_step();
   for (int i = 0; i < atom->nlocal; ++i) {
     if (!(mask[i] & groupbit) || (mask[i] & implicit_groupbit)) continue;
     const sediment::SphereDrag drag = everywhere ? immersed_drag(i) : sphere_drag(i);
+    const double *u = fluid->velocity_at(i);
     const double slip[3] = {v[i][0] - u[0], v[i][1] - u[1], v[i][2] - u[2]};
     visit(i, drag, slip);
   }

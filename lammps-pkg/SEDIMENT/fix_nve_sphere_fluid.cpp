@@ -197,12 +197,14 @@ void FixNVESphereFluid::setup(int /*vflag*/)
     half_step = floor_axis < 0 ? HalfStep::Linear : HalfStep::LinearOnFloor;
   else
     half_step = HalfStep::General;
-  bool nonlinear = false, set_valued = false;
+  bool nonlinear = false, set_valued = false, atom_flow = false;
   for (FixFluidDrag *drag : drags) {
     nonlinear |= drag->nonlinear();
     set_valued |= !drag->drag_model()->smooth();
+    atom_flow |= drag->fluid_fix()->has_atom_flow();
   }
-  if (nonlinear) half_step = set_valued ? HalfStep::Blocked : HalfStep::Smooth;
+  // A block steps its spheres in one flow: with a fix fluid/flow each sphere has its own (General).
+  if (nonlinear && !atom_flow) half_step = set_valued ? HalfStep::Blocked : HalfStep::Smooth;
   // Which vector copy of the block step runs here (benchmarks/cost.py records it with its figures).
   if (comm->me == 0 && nonlinear && !reported_vectors)
     utils::logmesg(lmp, "fix nve/sphere/fluid: nonlinear drag stepped in blocks, {} vectors\n",
@@ -549,7 +551,7 @@ void FixNVESphereFluid::initial_integrate(int /*vflag*/)
       if (sphere.model)
         error->one(FLERR, "Fix nve/sphere/fluid: atom {} is in the fluid of two fluid/drag fixes", atom->tag[i]);
       sphere = candidate;
-      u = drag->fluid_fix()->velocity();
+      u = drag->fluid_fix()->velocity_at(i);
       spin_rate = drag->rotation_rate(i, sphere);
       if (drag->fraction_capped(i)) counts[CAPPED] += 1.0;
     }

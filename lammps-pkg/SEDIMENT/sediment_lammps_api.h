@@ -171,3 +171,24 @@ inline MPI_Comm sediment_abort_universe(const LAMMPSAbortException &abort)
 }    // namespace LAMMPS_NS
 
 #endif
+
+// LAMMPS's distributed 3d FFT (KSPACE's fft3d_wrap.h, included before this header by the styles that
+// use it): 29 Sep 2021's constructor takes 17 sizes and bounds, the buffer size and `usecollective`;
+// current releases add `usenonblocking`. Planes in = out, unscaled, not permuted, point-to-point remaps.
+#if defined(LMP_FFT3D_WRAP_H) && !defined(LMP_SEDIMENT_FFT3D_API_H)
+#define LMP_SEDIMENT_FFT3D_API_H
+#include <type_traits>
+namespace LAMMPS_NS {
+template <class F = FFT3d>
+F *sediment_make_fft3d(LAMMPS *lmp, MPI_Comm comm, int nfast, int nmid, int nslow, int ilo, int ihi, int jlo, int jhi,
+                       int klo, int khi, int *nbuf)
+{
+  if constexpr (std::is_constructible<F, LAMMPS *, MPI_Comm, int, int, int, int, int, int, int, int, int, int,
+                                      int, int, int, int, int, int, int, int *, int, int>::value)
+    return new F(lmp, comm, nfast, nmid, nslow, ilo, ihi, jlo, jhi, klo, khi, ilo, ihi, jlo, jhi, klo, khi, 0, 0, nbuf,
+                 0, 0);
+  else
+    return new F(lmp, comm, nfast, nmid, nslow, ilo, ihi, jlo, jhi, klo, khi, ilo, ihi, jlo, jhi, klo, khi, 0, 0, nbuf, 0);
+}
+}    // namespace LAMMPS_NS
+#endif

@@ -10,6 +10,7 @@
 #include "fix_fluid.h"
 #include "fix_fluid_buoyancy.h"
 #include "fix_fluid_drag.h"
+#include "fix_fluid_flow.h"
 #include "fix_layers_hdf5.h"
 #include "fix_nve_sphere_fluid.h"
 #include "pair_lubricate_fluid.h"
@@ -44,6 +45,7 @@ const StyleEntry<Modify::FixCreator> fix_styles[] = {
     {"fluid", "fluid properties and geometry", &create<Fix, FixFluid>},
     {"fluid/buoyancy", "Archimedes buoyancy with partial submergence", &create<Fix, FixFluidBuoyancy>},
     {"fluid/drag", "Newtonian and Bingham drag laws", &create<Fix, FixFluidDrag>},
+    {"fluid/flow", "the flow the spheres drive, solved spectrally (two-way coupling)", &create<Fix, FixFluidFlow>},
     {"nve/sphere/fluid", "drag-implicit sphere integrator", &create<Fix, FixNVESphereFluid>},
     {"layers/hdf5", "layer profiles to HDF5", &create<Fix, FixLayersHDF5>},
 };

@@ -1,0 +1,446 @@
+// SPDX-License-Identifier: GPL-2.0-or-later
+/* ----------------------------------------------------------------------
+   SEDIMENT package: fix fluid/flow
+   One solve per step, at the end of the step: every rank spreads its spheres'
+   forces onto a copy of the whole grid, a reduce-scatter sums the copies into
+   each rank's slab of planes (the FFT's layout, in = out), the slabs are
+   transformed, the Stokes operator applied mode by mode (sediment/flow.hpp),
+   transformed back, and gathered whole on every rank, which reads the velocity
+   at its spheres. Memory and communication per rank are O(grid) per step.
+------------------------------------------------------------------------- */
+
+#include "fix_fluid_flow.h"
+
+#include "fft3d_wrap.h"    // KSPACE: LAMMPS's distributed 3d FFT (FFTW3 or KISS)
+
+#include "sediment_args.h"
+
+#include "fix_fluid.h"
+#include "fix_fluid_drag.h"
+
+#include "atom.h"
+#include "comm.h"
+#include "domain.h"
+#include "error.h"
+#include "memory.h"
+#include "modify.h"
+#include "update.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <mpi.h>
+
+using namespace LAMMPS_NS;
+using namespace FixConst;
+
+static inline int wrap(int i, int n)
+{
+  i %= n;
+  return i < 0 ? i + n : i;
+}
+
+FixFluidFlow::FixFluidFlow(LAMMPS *lmp, int narg, char **arg) :
+    Fix(lmp, narg, arg), fluid_id(nullptr), fluid(nullptr), nzt(0), column(false), column_lo(0.0), column_hi(0.0),
+    relax(1.0), velocity(nullptr), solved(false), fft(nullptr), plane_lo(0), plane_hi(-1), self_mobility(0.0)
+{
+  if (narg < 8 || strcmp(arg[4], "grid") != 0)
+    error->all(FLERR, "Fix fluid/flow: expected 'fix ID group fluid/flow FLUID-ID grid NX NY NZ keyword value ...'");
+  fluid_id = utils::strdup(arg[3]);
+  StyleArgs args(lmp, FLERR, "Fix fluid/flow", narg, arg, 4);
+  while (args.more()) {
+    int nvalues = 1;
+    if (args.is("grid")) {
+      args.need(3, "3 cell counts (x, y, z)");
+      for (int d = 0; d < 3; ++d) {
+        grid[d] = args.count(1 + d, 4096);
+        if (!sediment::fft_friendly(grid[d]))
+          args.fail("grid size {} in {} is not a product of 2, 3 and 5 (the sizes LAMMPS's FFTs take)", grid[d],
+                    "xyz"[d]);
+      }
+      nvalues = 3;
+    } else if (args.is("column")) {
+      args.need(2, "the bottom and the top of the column (z)");
+      column_lo = args.number(1);
+      column_hi = args.number(2);
+      if (!(column_hi > column_lo)) args.fail("column top {} must lie above its bottom {}", column_hi, column_lo);
+      column = true;
+      nvalues = 2;
+    } else if (args.is("brinkman")) {
+      args.need(1, "a value");
+      stokes.brinkman = args.number(1);
+      if (stokes.brinkman < 0.0) args.fail("brinkman resistance must be >= 0, not {}", stokes.brinkman);
+    } else if (args.is("width")) {
+      args.need(1, "a value");
+      kernel.width = args.number(1);
+      if (!(kernel.width >= 1.0 && kernel.width <= 2.0))
+        args.fail("width {} must be from 1 to 2 grid cells (the kernel's Gaussian is resolved from 1 on)",
+                  kernel.width);
+    } else if (args.is("relax")) {
+      args.need(1, "a value");
+      relax = args.number(1);
+      if (!(relax > 0.0 && relax <= 1.0)) args.fail("relax must be in (0, 1], not {}", relax);
+    } else {
+      args.unknown("grid, column, brinkman, width or relax");
+    }
+    args.next(nvalues);
+  }
+  if (domain->dimension != 3) error->all(FLERR, "Fix fluid/flow requires a 3d simulation");
+  if (!domain->xperiodic || !domain->yperiodic)
+    error->all(FLERR, "Fix fluid/flow requires a box periodic in x and y (boundary p p ...)");
+  if (!column && !domain->zperiodic)
+    error->all(FLERR, "Fix fluid/flow: a box not periodic in z needs keyword 'column ZLO ZHI' (the closed column)");
+  if (!atom->radius_flag || !atom->rmass_flag)
+    error->all(FLERR, "Fix fluid/flow requires atom attributes radius and rmass (atom_style sphere)");
+  for (int d = 0; d < 3; ++d)
+    if (grid[d] < kernel.max_count())
+      error->all(FLERR, "Fix fluid/flow: grid size {} in {} is smaller than the kernel's {} nodes (width {})", grid[d],
+                 "xyz"[d], kernel.max_count(), kernel.width);
+  nzt = column ? 2 * grid[2] : grid[2];
+
+  restart_global = 1;
+  restart_peratom = 1;
+  peratom_flag = 1;
+  size_peratom_cols = 3;
+  peratom_freq = 1;
+  vector_flag = 1;
+  size_vector = NDIAG;
+  global_freq = 1;
+  extvector = 0;
+  maxexchange = 3;
+  std::fill(diag, diag + NDIAG, 0.0);
+
+  grow_arrays(atom->nmax);
+  atom->add_callback(Atom::GROW);
+  atom->add_callback(Atom::RESTART);
+}
+
+FixFluidFlow::~FixFluidFlow()
+{
+  atom->delete_callback(id, Atom::GROW);
+  atom->delete_callback(id, Atom::RESTART);
+  memory->destroy(velocity);
+  delete fft;
+  delete[] fluid_id;
+}
+
+int FixFluidFlow::setmask()
+{
+  return END_OF_STEP;
+}
+
+void FixFluidFlow::init()
+{
+  fluid = FixFluid::find(lmp, fluid_id, "Fix fluid/flow");
+  if (fluid->is_bingham())
+    error->all(FLERR, "Fix fluid/flow: fluid '{}' is a Bingham fluid; the flow is solved for a Newtonian one",
+               fluid_id);
+  stokes.viscosity = fluid->properties().viscosity;
+
+  // The grid: cubic cells over the periodic box in x and y and the box or the column in z.
+  for (int d = 0; d < 3; ++d) {
+    origin[d] = domain->boxlo[d];
+    length[d] = domain->prd[d];
+  }
+  if (column) {
+    origin[2] = column_lo;
+    length[2] = column_hi - column_lo;
+  }
+  for (int d = 0; d < 3; ++d) spacing[d] = length[d] / grid[d];
+  for (int d = 1; d < 3; ++d)
+    if (std::abs(spacing[d] - spacing[0]) > 1e-6 * spacing[0])
+      error->all(FLERR, "Fix fluid/flow: the grid's cells must be cubes, not {} x {} x {} (grid counts in proportion "
+                 "to the box{})", spacing[0], spacing[1], spacing[2], column ? " and the column" : "");
+  self_mobility = sediment::gaussian_self_mobility(stokes.viscosity, kernel.width * spacing[0]);
+
+  if (!fft) {
+    const int nprocs = comm->nprocs, me = comm->me;
+    if (nzt < nprocs)
+      error->all(FLERR, "Fix fluid/flow: {} planes of the transform cannot be split over {} ranks", nzt, nprocs);
+    const int plane = 3 * grid[0] * grid[1];
+    plane_counts.resize(nprocs);
+    plane_offsets.resize(nprocs);
+    for (int r = 0; r < nprocs; ++r) {
+      const int lo = static_cast<int>(static_cast<long>(r) * nzt / nprocs);
+      const int hi = static_cast<int>(static_cast<long>(r + 1) * nzt / nprocs);
+      plane_counts[r] = plane * (hi - lo);
+      plane_offsets[r] = plane * lo;
+      if (r == me) {
+        plane_lo = lo;
+        plane_hi = hi - 1;
+      }
+    }
+    const long nodes = static_cast<long>(grid[0]) * grid[1] * nzt;
+    const long mine = static_cast<long>(grid[0]) * grid[1] * (plane_hi - plane_lo + 1);
+    spread.assign(3 * nodes, 0.0);
+    flow.assign(3 * nodes, 0.0);
+    slab.assign(3 * mine, 0.0);
+    for (auto &f : field) f.assign(2 * mine, 0.0);
+    int buffer = 0;
+    fft = sediment_make_fft3d(lmp, world, grid[0], grid[1], nzt, 0, grid[0] - 1, 0, grid[1] - 1, plane_lo, plane_hi,
+                              &buffer);
+  }
+  if (!solved) {    // until the first solve, the fluid's uniform velocity
+    const double *u = fluid->velocity();
+    for (int i = 0; i < atom->nlocal; ++i)
+      for (int c = 0; c < 3; ++c) velocity[i][c] = u[c];
+  }
+}
+
+void FixFluidFlow::setup(int /*vflag*/)
+{
+  drags.clear();
+  for (Fix *fix : sediment_fixes_of_style(lmp, "fluid/drag")) {
+    auto drag = static_cast<FixFluidDrag *>(fix);
+    if (drag->fluid_fix() == fluid) drags.push_back(drag);
+  }
+  if (drags.empty())
+    error->all(FLERR, "Fix fluid/flow: no fix fluid/drag takes its drag from fluid '{}' (the flow is driven by the drag)",
+               fluid_id);
+  // A run continues the flow it has (from the last run, or a restart): a new one starts from one solve.
+  if (!solved) {
+    const double keep = relax;
+    relax = 1.0;
+    solve();
+    relax = keep;
+  }
+}
+
+void FixFluidFlow::end_of_step()
+{
+  solve();
+}
+
+// The force sphere i puts on the fluid: minus its drag, against the fluid velocity it saw this step.
+void FixFluidFlow::sphere_force(int i, double *force) const
+{
+  force[0] = force[1] = force[2] = 0.0;
+  for (FixFluidDrag *drag : drags) {
+    const sediment::SphereDrag sphere = drag->sphere_drag(i);
+    if (!sphere.model) continue;
+    const double *v = atom->v[i], *u = velocity[i];
+    const double w[3] = {v[0] - u[0], v[1] - u[1], v[2] - u[2]};
+    double coeff = sphere.model->linear_coefficient(sphere.diameter, sphere.scale);
+    if (!(coeff > 0.0)) {
+      const double speed = sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]);
+      coeff = speed > 0.0 ? sphere.model->force(sphere.diameter, speed, sphere.scale) / speed : 0.0;
+    }
+    for (int c = 0; c < 3; ++c) force[c] = coeff * w[c];
+    return;
+  }
+}
+
+void FixFluidFlow::spread_point(const double *x, const double *force)
+{
+  int first[3], count[3];
+  double w[3][sediment::FlowKernel::max_nodes];
+  for (int d = 0; d < 3; ++d) count[d] = kernel.weights((x[d] - origin[d]) / spacing[d] - 0.5, first[d], w[d]);
+  const double per_volume = 1.0 / (spacing[0] * spacing[1] * spacing[2]);
+  const int n[3] = {grid[0], grid[1], nzt};
+  for (int c = 0; c < count[2]; ++c) {
+    const int k = wrap(first[2] + c, n[2]);
+    for (int b = 0; b < count[1]; ++b) {
+      const int j = wrap(first[1] + b, n[1]);
+      const double wzy = w[2][c] * w[1][b] * per_volume;
+      for (int a = 0; a < count[0]; ++a) {
+        const int i = wrap(first[0] + a, n[0]);
+        double *node = &spread[3 * ((static_cast<long>(k) * n[1] + j) * n[0] + i)];
+        const double weight = wzy * w[0][a];
+        node[0] += weight * force[0];
+        node[1] += weight * force[1];
+        node[2] += weight * force[2];
+      }
+    }
+  }
+}
+
+void FixFluidFlow::read_point(const double *x, double *u) const
+{
+  int first[3], count[3];
+  double w[3][sediment::FlowKernel::max_nodes];
+  for (int d = 0; d < 3; ++d) count[d] = kernel.weights((x[d] - origin[d]) / spacing[d] - 0.5, first[d], w[d]);
+  const int n[3] = {grid[0], grid[1], nzt};
+  u[0] = u[1] = u[2] = 0.0;
+  for (int c = 0; c < count[2]; ++c) {
+    const int k = wrap(first[2] + c, n[2]);
+    for (int b = 0; b < count[1]; ++b) {
+      const int j = wrap(first[1] + b, n[1]);
+      const double wzy = w[2][c] * w[1][b];
+      for (int a = 0; a < count[0]; ++a) {
+        const int i = wrap(first[0] + a, n[0]);
+        const double *node = &flow[3 * ((static_cast<long>(k) * n[1] + j) * n[0] + i)];
+        const double weight = wzy * w[0][a];
+        u[0] += weight * node[0];
+        u[1] += weight * node[1];
+        u[2] += weight * node[2];
+      }
+    }
+  }
+}
+
+void FixFluidFlow::solve()
+{
+  const int nlocal = atom->nlocal;
+  const int *mask = atom->mask;
+  double **x = atom->x;
+  std::fill(spread.begin(), spread.end(), 0.0);
+  std::vector<double> forces(3 * static_cast<size_t>(nlocal), 0.0);
+  std::vector<char> inside(nlocal, 0);
+  double local[4] = {0.0, 0.0, 0.0, 0.0};    // force on the fluid, spheres outside the column
+  for (int i = 0; i < nlocal; ++i) {
+    if (!(mask[i] & groupbit)) continue;
+    if (column && !(x[i][2] >= column_lo && x[i][2] < column_hi)) {
+      local[3] += 1.0;
+      continue;
+    }
+    inside[i] = 1;
+    double *force = &forces[3 * i];
+    sphere_force(i, force);
+    if (force[0] == 0.0 && force[1] == 0.0 && force[2] == 0.0) continue;
+    for (int c = 0; c < 3; ++c) local[c] += force[c];
+    spread_point(x[i], force);
+    if (column) {    // the mirror image below the bottom (and so above the top): free slip at both
+      const double image[3] = {x[i][0], x[i][1], 2.0 * column_lo - x[i][2]};
+      const double image_force[3] = {force[0], force[1], -force[2]};
+      spread_point(image, image_force);
+    }
+  }
+  double total[4];
+  MPI_Allreduce(local, total, 4, MPI_DOUBLE, MPI_SUM, world);
+
+  // Sum the ranks' grids into each rank's planes, transform, solve, transform back.
+  MPI_Reduce_scatter(spread.data(), slab.data(), plane_counts.data(), MPI_DOUBLE, MPI_SUM, world);
+  const size_t mine = slab.size() / 3;
+  for (int c = 0; c < 3; ++c) {
+    double *f = field[c].data();
+    for (size_t m = 0; m < mine; ++m) {
+      f[2 * m] = slab[3 * m + c];
+      f[2 * m + 1] = 0.0;
+    }
+    fft->compute(f, f, FFT3d::FORWARD);
+  }
+  const int n[3] = {grid[0], grid[1], nzt};
+  const double transform_length[3] = {length[0], length[1], column ? 2.0 * length[2] : length[2]};
+  const int lo[3] = {0, 0, plane_lo}, hi[3] = {grid[0] - 1, grid[1] - 1, plane_hi};
+  sediment::stokes_apply_brick(stokes, n, transform_length, lo, hi, field[0].data(), field[1].data(), field[2].data(),
+                               1.0 / (static_cast<double>(n[0]) * n[1] * n[2]));
+  for (int c = 0; c < 3; ++c) {
+    double *f = field[c].data();
+    fft->compute(f, f, FFT3d::BACKWARD);
+    for (size_t m = 0; m < mine; ++m) slab[3 * m + c] = f[2 * m];
+  }
+  MPI_Allgatherv(slab.data(), static_cast<int>(slab.size()), MPI_DOUBLE, flow.data(), plane_counts.data(),
+                 plane_offsets.data(), MPI_DOUBLE, world);
+
+  // Diagnostics: the largest mean vertical velocity over a plane of nodes in the fluid (zero: no
+  // net flux) and the largest speed component on the grid.
+  double flux = 0.0, peak = 0.0;
+  const long plane = static_cast<long>(grid[0]) * grid[1];
+  for (int k = 0; k < grid[2]; ++k) {
+    double sum = 0.0;
+    for (long m = k * plane; m < (k + 1) * plane; ++m) {
+      sum += flow[3 * m + 2];
+      for (int c = 0; c < 3; ++c) peak = std::max(peak, std::abs(flow[3 * m + c]));
+    }
+    flux = std::max(flux, std::abs(sum / plane));
+  }
+  for (int c = 0; c < 3; ++c) diag[FX + c] = total[c];
+  diag[FLUX] = flux;
+  diag[PEAK] = peak;
+  diag[OUTSIDE] = total[3];
+
+  // Each sphere's fluid velocity: the uniform flow of fix fluid plus what the grid gives it, less what
+  // its own force gives it back in unbounded fluid (the others' and its images' flow remains).
+  const double *uniform = fluid->velocity();
+  for (int i = 0; i < nlocal; ++i) {
+    if (!(mask[i] & groupbit)) continue;
+    double u[3] = {0.0, 0.0, 0.0};
+    if (inside[i]) {
+      read_point(x[i], u);
+      for (int c = 0; c < 3; ++c) u[c] -= self_mobility * forces[3 * i + c];
+    }
+    for (int c = 0; c < 3; ++c) {
+      const double target = uniform[c] + u[c];
+      velocity[i][c] = relax < 1.0 ? velocity[i][c] + relax * (target - velocity[i][c]) : target;
+    }
+  }
+  solved = true;
+}
+
+double FixFluidFlow::compute_vector(int n)
+{
+  // force on the fluid (x, y, z), largest |mean u_z| over a plane of nodes, largest |u| component on
+  // the grid, spheres of the group outside the column (all of the last solve)
+  return diag[n];
+}
+
+void FixFluidFlow::grow_arrays(int nmax)
+{
+  memory->grow(velocity, nmax, 3, "fluid/flow:velocity");
+  array_atom = velocity;
+}
+
+void FixFluidFlow::copy_arrays(int i, int j, int /*delflag*/)
+{
+  for (int c = 0; c < 3; ++c) velocity[j][c] = velocity[i][c];
+}
+
+int FixFluidFlow::pack_exchange(int i, double *buf)
+{
+  for (int c = 0; c < 3; ++c) buf[c] = velocity[i][c];
+  return 3;
+}
+
+int FixFluidFlow::unpack_exchange(int nlocal, double *buf)
+{
+  for (int c = 0; c < 3; ++c) velocity[nlocal][c] = buf[c];
+  return 3;
+}
+
+void FixFluidFlow::write_restart(FILE *fp)
+{
+  if (comm->me != 0) return;
+  const double state[1] = {solved ? 1.0 : 0.0};
+  const int size = sizeof(state);
+  fwrite(&size, sizeof(int), 1, fp);
+  fwrite(state, sizeof(double), 1, fp);
+}
+
+void FixFluidFlow::restart(char *buf)
+{
+  double state;
+  memcpy(&state, buf, sizeof(double));
+  solved = state != 0.0;
+}
+
+int FixFluidFlow::pack_restart(int i, double *buf)
+{
+  buf[0] = 4;
+  for (int c = 0; c < 3; ++c) buf[1 + c] = velocity[i][c];
+  return 4;
+}
+
+void FixFluidFlow::unpack_restart(int nlocal, int nth)
+{
+  double **extra = atom->extra;
+  int m = 0;
+  for (int k = 0; k < nth; ++k) m += static_cast<int>(extra[nlocal][m]);
+  ++m;
+  for (int c = 0; c < 3; ++c) velocity[nlocal][c] = extra[nlocal][m + c];
+}
+
+int FixFluidFlow::size_restart(int /*i*/)
+{
+  return 4;
+}
+
+int FixFluidFlow::maxsize_restart()
+{
+  return 4;
+}
+
+double FixFluidFlow::memory_usage()
+{
+  const double grids = static_cast<double>(spread.size() + flow.size() + slab.size() + 3 * field[0].size());
+  return (3.0 * atom->nmax + grids) * sizeof(double);
+}

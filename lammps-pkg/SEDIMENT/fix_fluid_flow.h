@@ -1,0 +1,92 @@
+// SPDX-License-Identifier: GPL-2.0-or-later
+/* ----------------------------------------------------------------------
+   SEDIMENT package: the flow the spheres drive (two-way coupling). Each
+   sphere's force on the fluid (its drag, with the opposite sign) is spread
+   onto a grid, the Stokes (or Brinkman) equations are solved spectrally with
+   LAMMPS's FFT3d (KSPACE), and the fluid velocity read back at every sphere
+   is the one its drag is taken against in the next step (fix fluid's
+   velocity_at()). Periodic in x and y; in z periodic or a closed column
+   (free-slip bottom and top, by mirror images).
+------------------------------------------------------------------------- */
+
+#ifdef FIX_CLASS
+// clang-format off
+FixStyle(fluid/flow,FixFluidFlow);
+// clang-format on
+#else
+
+#ifndef LMP_FIX_FLUID_FLOW_H
+#define LMP_FIX_FLUID_FLOW_H
+
+#include "fix.h"
+
+#include "sediment/flow.hpp"
+
+#include <vector>
+
+namespace LAMMPS_NS {
+
+class FixFluidFlow : public Fix {
+ public:
+  FixFluidFlow(class LAMMPS *, int, char **);
+  ~FixFluidFlow() override;
+  int setmask() override;
+  void init() override;
+  void setup(int) override;
+  void end_of_step() override;
+  double compute_vector(int) override;
+
+  void grow_arrays(int) override;
+  void copy_arrays(int, int, int) override;
+  int pack_exchange(int, double *) override;
+  int unpack_exchange(int, double *) override;
+  void write_restart(FILE *) override;
+  void restart(char *) override;
+  int pack_restart(int, double *) override;
+  void unpack_restart(int, int) override;
+  int size_restart(int) override;
+  int maxsize_restart() override;
+  double memory_usage() override;
+
+  // The fix fluid whose velocity this fix gives (fix fluid attaches it in its init()).
+  const char *fluid_name() const { return fluid_id; }
+  // The per-atom fluid velocity, as the address of the fix's row pointer (rows move when they grow).
+  double **const *velocity_rows() const { return &velocity; }
+
+ private:
+  char *fluid_id;
+  class FixFluid *fluid;
+  std::vector<class FixFluidDrag *> drags;    // the fluid/drag fixes of this fluid (setup())
+  int grid[3];           // cells of the fluid: x, y, and z of the box (periodic) or of the column
+  int nzt;               // planes of the transform: grid[2], or 2 grid[2] with the column's mirror
+  bool column;           // closed in z: free slip at column_lo and column_hi
+  double column_lo, column_hi;
+  double relax;          // u <- (1 - relax) u + relax u_solved
+  sediment::StokesOperator stokes;
+  sediment::FlowKernel kernel;
+  double **velocity;     // per atom: the fluid velocity its drag is taken against
+  bool solved;           // velocity holds a solve (or was read from a restart)
+  class FFT3d *fft;
+  int plane_lo, plane_hi;         // this rank's planes of the transform grid
+  std::vector<int> plane_counts;  // doubles per rank in the reduce-scatter and the gather
+  std::vector<int> plane_offsets;
+  std::vector<double> spread;     // global force density, [k][j][i][c]
+  std::vector<double> slab;       // this rank's planes of it, then of the velocity
+  std::vector<double> field[3];   // this rank's planes, complex (re, im), one per component
+  std::vector<double> flow;       // global velocity on the grid, [k][j][i][c]
+  double origin[3], spacing[3], length[3];
+  double self_mobility;
+  // Diagnostics of the last solve (compute_vector)
+  enum { FX, FY, FZ, FLUX, PEAK, OUTSIDE, NDIAG };
+  double diag[NDIAG];
+
+  void solve();
+  void spread_point(const double *x, const double *force);
+  void read_point(const double *x, double *u) const;
+  void sphere_force(int i, double *force) const;
+};
+
+}    // namespace LAMMPS_NS
+
+#endif
+#endif
