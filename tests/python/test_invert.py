@@ -18,6 +18,7 @@ from sediment.lab.readout import Suspension
 from sediment.lab.sheet import SheetError, check_sheet, read_sheet
 
 EXAMPLE = Path(__file__).resolve().parents[2] / "examples" / "inverse"
+DATA = Path(__file__).resolve().parents[1] / "data"
 HYDROMETER = "time_min,reading,temperature_C\n"
 
 
@@ -443,7 +444,39 @@ def test_a_split_that_the_specimen_did_not_pass_is_noted(tmp_path, capsys):
     assert cli.main(argv + ["--split", "0.075", "--out", str(tmp_path / "split")]) == 0
     assert "check: the curve rises by" in capsys.readouterr().out
     assert cli.main(argv + ["--out", str(tmp_path / "plain")]) == 0
-    assert "check: the curve rises" not in capsys.readouterr().out
+    printed = capsys.readouterr().out
+    assert "check: the curve rises" not in printed and "pull the curve apart" not in printed
+
+
+def test_readings_far_closer_to_the_fit_than_their_errors_are_noted(tmp_path, capsys):
+    """The clay loam's 152H sheet written as a 151H's 1000 (G - 1) (0.6226 R) and given as a 152H's: it fits, at a
+    chi-square per reading of about 0.02 (0.06 as the 152H it is), and the note names both readings of that;
+    with its sieves, the step to the 75 um sieve names the unit."""
+    lines = (SOIL / "hydrometer.csv").read_text().splitlines()
+    head = lines[0].split(",")
+    scaled = [",".join(f"{0.6226 * float(v):.1f}" if name in ("reading", "blank") else v
+                       for name, v in zip(head, line.split(","))) for line in lines[1:]]
+    sheet = tmp_path / "as_151h.csv"
+    sheet.write_text("\n".join([lines[0], *scaled]) + "\n")
+    assert cli.main(["invert", str(sheet), "--mass", "0.05", "--out", str(tmp_path / "alone")]) == 0
+    printed = capsys.readouterr().out
+    assert "lie far closer to the fit than their stated errors say" in printed and "--hydrometer-type 151H" in printed
+    assert cli.main(["invert", str(sheet), str(SOIL / "sieve.csv"), "--mass", "0.05", "--particles", "4000",
+                     "--out", str(tmp_path / "sieved")]) == 0
+    assert "a 151H's as a 152H's" in capsys.readouterr().out
+
+
+def test_a_sieve_sheet_of_another_soil_is_noted(tmp_path, capsys):
+    """The clay loam's 152H with the sieves of a clay (84 % passing 75 um, not 74): the fit takes a 10-point
+    step between the coarsest cut (45 um) and the 75 um sieve, under the step note's, and fits (chi-square
+    per reading 0.9); but its first reading and the 75 um sieve are each over 2 noise units off the fit, the
+    other way each, which the note names."""
+    argv = ["invert", str(EXAMPLE / "soil" / "hydrometer.csv"), str(DATA / "sieve_of_another_soil.csv"), "--mass", "0.05",
+            "--particles", "4000", "--out", str(tmp_path / "other")]
+    assert cli.main(argv) == 0
+    printed = capsys.readouterr().out
+    assert "the hydrometer's first reading (1 min" in printed and "0.075 mm sieve" in printed
+    assert "pull the curve apart" in printed and "a sieve sheet of another sample" in printed
 
 
 @pytest.mark.parametrize("totals, message", [
@@ -457,3 +490,27 @@ def test_a_budget_that_is_not_this_tests_is_refused_before_the_inversion(tmp_pat
                      "--out", str(tmp_path / "out")]) == 2
     assert message in capsys.readouterr().err
     assert not (tmp_path / "out").exists()
+
+
+def test_a_budget_of_another_test_is_named_and_recorded(tmp_path, capsys):
+    """A budget made for sample 5 (its PSD 40-50 points off the clay loam's at 2-20 um) widens the band, and the
+    note names its sample and how far its PSD is from the one recovered; one made for the clay loam itself
+    (its truth) at its mass gets no note; invert.json records which budget, by its SHA-256."""
+    from sediment.lab.psd import read_psd as psd_of
+
+    def budget(name: str, psd, mass: float) -> Path:
+        path = tmp_path / f"{name}.json"
+        made_for = {"diameter_um": (psd.diameter * 1e6).tolist(), "percent_finer": psd.percent_finer.tolist(),
+                    "mass_kg": mass, "temperature_C": 20.0}
+        path.write_text(json.dumps([{"sample": name, "physical_total_pp": {"hydrometer": 1.0}, "made_for": made_for}]))
+        return path
+    argv = ["invert", str(SOIL / "hydrometer.csv"), str(SOIL / "sieve.csv"), "--mass", "0.05", "--particles", "4000"]
+    other = budget("sample5", psd_of(EXAMPLE.parent / "granulometry" / "psd" / "sample5.csv"), 0.06)
+    assert cli.main(argv + ["--budget", str(other), "--out", str(tmp_path / "other")]) == 0
+    printed = capsys.readouterr().out
+    assert "(sample 'sample5') was made for another test: its PSD is" in printed
+    recorded = json.loads((tmp_path / "other" / "invert.json").read_text())["inputs"]["budget"]
+    assert recorded["sample"] == "sample5" and len(recorded["sha256"]) == 64 and recorded["made_for"]["mass_kg"] == 0.06
+    own = budget("clay_loam", psd_of(SOIL / "truth_psd.csv"), 0.05)
+    assert cli.main(argv + ["--budget", str(own), "--out", str(tmp_path / "own")]) == 0
+    assert "was made for another test" not in capsys.readouterr().out

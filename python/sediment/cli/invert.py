@@ -246,21 +246,56 @@ def _refuse_repeats(sheets: list) -> None:
         seen[key] = sheet.path
 
 
+BUDGET_PSD_TOLERANCE = 15.0    # points of percent finer between the budget's PSD and the one recovered
+BUDGET_MASS_TOLERANCE = 0.3    # and a specimen mass off the budget's by more than this share
+
+
+def budget_note(entry: dict, path: Path, diameter, percent, mass: float) -> str | None:
+    """A note where a budget's test is not this one: its PSD far from the recovered one, or another mass;
+    or where it does not say (a budget of an earlier version)."""
+    import numpy as np
+
+    from ..studies.budget import made_for_psd
+
+    made = made_for_psd(entry)
+    name = f"--budget {path} (sample '{entry['sample']}')"
+    if made is None:
+        return (f"check: {name} records no test it was made for (a budget of an earlier version): that its band is "
+                "this sample's is not checked")
+    inside = (diameter >= made.diameter[0]) & (diameter <= made.diameter[-1])
+    gap = np.abs(made.at(diameter[inside]) - percent[inside]) if inside.any() else np.zeros(1)
+    budget_mass = float((entry.get("made_for") or {}).get("mass_kg", mass))
+    differs = []
+    if gap.max() > BUDGET_PSD_TOLERANCE:
+        k = int(np.argmax(gap))
+        differs.append(f"its PSD is {gap[k]:.3g} points off the one recovered here (at {diameter[inside][k] * 1e6:.3g} um)")
+    if abs(budget_mass / mass - 1) > BUDGET_MASS_TOLERANCE:
+        differs.append(f"its specimen was {budget_mass * 1e3:.4g} g, this one {mass * 1e3:.4g} g")
+    if not differs:
+        return None
+    return (f"check: {name} was made for another test: {'; '.join(differs)}: its physical totals, which widen the "
+            "band, may not be this sample's; make the budget of this PSD (sediment budget psd.csv)")
+
+
 def _invert(args: argparse.Namespace, test, sheets) -> int:
     """Inverts the sheets; prints the PSD and the verdict, writes the report (exit 3: no PSD fits)."""
     from ..inverse import invert
 
-    band, budget = 0.0, None
+    band, budget, entry = 0.0, None, None
     if args.budget is not None:
-        from ..studies.budget import band_of
+        from ..sim.run import file_digest
+        from ..studies.budget import budget_entry
 
-        totals = band_of(args.budget, args.budget_sample)
+        entry = budget_entry(args.budget, args.budget_sample)
+        totals = entry["physical_total_pp"]
         missing = sorted({s.instrument for s in sheets if s.instrument != "sieve"} - set(totals))
         if missing:
             raise ValueError(f"--budget {args.budget}: no physical total for the {' and '.join(missing)} (it has "
                              f"{', '.join(sorted(totals))}): give the budget of this test's instruments")
         band = max(totals[s.instrument] for s in sheets if s.instrument != "sieve")
-        budget = {"file": str(args.budget), "sample": args.budget_sample, "physical_total_pp": totals, "band_pp": band}
+        budget = {"file": str(args.budget), "sha256": file_digest(args.budget), "sample": entry["sample"],
+                  "physical_total_pp": totals, "band_pp": band,
+                  "made_for": {k: v for k, v in (entry.get("made_for") or {}).items() if k in ("mass_kg", "temperature_C")}}
     readings = [s for s in sheets if s.instrument != "sieve"]
     sieve = next((s for s in sheets if s.instrument == "sieve"), None)
     split = args.split
@@ -279,6 +314,10 @@ def _invert(args: argparse.Namespace, test, sheets) -> int:
     if args.batch_key is not None:
         result.inputs["batch_key"] = args.batch_key
     result.inputs["budget"] = budget
+    if entry is not None:
+        note = budget_note(entry, args.budget, result.diameter, result.percent, test.mass)
+        if note:
+            result.notes.insert(-1, note)
     if args.washed is not None:
         result.inputs |= {"washed_mm": args.washed, "whole_specimen_mass": whole}
         result.notes.insert(-1, f"washed through {args.washed:g} mm before the hydrometer: {test.mass * 1e3:.4g} g in "

@@ -401,7 +401,7 @@ def invert(sheets: list[Sheet], test: LabTest, folder: Path, *, sieve: SieveShee
     if in_tails:
         out.notes.append(f"{', '.join(in_tails)} lie(s) in a tail, where the data give the mass but not its placement: "
                          "read them with their band")
-    step = _sieves_step(grid, shares, sieves)
+    step = _sieves_step(grid, shares, sieves) or _sieves_tension(rows)
     if step is not None:
         out.notes.append(step)
     out.notes.append(_inputs_line(test, inputs))
@@ -415,6 +415,14 @@ def invert(sheets: list[Sheet], test: LabTest, folder: Path, *, sieve: SieveShee
     for name, t, opening, measured, modelled, s in flagged:
         where = f"{opening * 1e3:g} mm" if name == "sieve" else f"{t / 60:g} min"
         out.notes.append(f"{name} at {where} is {abs(modelled - measured) / s:.1f} noise units off the fit: check it")
+    read = [r for r in rows if r[0] != "sieve"]
+    if len(read) >= 5 and out.reduced_chi2 < TOO_GOOD:
+        units = {s.instrument: noise_text(s.instrument, test.noise[s.instrument], s.scale) for s in sheets}
+        out.notes.append(f"note: the readings lie far closer to the fit than their stated errors say (chi-square per "
+                         f"reading {out.reduced_chi2:.2g}, where about 1 is expected): the band, which those errors set "
+                         f"({', '.join(f'{k} {v}' for k, v in units.items())}), is wider than the readings need; or the "
+                         "readings are not in the instrument's unit (a 151H's 1000 (G - 1) is not a 152H's g/L: give "
+                         "--hydrometer-type 151H and its specific gravities)")
     if not out.consistent:
         out.notes.append(f"{NOT_FITTING}: a misread, a flocculated sample, or a wrong specimen mass or particle density "
                          "(check the readings named above)")
@@ -459,7 +467,35 @@ def _sieves_step(grid: SizeGrid, shares: np.ndarray, sieves: SieveData) -> str |
         return None
     return (f"check: the curve rises by {rise:.3g} points between the coarsest reading's cut ({grid.edges[cut] * 1e6:.3g} "
             f"um) and the {grid.edges[above[0]] * 1e3:g} mm sieve ({steepness:.3g} points per decade of diameter): a "
-            "gap in the grading, or a wrong --mass or a sieve sheet of another sample, which a step there absorbs")
+            "gap in the grading, or a wrong --mass, a sieve sheet of another sample or readings in another unit (a "
+            "151H's as a 152H's: --hydrometer-type), which a step there absorbs")
+
+
+# chi-square per reading under which the readings fit too well for their stated errors: a real laboratory's
+# sheets fit at 0.4-0.7, synthetic sheets read to 0.5 g/L at 0.004-0.09 (many bins fitted to few readings);
+# a 151H's 1000 (G - 1) read as g/L shrinks the scatter by 0.62^2
+TOO_GOOD = 0.03
+TENSION = 2.0    # noise units each way: by chance both at once about once in a thousand fits
+
+
+def _sieves_tension(rows: list[tuple[str, float, float, float, float, float]]) -> str | None:
+    """A note where the fit is pulled apart at the sieves' join: the first reading of an instrument (its
+    coarsest cut) and the finest sieve off the fit by TENSION noise units or more, the other way each. A
+    step between them has absorbed what they disagree on; the step note sees it only when it is steep."""
+    sieves = [r for r in rows if r[0] == "sieve"]
+    if not sieves:
+        return None
+    finest = min(sieves, key=lambda r: r[2])
+    pull = (finest[4] - finest[3]) / finest[5]
+    for instrument in dict.fromkeys(r[0] for r in rows if r[0] != "sieve"):
+        first = min((r for r in rows if r[0] == instrument), key=lambda r: r[1])
+        against = (first[4] - first[3]) / first[5]
+        if abs(pull) >= TENSION and abs(against) >= TENSION and pull * against < 0:
+            return (f"check: the {instrument}'s first reading ({first[1] / 60:g} min, {against:+.1f} noise units off the "
+                    f"fit) and the {finest[2] * 1e3:g} mm sieve ({pull:+.1f}) pull the curve apart where they meet: a "
+                    "sieve sheet of another sample, a wrong --mass, a first reading taken before the suspension stilled, "
+                    "or a gap in the grading, which a step there absorbs")
+    return None
 
 
 def _inputs_line(test: LabTest, inputs: dict) -> str:

@@ -87,6 +87,8 @@ class Budget:
     name: str
     reference: str
     rows: list[tuple[str, str, str, dict]]    # key, label, kind, {instrument: pp}
+    # the test it is the budget of: its PSD (diameter_um, percent_finer), mass [kg] and temperature [C]
+    made_for: dict = field(default_factory=dict)
 
     def physical_total(self) -> dict[str, float]:
         """Root sum of squares of the physical rows per instrument (both temperature rows count as one,
@@ -120,7 +122,7 @@ class Budget:
         """Everything in the table, for scripts (budget.json)."""
         return {"sample": self.name, "reference": self.reference,
                 "rows": [{"row": k, "label": label, "kind": kind, "change_pp": c} for k, label, kind, c in self.rows],
-                "physical_total_pp": self.physical_total()}
+                "physical_total_pp": self.physical_total(), "made_for": self.made_for}
 
 
 def _readings(layer_file: Path, lab: Suspension, cylinder: Cylinder) -> dict[str, tuple[np.ndarray, np.ndarray]]:
@@ -240,7 +242,9 @@ def error_budget(psd: PSD, folder: Path, *, particles: int = 20000, courant: flo
     rows.append(("brownian", "Brownian motion (front spread; analytic, not simulated)", "physical",
                  {n: brownian for n in INSTRUMENTS}))
     described = f"standard drag curve + Richardson & Zaki, water at {temperature:g} C, {particles} parcels, Courant {courant:g}"
-    return Budget(name, described, rows)
+    made_for = {"diameter_um": (psd.diameter * 1e6).tolist(), "percent_finer": psd.percent_finer.tolist(),
+                "mass_kg": mass, "temperature_C": temperature}
+    return Budget(name, described, rows, made_for)
 
 
 def save(budgets: list[Budget], folder: Path) -> list[Path]:
@@ -279,9 +283,8 @@ def plot(budgets: list[Budget], path: Path) -> Path:
     return figures.save(fig, path)
 
 
-def band_of(budget_file: Path, sample: str | None = None) -> dict[str, float]:
-    """The physical total of a budget (budget.json), per instrument [pp]: the band the physical
-    uncertainty puts around a simulated reading of that test."""
+def budget_entry(budget_file: Path, sample: str | None = None) -> dict:
+    """The budget of one sample in a budget.json (its physical totals checked: points of percent finer)."""
     what = f"{budget_file} is not a budget.json of `sediment budget`"
     try:
         content = json.loads(Path(budget_file).read_text())
@@ -304,4 +307,19 @@ def band_of(budget_file: Path, sample: str | None = None) -> dict[str, float]:
     if not band or not all(math.isfinite(v) and 0 <= v <= 100 for v in band.values()):
         raise ValueError(f"{what}: the physical totals of '{chosen['sample']}' are not points of percent finer "
                          "(numbers from 0 to 100)")
-    return band
+    return chosen | {"physical_total_pp": band}
+
+
+def band_of(budget_file: Path, sample: str | None = None) -> dict[str, float]:
+    """The physical total of a budget (budget.json), per instrument [pp]: the band the physical
+    uncertainty puts around a simulated reading of that test."""
+    return budget_entry(budget_file, sample)["physical_total_pp"]
+
+
+def made_for_psd(entry: dict) -> PSD | None:
+    """The PSD a budget entry was made for, where it records one (budgets of SEDIMENT 0.1.0 before this)."""
+    made = entry.get("made_for") or {}
+    try:
+        return PSD(np.asarray(made["diameter_um"], float) * 1e-6, np.asarray(made["percent_finer"], float))
+    except (KeyError, TypeError, ValueError):
+        return None
