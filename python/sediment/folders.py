@@ -33,7 +33,7 @@ MANIFEST = ".sediment-files.json"
 JOURNAL = ".sediment-publishing.json"
 STAGE = ".sediment-stage-"
 _OWN = ".sediment"                         # the folders' own bookkeeping: never part of a result
-_FORMAT = 1
+_FORMAT = 2    # 2: with the checksum of its sets
 
 
 @contextmanager
@@ -147,7 +147,7 @@ class OutputSet:
             other["files"] = {r: i for r, i in other["files"].items() if _entry(r) not in self._foreign}
         sets = {k: v for k, v in sets.items() if v["files"] or k == self.name}
         manifest["sets"] = sets
-        (self.stage / MANIFEST).write_text(json.dumps(manifest) + "\n")
+        (self.stage / MANIFEST).write_text(manifest_text(manifest))
         self.dropped = sorted(touched - set(entries))
         journal = {"set": self.name, "stage": self.stage.name, "move": entries,
                    "remove": self.dropped + self._foreign}
@@ -160,7 +160,7 @@ class OutputSet:
             if below != self.folder:
                 record = read_manifest(below)
                 record["sets"].pop(name, None)
-                write_text(below / MANIFEST, json.dumps(record) + "\n")
+                write_text(below / MANIFEST, manifest_text(record))
         return [self.folder / e for e in entries]
 
     def _derived(self, sets: dict) -> None:
@@ -215,6 +215,15 @@ class OutputSet:
                                  "it: choose another --out")
 
 
+def _checksum(sets: dict) -> str:
+    return hashlib.sha256(json.dumps(sets, sort_keys=True).encode()).hexdigest()
+
+
+def manifest_text(manifest: dict) -> str:
+    """A manifest as written: with the checksum of its sets, so that one edited by hand is not trusted."""
+    return json.dumps({**manifest, "format": _FORMAT, "checksum": _checksum(manifest["sets"])}) + "\n"
+
+
 def read_manifest(folder: Path) -> dict:
     """The folder's manifest (empty if it has none); ValueError naming it if it is damaged."""
     path = Path(folder) / MANIFEST
@@ -234,6 +243,12 @@ def read_manifest(folder: Path) -> dict:
         raise ValueError(f"{path} is damaged: it records which sediment command wrote each file of {folder}; "
                          "delete it only if no file there needs protecting (commands then refuse to replace "
                          "any file of the folder)") from None
+    # (a manifest of format 1 has no checksum: it is taken as written, and gets one when next written)
+    if manifest.get("format", 1) != 1 and manifest.get("checksum") != _checksum(sets):
+        raise ValueError(f"{path} was edited (its checksum fails): it records which sediment command wrote each file "
+                         f"of {folder}, and a command removes the files it names; put back the one sediment wrote, or "
+                         "delete it only if no file there needs protecting (commands then refuse to replace any file "
+                         "of the folder)")
     return manifest
 
 

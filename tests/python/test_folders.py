@@ -131,6 +131,29 @@ def test_damaged_bookkeeping_is_named(tmp_path):
     assert (tmp_path / "keep").read_text() == "k"
 
 
+def test_a_manifest_edited_by_hand_is_not_trusted(tmp_path):
+    """A set renamed in the manifest (an inversion's files made a readout's), or an entry forged for a user's
+    file, would have the next command remove them: the manifest's checksum fails, and nothing is removed."""
+    publish(tmp_path, "invert", {"psd.csv": "p", "fit.csv": "f"})
+    (tmp_path / "notes.txt").write_text("mine")
+    manifest = json.loads((tmp_path / MANIFEST).read_text())
+    assert manifest["format"] == 2 and len(manifest["checksum"]) == 64
+    for edit in (lambda m: m["sets"].__setitem__("readout", m["sets"].pop("invert")),
+                 lambda m: m["sets"]["invert"]["files"].__setitem__("notes.txt", [4, "0" * 64])):
+        edited = json.loads(json.dumps(manifest))
+        edit(edited)
+        (tmp_path / MANIFEST).write_text(json.dumps(edited))
+        before = contents(tmp_path)
+        with pytest.raises(ValueError, match=f"{MANIFEST} was edited \\(its checksum fails\\)"):
+            publish(tmp_path, "readout", {"hydrometer.csv": "h"})
+        assert contents(tmp_path) == before
+    # a manifest of format 1 (no checksum) is read as written, and written again with its checksum
+    (tmp_path / MANIFEST).write_text(json.dumps({"format": 1, "sets": manifest["sets"]}))
+    publish(tmp_path, "invert", {"psd.csv": "p2"})
+    assert read_manifest(tmp_path)["format"] == 2 and not (tmp_path / "fit.csv").exists()
+    assert (tmp_path / "notes.txt").read_text() == "mine"
+
+
 def test_a_full_disk_while_staging_leaves_the_folder_as_it_was(tmp_path):
     publish(tmp_path, "readout", {"a.csv": "a1"})
     with pytest.raises(OSError, match="No space left on device .*a.csv.*nothing of this sediment readout was published"):
