@@ -172,3 +172,26 @@ def test_the_core_stub_matches_the_built_module():
     stub = runpy.run_path(str(REPO / "scripts" / "core-stub.py"))["stub_text"](_core)
     assert (REPO / "python" / "sediment" / "_core.pyi").read_text() == stub, "run scripts/core-stub.py"
     assert (REPO / "python" / "sediment" / "py.typed").is_file()
+
+
+def test_a_signal_whose_interrupt_was_lost_still_stops_the_command(tmp_path, monkeypatch, capsys):
+    """A SIGINT that lands in a finaliser while a module loads raises its KeyboardInterrupt there, where Python
+    prints it and goes on: the command must still end with 130 and publish nothing."""
+    import signal
+
+    from sediment.cli import readout
+
+    real = readout.run
+
+    def swallowed(args):
+        try:
+            signal.raise_signal(signal.SIGINT)    # the handler raises here ...
+        except KeyboardInterrupt:
+            pass                                  # ... and the interrupt is lost, as in a finaliser
+        return real(args)
+    monkeypatch.setattr(readout, "run", swallowed)
+    psd = Path(__file__).resolve().parents[2] / "examples" / "granulometry" / "psd" / "sample5.csv"
+    out = tmp_path / "preview"
+    assert cli.main(["readout", "--psd", str(psd), "--stokes-preview", "--out", str(out)]) == 130
+    assert "interrupted by SIGINT" in capsys.readouterr().err
+    assert not out.exists() or not any(p for p in out.iterdir() if not p.name.startswith(".sediment"))

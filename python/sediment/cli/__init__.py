@@ -58,6 +58,7 @@ def main(argv: list[str] | None = None) -> int:
     # SIGINT and SIGTERM stop every command alike, through its clean-up, also where SIGINT came in
     # ignored (a background job of a script): `sediment run` takes them so while its run lasts.
     previous = {}
+    _RECEIVED.clear()
     if threading.current_thread() is threading.main_thread():    # where Python lets a handler be set
         previous = {sig: signal.signal(sig, _interrupt) for sig in (signal.SIGINT, signal.SIGTERM)}
     try:
@@ -88,7 +89,9 @@ def _command(argv: list[str] | None) -> int:
     outputs = None
     try:
         if getattr(args, "out", None) is None:
-            return args.func(args)
+            status = args.func(args)
+            _still_interrupted()
+            return status
         from ..folders import OutputSet
 
         with OutputSet(args.out, result_set(args), inputs_of(args)) as outputs:
@@ -96,6 +99,7 @@ def _command(argv: list[str] | None) -> int:
             args.publish = lambda: _publish(outputs)
             status = args.func(args)
             args.publish()
+        _still_interrupted()
         return status
     except RunInterrupted as exc:    # says what the run left
         print(f"sediment {args.command}: {exc}", file=sys.stderr)
@@ -122,6 +126,7 @@ def _publish(outputs) -> None:
     """Publishes a command's set (once: a command may do it before its last words) and says so."""
     if outputs.published:
         return
+    _still_interrupted()
     written = outputs.publish()
     if written:
         print(f"wrote {outputs.folder}: " + ", ".join(p.name + ("/" if p.is_dir() else "") for p in written))
@@ -152,8 +157,20 @@ def inputs_of(args: argparse.Namespace) -> list[Path]:
     return found
 
 
+_RECEIVED: list[str] = []    # the signals this command took, whether or not their KeyboardInterrupt got through
+
+
 def _interrupt(signum: int, _frame: object) -> None:
-    raise KeyboardInterrupt(signal.Signals(signum).name)
+    _RECEIVED.append(signal.Signals(signum).name)
+    raise KeyboardInterrupt(_RECEIVED[-1])
+
+
+def _still_interrupted() -> None:
+    """Raises the interrupt of a signal taken earlier whose KeyboardInterrupt was lost: raised inside a
+    finaliser or a library's handler while a module loaded, Python prints it and goes on. The command
+    then neither publishes nor ends with 0."""
+    if _RECEIVED:
+        raise KeyboardInterrupt(_RECEIVED[0])
 
 
 class _ReaderMayLeave(io.TextIOBase):
