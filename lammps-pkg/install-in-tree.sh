@@ -1,7 +1,7 @@
 #!/bin/sh
 # SPDX-License-Identifier: GPL-2.0-or-later
 # Installs SEDIMENT as a package of a LAMMPS source tree (CMake build), so that
-#   cmake -S LAMMPS/cmake -B build -D PKG_SEDIMENT=on -D PKG_GRANULAR=on ...
+#   cmake -S LAMMPS/cmake -B build -D PKG_SEDIMENT=on -D PKG_GRANULAR=on -D PKG_KSPACE=on -D FFT=FFTW3 ...
 # builds its styles into liblammps and lmp:
 #   lammps-pkg/install-in-tree.sh /path/to/lammps        (the folder with src/ and cmake/)
 # Copies the styles and the physics core to src/SEDIMENT, the CMake module to
@@ -71,4 +71,4 @@ if [ -d "$lammps/examples" ]; then
     mkdir -p "$lammps/examples/PACKAGES/sediment"
     for f in "$here"/examples/*; do update "$f" "$lammps/examples/PACKAGES/sediment/$(basename "$f")"; done
 fi
-echo "SEDIMENT installed in $lammps: configure with -D PKG_SEDIMENT=on -D PKG_GRANULAR=on"
+echo "SEDIMENT installed in $lammps: configure with -D PKG_SEDIMENT=on -D PKG_GRANULAR=on -D PKG_KSPACE=on -D FFT=FFTW3"

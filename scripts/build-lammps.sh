@@ -7,7 +7,8 @@
 #          2022      29 Sep 2021 (Debian 12, 20220106): the source package of the
 #                    installed liblammps-dev (bookworm's newest without it), whose tree sets C++11
 # DEST/lammps: the source tree (src, cmake, doc) with SEDIMENT installed (lammps-pkg/install-in-tree.sh);
-# DEST/build: liblammps.so and lmp with GRANULAR, PLUGIN and SEDIMENT, MPI, no FFT library.
+# DEST/build: liblammps.so and lmp with GRANULAR, KSPACE (FFTW3: fix fluid/flow's FFTs), PLUGIN and
+# SEDIMENT, MPI.
 # Each step is skipped when done (the tarball, the unpacked tree); the build is incremental, so a
 # rerun recompiles only what changed. Nothing of LAMMPS is committed to the project.
 set -euo pipefail
@@ -46,7 +47,8 @@ build="$dest/build"
 # Configured every time (seconds): LAMMPS's CMake lists a package's sources when it configures, so a
 # style added to or removed from SEDIMENT since the last run is picked up.
 cmake -S "$tree/cmake" -B "$build" -D CMAKE_BUILD_TYPE=Release -D BUILD_SHARED_LIBS=on -D BUILD_MPI=on \
-    -D BUILD_OMP=off -D BUILD_TOOLS=off -D FFT=KISS -D WITH_JPEG=off -D WITH_PNG=off -D WITH_GZIP=off \
-    -D WITH_FFMPEG=off -D WITH_CURL=off -D PKG_GRANULAR=on -D PKG_PLUGIN=on -D PKG_SEDIMENT=on >/dev/null
+    -D BUILD_OMP=off -D BUILD_TOOLS=off -D FFT=FFTW3 -D FFT_SINGLE=off -D WITH_JPEG=off -D WITH_PNG=off \
+    -D WITH_GZIP=off -D WITH_FFMPEG=off -D WITH_CURL=off -D PKG_GRANULAR=on -D PKG_KSPACE=on -D PKG_PLUGIN=on \
+    -D PKG_SEDIMENT=on >/dev/null
 cmake --build "$build" -j "${JOBS:-2}" >/dev/null
 echo "LAMMPS $(basename "$orig" | sed 's/lammps_\(.*\)\.orig.*/\1/') with SEDIMENT: $build/lmp"

@@ -3,6 +3,15 @@
 # sources (installed by lammps-pkg/install-in-tree.sh). fix layers/hdf5 writes HDF5 (serial
 # interface, rank 0 only); the physics core's headers sit in src/SEDIMENT/sediment/.
 enable_language(C)
+# fix fluid/flow solves the flow with KSPACE's distributed FFT (fft3d_wrap.h): the package needs it,
+# in double precision (the style passes doubles), best over FFTW3 (-D FFT=FFTW3).
+if(NOT PKG_KSPACE)
+  message(FATAL_ERROR "SEDIMENT needs the KSPACE package (fix fluid/flow uses its FFTs): add -D PKG_KSPACE=on "
+                      "(with -D FFT=FFTW3 for FFTW)")
+endif()
+if(FFT_SINGLE)
+  message(FATAL_ERROR "SEDIMENT needs KSPACE's FFTs in double precision: -D FFT_SINGLE=off")
+endif()
 # The styles and the physics core are C++17 (std::optional, std::string_view, std::clamp). A tree may set
 # less for itself (LAMMPS 29 Sep 2021, Debian 12's, sets CMAKE_CXX_STANDARD 11 unconditionally, so
 # -D CMAKE_CXX_STANDARD=17 is ignored): ask for C++17 on the target, which raises the standard where

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-2.0-or-later
-// The spectral Stokes operator and the spreading kernel of two-way coupling (docs/physics.md section 9),
+// The spectral Stokes operator and the spreading kernel of two-way coupling (docs/physics.md section 8),
 // against closed-form flows: a shear wave, a longitudinal force the pressure takes whole, the return
 // flow (no net flux through any plane), and the periodic box's self-mobility of a spread point force
 // (Hasimoto). The transforms here are plain separable DFTs (fix fluid/flow uses LAMMPS's FFT3d).

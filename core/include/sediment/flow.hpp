@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-2.0-or-later
-// The flow that the spheres drive (two-way coupling, docs/physics.md section 9): each sphere's force
+// The flow that the spheres drive (two-way coupling, docs/physics.md section 8): each sphere's force
 // on the fluid is spread onto a regular grid with a Gaussian kernel, the incompressible Stokes (or
 // Brinkman) equations are solved mode by mode in Fourier space, and the velocity is read back at the
 // spheres with the same kernel. No FFT here: the caller transforms (LAMMPS's FFT3d in fix
