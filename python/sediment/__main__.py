@@ -16,7 +16,12 @@ try:
     from .cli import main
 
     _began = True
-    sys.exit(main())
+    status = main()
+    # the command is over: a signal from here on, through the interpreter's shutdown (which gives the
+    # signals back their default, killing the process without a word), changes nothing it did
+    for _signal in (signal.SIGINT, signal.SIGTERM):
+        signal.signal(_signal, signal.SIG_IGN)
+    sys.exit(status)
 except KeyboardInterrupt as exc:    # while the command's parts loaded, or a second signal as it ended
     left = ("as the command ended (its own message says what it left)" if _began else
             "before the command began; nothing was written: run it again")

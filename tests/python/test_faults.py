@@ -350,3 +350,40 @@ def test_damaged_files_and_interrupts_end_in_one_line(tmp_path):
     running.send_signal(signal.SIGINT)
     _, err = running.communicate(timeout=HANG_GUARD)
     assert running.returncode == 130 and "stopped by SIGINT" in err and "Traceback" not in err
+
+
+@pytest.mark.parametrize("where", ["after LAMMPS ended", "while the record was written"])
+def test_a_signal_as_the_run_finishes_keeps_its_complete_result(tmp_path, monkeypatch, where):
+    """A SIGINT once LAMMPS has finished (its layer file complete) but before the run's bookkeeping is done:
+    the run record says finished, with the layer file's SHA-256, the log is in place, and the message says
+    the results are complete (it said 'files left as *.partial ... --resume continues', the record 'failed')."""
+    import json
+
+    from sediment.sim import run as sim_run
+
+    deck = sample(tmp_path / "s", "--particles", 1000)
+    real_run, real_write = sim_run._run, sim_run._write_record
+
+    def then_interrupted(*args, **kwargs):
+        real_run(*args, **kwargs)
+        raise KeyboardInterrupt("SIGINT")
+
+    def interrupted_while_written(folder, **record):
+        real_write(folder, **record)
+        if record.get("state") == "finished":
+            signal.raise_signal(signal.SIGINT)    # held until the record is written, then raised
+    if where == "after LAMMPS ended":
+        monkeypatch.setattr(sim_run, "_run", then_interrupted)
+    else:
+        monkeypatch.setattr(sim_run, "_write_record", interrupted_while_written)
+    from sediment import cli
+
+    with pytest.raises(sim_run.RunInterrupted, match="its results are complete"):
+        previous = signal.signal(signal.SIGINT, cli._interrupt)
+        try:
+            sim_run.run_deck(deck, progress=False)
+        finally:
+            signal.signal(signal.SIGINT, previous)
+    record = json.loads((deck.parent / sim_run.RECORD).read_text())
+    assert record["state"] == "finished" and record["layers"]["sha256"] == digest(deck.parent / "layers.h5")
+    assert (deck.parent / "log.lammps").is_file() and read_layers(deck.parent / "layers.h5").complete

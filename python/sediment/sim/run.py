@@ -487,6 +487,11 @@ def _run_recorded(deck: Path, ranks: int, variables: dict[str, str], launch: dic
     try:
         result = _run(deck, ranks, launch, progress)
     except BaseException as exc:
+        if isinstance(exc, KeyboardInterrupt) and layers is not None and _finished(layers, record["run_id"]):
+            # the stop came once LAMMPS had finished, before the run's bookkeeping: its results are whole
+            _finish_record(deck, record, layers)
+            raise RunInterrupted(f"stopped by {exc or 'SIGINT'} as the run finished: its results are complete "
+                                 f"({layers.name} and the run record)") from None
         if earlier is not None and layers is not None and _stamp(layers) == frames:
             # refused before it wrote a frame (fix layers/hdf5 keeps an earlier run's frames): the
             # record still describes the run whose frames are there
@@ -494,10 +499,25 @@ def _run_recorded(deck: Path, ranks: int, variables: dict[str, str], launch: dic
         else:
             _write_record(deck.parent, **record, state="interrupted" if isinstance(exc, RunInterrupted) else "failed")
         raise
-    if layers is not None and _finished(layers, record["run_id"]):
-        record["layers"] = {"file": layers.name, "sha256": file_digest(layers)}
-    _write_record(deck.parent, **record, state="finished")
+    try:
+        _finish_record(deck, record, layers)
+    except KeyboardInterrupt as exc:    # held while the record was written, raised after it
+        raise RunInterrupted(f"stopped by {exc or 'SIGINT'} after the run finished: its results are complete"
+                             + (f" ({layers.name} and the run record)" if layers is not None else "")) from None
     return result
+
+
+def _finish_record(deck: Path, record: dict, layers: Path | None) -> None:
+    """The run record of a finished run, with its layer file's SHA-256 and its log in place; signals wait
+    until it is written."""
+    from ..folders import signals_held
+
+    with signals_held():
+        for partial in deck.parent.glob(f".log.lammps.{os.getpid()}.partial"):    # a stop before the log's move
+            os.replace(partial, deck.parent / "log.lammps")
+        if layers is not None and _finished(layers, record["run_id"]):
+            record["layers"] = {"file": layers.name, "sha256": file_digest(layers)}
+        _write_record(deck.parent, **record, state="finished")
 
 
 def _run(deck: Path, ranks: int, variables: dict[str, str], progress: bool) -> RunResult:
