@@ -387,3 +387,29 @@ def test_a_signal_as_the_run_finishes_keeps_its_complete_result(tmp_path, monkey
     record = json.loads((deck.parent / sim_run.RECORD).read_text())
     assert record["state"] == "finished" and record["layers"]["sha256"] == digest(deck.parent / "layers.h5")
     assert (deck.parent / "log.lammps").is_file() and read_layers(deck.parent / "layers.h5").complete
+
+
+def test_resume_names_what_changed_since_the_interrupted_run(tmp_path):
+    """--resume of a run whose inputs changed names the file: the deck edited, sample.data deleted, a file the
+    deck now includes (it blamed sample.data for an edited deck, and said '(none) changed' once it was gone)."""
+    import json
+
+    from sediment.sim.run import RECORD
+
+    deck = sample(tmp_path / "r", "--particles", 1000)
+    assert sediment("run", deck, "--quiet").returncode == 0
+    record = json.loads((deck.parent / RECORD).read_text())
+    (deck.parent / RECORD).write_text(json.dumps(record | {"state": "interrupted"}))    # as a killed run leaves it
+    assert (deck.parent / "restart.a.bin").is_file()
+    text = deck.read_text()
+    for change, words in [(lambda: deck.write_text(text + "variable edited equal 1\n"), "in.sedimentation changed"),
+                          (lambda: (deck.parent / "sample.data").rename(deck.parent / "kept.data"), "sample.data deleted"),
+                          (lambda: ((deck.parent / "extra.lmp").write_text("print hello\n"),
+                                    deck.write_text(text + "include extra.lmp\n")), "in.sedimentation now reads extra.lmp")]:
+        change()
+        done = sediment("run", deck, "--resume", "--quiet")
+        assert done.returncode == 2 and words in done.stderr and "since the interrupted run started" in done.stderr, \
+            done.stderr
+        deck.write_text(text)
+        if (deck.parent / "kept.data").exists():
+            (deck.parent / "kept.data").rename(deck.parent / "sample.data")

@@ -322,13 +322,25 @@ def _resume_id(deck: Path, variables: dict[str, str]) -> str:
     if record["state"] == "finished":
         raise ValueError(f"the run of {deck.name} in {folder} finished: nothing to resume; run it again with --force")
     if record["run_id"].split("-")[0] != inputs_id(deck):
-        raise ValueError(f"{deck.name} or a file it reads ({', '.join(p.name for p in input_files(deck)) or 'none'}) "
-                         "changed since the interrupted run: its restart files are of other inputs; start the run "
-                         "anew with --force")
+        raise ValueError(f"{_what_changed(deck, record.get('files', {}))} since the interrupted run started: its "
+                         "restart files are of other inputs; put them back as they were, or start the run anew with "
+                         "--force")
     if record.get("variables", {}) != variables:
         raise ValueError(f"the interrupted run had the variables {record.get('variables')}, this one {variables}: "
                          "resume it with the same --var options")
     return record["run_id"]
+
+
+def _what_changed(deck: Path, started: dict[str, str]) -> str:
+    """Which of the files a run started with (the record's names and SHA-256) are gone or changed, and which
+    the deck reads now that it did not, as a message's start."""
+    now = [deck, *input_files(deck)]
+    gone = [n for n in started if n not in COMPARED and not (deck.parent / n).is_file()]
+    changed = [p.name for p in now if p.name in started and file_digest(p) != started[p.name]]
+    new = [p.name for p in now if p.name not in started]
+    parts = ([f"{', '.join(changed)} changed"] if changed else []) + ([f"{', '.join(gone)} deleted"] if gone else []) \
+        + ([f"{deck.name} now reads {', '.join(new)}"] if new else [])
+    return "; ".join(parts) if parts else f"{deck.name} or a file it reads changed (the run record names no files)"
 
 
 def _check_partial(deck: Path, variables: dict[str, str], identity: str) -> None:
@@ -467,8 +479,8 @@ def run_deck(deck: Path, ranks: int = 1, variables: dict[str, str] | None = None
                       file=sys.stderr)
         if all("written by run" in f for f in failures):
             raise RuntimeError(f"the restart files in {folder} are of another run (an earlier one, or copied from "
-                               f"elsewhere), not of the interrupted run {identity}, which stopped before it wrote "
-                               "one: start it anew with --force")
+                               f"elsewhere), not of the interrupted run {identity}: its own are gone (replaced since, or "
+                               "it stopped before it wrote one); start it anew with --force")
         reasons = dict.fromkeys(f.split(": ", 1)[1] for f in failures)    # the same reason once
         raise RuntimeError(f"cannot resume from {' or '.join(f.split(':')[0] for f in failures)}: " + "; ".join(reasons))
 
