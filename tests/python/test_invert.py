@@ -514,3 +514,16 @@ def test_a_budget_of_another_test_is_named_and_recorded(tmp_path, capsys):
     own = budget("clay_loam", psd_of(SOIL / "truth_psd.csv"), 0.05)
     assert cli.main(argv + ["--budget", str(own), "--out", str(tmp_path / "own")]) == 0
     assert "was made for another test" not in capsys.readouterr().out
+
+
+def test_a_gravelly_sieve_sheet_without_a_split_names_the_split(tmp_path, capsys):
+    """A whole-sample sieve sheet into gravel (all of it passes 25 mm only) without --split: no column of the
+    test holds its grains, and the refusal names --split 2.0 (it said only that 0.36 m is not tall enough)."""
+    sieve = tmp_path / "gravelly.csv"
+    sieve.write_text("opening_mm,percent_passing\n25,100\n19,96\n9.5,90\n4.75,86\n2,82\n0.85,78\n0.425,72\n0.25,66\n"
+                     "0.15,60\n0.075,52\n")
+    assert cli.main(["invert", str(SOIL / "hydrometer.csv"), str(sieve), "--mass", "0.05",
+                     "--out", str(tmp_path / "out")]) == 2
+    err = capsys.readouterr().err
+    assert "passes only the 25 mm sieve" in err and "which 82 % passes" in err and "give --split 2.0" in err
+    assert not (tmp_path / "out").exists()

@@ -18,6 +18,7 @@ from ..results import Table, write_text
 from .breakdown import Breakdown, breakdown, breakdown_band
 from .fit import ROUGHNESS_DECADES, draw_placement, end_placement, fit, penalty
 from .grid import NEAR, TOP, SizeGrid, size_grid
+from ..sim.scene import COLUMN_DIAMETERS
 from .model import LabTest, cut_diameters, effective_times, linearise, psd_of, run_forward, solids_signal, \
     whole_sample_reading
 
@@ -276,6 +277,13 @@ def invert(sheets: list[Sheet], test: LabTest, folder: Path, *, sieve: SieveShee
         check_sheet(sheet, whole_sample_reading(sheet, test, water), tolerance, reading,
                     NOISE_OPTIONS[sheet.instrument] + stated)
     sieves = sieve_data(sieve, split, test.noise["sieve"])
+    if split is None and sieves.top > test.height / COLUMN_DIAMETERS:
+        d422 = [p for o, p in zip(sieve.opening, sieve.passing) if abs(o - 2e-3) < 1e-5]
+        raise SheetError(f"{sieve.label}: the whole sample passes only the {sieves.top * 1e3:g} mm sieve, and a column of "
+                         f"{test.height:.3g} m settles grains up to {test.height / COLUMN_DIAMETERS * 1e3:.3g} mm ("
+                         f"{COLUMN_DIAMETERS} diameters): the hydrometer's specimen is the part passing a sieve (D422's "
+                         f"2 mm{f', which {d422[0]:g} % passes' if d422 else ''}); give --split 2.0 (or the opening it "
+                         "was split at)")
     reduction = [standard_reduction(sheet, water, c0, test.hydrometer, test.cylinder_area, test.sphere, test.meniscus,
                                     test.correction(sheet)) for sheet in sheets]
     times = [effective_times(s, water) for s in sheets]

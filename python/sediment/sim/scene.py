@@ -275,6 +275,9 @@ def terminal_speed(suspension: Suspension, diameter: float, law: str) -> float:
     return speed
 
 
+COLUMN_DIAMETERS = 20    # a column is at least this many of its largest grains tall
+
+
 def plan(psd: PSD, *, geometry: str = "column", cylinder: Cylinder = Cylinder(), mass: float = 0.060,
          suspension: Suspension = Suspension(), width: float | None = None, classes: int | np.ndarray = 40,
          particles: int | None = 20000, effects: Effects = Effects(), layers: int = 400, t_end: float = 86400.0,
@@ -326,9 +329,9 @@ def plan(psd: PSD, *, geometry: str = "column", cylinder: Cylinder = Cylinder(),
         raise ValueError(f"grains of {suspension.particle_density:g} kg/m3 do not settle in water of "
                          f"{suspension.fluid_density:g} kg/m3")
     d_largest = psd.span()[1]
-    if cylinder.height < 20 * d_largest:
+    if cylinder.height < COLUMN_DIAMETERS * d_largest:
         raise ValueError(f"a column of {cylinder.height:g} m is not tall enough for grains of {d_largest * 1e6:.3g} um "
-                         "(at least 20 diameters)")
+                         f"(at least {COLUMN_DIAMETERS} diameters)")
     solids = mass / (cylinder.area * cylinder.height) / suspension.particle_density
     if solids >= 0.5:
         raise ValueError(f"{mass:g} kg of solids would fill {solids:.0%} of the {cylinder.area * cylinder.height * 1e3:.3g} L "
