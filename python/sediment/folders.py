@@ -90,6 +90,7 @@ class OutputSet:
         self._foreign: list[str] = []
         self.removed_sets: list[tuple[str, Path]] = []    # sets (name, folder) removed with what they were made from
         self.dropped: list[str] = []    # the previous set's entries this one did not write again, removed with it
+        self.removed_also: list[str] = []    # the files of the folder asked to go with it (remove_also)
         self._created = [p for p in (self.folder, *self.folder.parents) if not p.exists()]
         self._lock = folder_lock(self.folder, "write")
 
@@ -125,6 +126,7 @@ class OutputSet:
         """Files of the folder, not this set's, that the user asked to have removed with it (by path
         relative to the folder); removed when the set is published."""
         self._foreign += [str(n) for n in names]
+        self.removed_also += [str(n) for n in names]
 
     def publish(self) -> list[Path]:
         """Moves the staged set into the folder, replacing this set's previous files. ValueError, with

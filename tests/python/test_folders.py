@@ -239,7 +239,9 @@ def test_sample_force_removes_the_run_and_what_was_read_from_it(tmp_path, capsys
     assert cli.main(["sample", str(other)] + small) == 2
     assert "holds a run of another scene (layers.h5)" in capsys.readouterr().err
     assert cli.main(["sample", str(other), "--force"] + small) == 0
-    assert "removed the results of sediment readout" in capsys.readouterr().out
+    printed = capsys.readouterr().out
+    assert "removed the results of sediment readout" in printed and "removed 1 file(s) in" in printed
+    assert "that this sample replaces: layers.h5" in printed
     assert not (out / "layers.h5").exists() and not (out / "hydrometer.csv").exists()
     assert not (out / "r" / "pipette.csv").exists() and (out / "mine" / "pipette.csv").is_file()
     assert set(read_manifest(out)["sets"]) == {"sample"} and read_manifest(out / "r")["sets"] == {}

@@ -135,6 +135,9 @@ def _publish(outputs) -> None:
     if outputs.dropped:
         print(f"removed {len(outputs.dropped)} file(s) of this {outputs.name}'s previous results that it did not write "
               f"again: {', '.join(outputs.dropped)}")
+    asked = [n for n in outputs.removed_also if n not in outputs.dropped]
+    if asked:
+        print(f"removed {len(asked)} file(s) in {outputs.folder} that this {outputs.name} replaces: {', '.join(asked)}")
     for name, folder in outputs.removed_sets:
         print(f"removed the results of sediment {name} in {folder}: they were made from files this "
               f"{outputs.name} removed")
