@@ -413,3 +413,20 @@ def test_resume_names_what_changed_since_the_interrupted_run(tmp_path):
         deck.write_text(text)
         if (deck.parent / "kept.data").exists():
             (deck.parent / "kept.data").rename(deck.parent / "sample.data")
+
+
+def test_a_run_that_starts_after_the_stop_is_stopped_at_once(tmp_path):
+    """The planner stops its trials together on Ctrl-C; a trial whose thread had started its LAMMPS but not yet
+    added it to the runs under way was missed, and the plan waited for it (for ever, were it paused). A run
+    added after the stop is stopped as soon as it is known, and none starts after it."""
+    from sediment.sim.run import RunInterrupted, Runs, _start, run_batch
+
+    runs = Runs()
+    runs.stop()
+    proc = _start(["sleep", "600"], dict(os.environ), tmp_path)
+    runs.add(proc)
+    assert proc.poll() is not None
+    deck = tmp_path / "in.none"
+    deck.write_text("print hello\n")
+    with pytest.raises(RunInterrupted, match="stopped before this one began"):
+        run_batch(deck, running=runs)

@@ -148,7 +148,7 @@ def _measure_contacts(test, args: argparse.Namespace, tolerance: float) -> None:
     from ..planner.contacts import ReducedScene, measure_contacts
     from ..planner.scenes import prepare
     from ..results import write_text
-    from ..sim.run import stop_all
+    from ..sim.run import Runs, stop_all
 
     largest = test.psd.span()[1]
     cut = largest / 3 if args.contact_cut is None else args.contact_cut * 1e-6
@@ -158,7 +158,7 @@ def _measure_contacts(test, args: argparse.Namespace, tolerance: float) -> None:
           f"({min(args.jobs, 2)} at once) ...", flush=True)
     # One name per measurement: its run folder and its rows in contacts.csv/json.
     kinds = ["contacts_lubrication" if setup.lubrication else "contacts" for setup in setups]
-    running: set = set()
+    running = Runs()
     # One bar per run in steps (the relaxation and the measured window), with tqdm's ETA.
     bars = [progress_bar(total=1, desc=kind, unit="step", position=k, file=sys.stderr, dynamic_ncols=True,
                      mininterval=0.5) for k, kind in enumerate(kinds)]

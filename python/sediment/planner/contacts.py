@@ -31,7 +31,7 @@ import numpy as np
 
 from ..lab.psd import PSD
 from ..results import Table, write_text
-from ..sim.run import run_batch
+from ..sim.run import Runs, run_batch
 from ..sim.scene import OVERLAP_TOLERANCE, Cylinder, Effects, pair_lines, plan, write_data
 from .screening import ReadingModel, SedimentationTest, encounters, terminal_speeds
 
@@ -101,7 +101,7 @@ def coarse_part(psd: PSD, smallest: float) -> tuple[PSD, float]:
 
 
 def measure_contacts(test: SedimentationTest, setup: ReducedScene, folder: Path, ranks: int = 1,
-                     running: set | None = None,
+                     running: Runs | None = None,
                      on_progress: Callable[[int, int], None] | None = None) -> ContactMeasurement:
     """Runs the reduced scene in `folder` and measures each class's speed (see the module).
 

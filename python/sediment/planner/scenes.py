@@ -21,7 +21,7 @@ import numpy as np
 
 from ..results import write_text
 from ..sim.deck import deck_text, index_variables
-from ..sim.run import run_batch
+from ..sim.run import Runs, run_batch
 from ..constants import DRAGS, HINDRANCES
 from .screening import INCLUDE, MEASURE, OMIT, Screen, SedimentationTest, screen, verdict_of
 
@@ -109,7 +109,7 @@ class SampleScene:
         self.test = test
         self.options = options              # further keyword arguments of scene.plan
         self.water_record: tuple = ()       # the water's temperature over the test (--temperature-record)
-        self.running: set = set()           # runs under way (stopped together on an interrupt)
+        self.running = Runs()           # runs under way (stopped together on an interrupt)
         if not particles or any(p < 1 for p in particles):
             raise ValueError("the particle ladder needs at least one count >= 1")
         if not courant or any(not c > 0 for c in courant):
@@ -249,7 +249,7 @@ class DeckScene:
                 raise ValueError(f"{deck}: the deck has no 'variable {name} index ...' for the ladder to set")
         self.observables = observables
         self.tolerance = tolerance
-        self.running: set = set()           # runs under way (stopped together on an interrupt)
+        self.running = Runs()           # runs under way (stopped together on an interrupt)
         self.variables = dict(variables or {})
         self.ranks = ranks
         self.knobs = [Knob(name, ("yes", "no"), "effect", (name,)) for name, _ in effects]

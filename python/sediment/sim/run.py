@@ -644,7 +644,7 @@ class DeckOutput:
 
 
 def run_batch(deck: Path, variables: dict[str, object] | None = None, ranks: int = 1, cwd: Path | None = None,
-              timeout: float | None = None, check: bool = True, running: set | None = None,
+              timeout: float | None = None, check: bool = True, running: Runs | None = None,
               on_line: Callable[[str], None] | None = None) -> DeckOutput:
     """Runs a deck quietly (no log file) and collects what it prints.
 
@@ -662,9 +662,9 @@ def run_batch(deck: Path, variables: dict[str, object] | None = None, ranks: int
         Seconds before the run is killed.
     check : bool
         Raise RuntimeError with LAMMPS's message if the run fails.
-    running : set, optional
+    running : Runs, optional
         Holds the run's process while it runs, for a caller running several at once to stop them
-        (`stop_all`).
+        (`stop_all`); a run started after they were stopped is refused (RunInterrupted).
     on_line : callable, optional
         Called with each line LAMMPS prints as it prints it (a progress bar follows the thermo rows).
 
@@ -677,6 +677,8 @@ def run_batch(deck: Path, variables: dict[str, object] | None = None, ranks: int
     if not deck.is_file():
         raise FileNotFoundError(f"{deck}: no such deck")
     cmd, env = _launch(str(deck), "none", ranks, variables)
+    if running is not None and running.stopped:
+        raise RunInterrupted("the runs were stopped before this one began")
     start = time.monotonic()
     proc = _start(cmd, env, cwd or deck.parent, stdout=subprocess.PIPE, stderr=subprocess.PIPE)
     if running is not None:
@@ -730,10 +732,42 @@ def run_batch(deck: Path, variables: dict[str, object] | None = None, ranks: int
     return out
 
 
-def stop_all(running: set) -> None:
-    """Stops every run in `running` (see run_batch) and its ranks."""
-    for proc in list(running):
-        _stop(proc, grace=2.0)
+class Runs:
+    """The runs under way of a caller that runs several at once (threads), to be stopped together: once
+    stopped, a run that a thread starts after it is stopped as soon as it is known (a thread may be
+    between starting its LAMMPS and adding it here when the stop comes)."""
+
+    def __init__(self) -> None:
+        self._procs: set[subprocess.Popen] = set()
+        self._lock = threading.Lock()
+        self.stopped = False
+
+    def add(self, proc: subprocess.Popen) -> None:
+        with self._lock:
+            self._procs.add(proc)
+            late = self.stopped
+        if late:
+            _stop(proc, grace=2.0)
+
+    def discard(self, proc: subprocess.Popen) -> None:
+        with self._lock:
+            self._procs.discard(proc)
+
+    def __len__(self) -> int:
+        return len(self._procs)
+
+    def stop(self) -> None:
+        """Stops every run under way and every one added from now on, with their ranks."""
+        with self._lock:
+            self.stopped = True
+            procs = list(self._procs)
+        for proc in procs:
+            _stop(proc, grace=2.0)
+
+
+def stop_all(running: Runs) -> None:
+    """Stops every run in `running` (see run_batch), those started after included, and their ranks."""
+    running.stop()
 
 
 def _is_float(word: str) -> bool:
