@@ -86,7 +86,7 @@ def read_layers(path: str | Path) -> LayerFile:
     try:
         handle = h5py.File(path, "r")
     except OSError as exc:
-        if "lock" in str(exc).lower():    # HDF5 locks a file it writes: a run writing its frames now
+        if "unable to lock file" in str(exc).lower():    # HDF5 locks a file it writes: a run writing its frames now
             raise LayerFileError(f"{path}: another process holds it open for writing (a run still writing its "
                                  "frames?): read it once that run has ended") from None
         raise LayerFileError(f"{path}: not a readable HDF5 file (truncated or corrupt?): {exc}") from None
@@ -104,7 +104,7 @@ def read_layers(path: str | Path) -> LayerFile:
         try:
             # A run killed between the datasets of a frame leaves them of different lengths:
             # the frames present in all three are the complete ones.
-            frames = min(len(f["time"]), len(f["step"]), len(f["fraction"]), *([len(f["fluid"])] if "fluid" in f else []))
+            frames = min(len(f[name]) for name in ("time", "step", "fraction", "fluid") if name in f)
             fluid = np.asarray(f["fluid"][:frames], float) if "fluid" in f else None
             complete = f.attrs.get("complete", 0) == 1
             if fluid is not None and fluid.shape == (frames, 2) and not complete:
@@ -196,7 +196,8 @@ def check_content(layers: LayerFile) -> None:
         off = np.abs(parts - total) > 1e-9 * np.maximum(total, 1e-12) + 1e-15
         if off.any():
             frame = int(np.argmax(off.any(axis=1)))
-            refuse(f"the size classes' fractions do not add up to the total in frame {frame} (at {layers.time[frame]:g})")
+            refuse(f"the size classes' fractions do not add up to the total in frame {frame} "
+                   f"(at {layers.time[frame]:g})")
     if not total[0].sum() > 0:
         refuse("its first frame holds no solids (every fraction 0)")
     steps = np.asarray(layers.step)
@@ -206,9 +207,9 @@ def check_content(layers: LayerFile) -> None:
         for name, quantity in PHYSICAL:
             value = layers.attributes.get(name)
             limits = RANGES[quantity]
-            if value is not None and not (limits.low <= value <= limits.high or (name == "fluid_yield_stress" and value == 0)):
-                refuse(f"its {name} is {value:g} {limits.unit}, which no {quantity.replace('_', ' ')} is ({limits.low:g}-"
-                       f"{limits.high:g} {limits.unit}: {limits.why})")
+            if value is not None and not (limits.low <= value <= limits.high or value == 0 == limits.low):
+                refuse(f"its {name} is {value:g} {limits.unit}, which no {quantity.replace('_', ' ')} is "
+                       f"({limits.low:g}-{limits.high:g} {limits.unit}: {limits.why})")
         rho_p, rho_f = (layers.attributes.get(k) for k in ("particle_density", "fluid_density"))
         if rho_p is not None and rho_f is not None and not rho_p > rho_f:
             refuse(f"its grains ({rho_p:g} kg/m3) are not denser than its fluid ({rho_f:g} kg/m3)")
