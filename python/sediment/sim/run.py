@@ -334,6 +334,9 @@ def _resume_id(deck: Path, variables: dict[str, str]) -> str:
 def _what_changed(deck: Path, started: dict[str, str]) -> str:
     """Which of the files a run started with (the record's names and SHA-256) are gone or changed, and which
     the deck reads now that it did not, as a message's start."""
+    if deck.name not in started:    # a record of another run, or damaged
+        return (f"the run record ({RECORD}) names no start of {deck.name} (damaged, or of another run), and "
+                f"{deck.name} or a file it reads changed")
     now = [deck, *input_files(deck)]
     gone = [n for n in started if n not in COMPARED and not (deck.parent / n).is_file()]
     changed = [p.name for p in now if p.name in started and file_digest(p) != started[p.name]]
