@@ -1572,7 +1572,6 @@ OUTCOME_NAMES = ("ok", "wrong", "crash", "vague")
 KNOWN_BAD: set[str] = {   # not ok in the round of docs/hostile.md; take a case off when it is fixed
     "paste-balls/unit--viscosity=279",
     "run/again-after-it-finished",
-    "run/damaged-sample.data/text",
     "spheres/spheres/binary-garbage",
     "spheres/spheres/eta-in-mPa-s",
     "sweep/value-25-a-negative-step",

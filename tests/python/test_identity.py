@@ -232,6 +232,10 @@ def test_6_cut_inputs_are_refused(tmp_path):
     data = deck.parent / "sample.data"
     data.write_text(data.read_text().split("\nWeights")[0] + "\n")
     no_weights = sediment("run", deck, "--quiet", "--force")
+    assert no_weights.returncode == 2 and "sample.data changed since sediment sample wrote it" in no_weights.stderr
+    # without the folder's record of what sample wrote, the deck's own check of the weights stops it
+    (deck.parent / ".sediment-files.json").unlink()
+    no_weights = sediment("run", deck, "--quiet", "--force")
     assert no_weights.returncode == 2 and "did the data file lose its weights section" in no_weights.stderr
     assert digest(deck.parent / "layers.h5") == finished
 

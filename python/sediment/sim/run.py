@@ -331,6 +331,19 @@ def _resume_id(deck: Path, variables: dict[str, str]) -> str:
     return record["run_id"]
 
 
+def _check_written(deck: Path) -> None:
+    """Refuses a deck that reads a file `sediment sample` wrote beside it whose bytes have changed since
+    (its size and SHA-256 in the folder's manifest): a damaged data file may read as no atoms at all."""
+    from ..folders import read_manifest
+
+    written = read_manifest(deck.parent)["sets"].get("sample", {}).get("files", {})
+    for path in input_files(deck):
+        held = written.get(path.name)
+        if held is not None and [path.stat().st_size, file_digest(path)] != held:
+            raise ValueError(f"{path} changed since sediment sample wrote it ({path.stat().st_size} bytes, "
+                             f"{held[0]} then): damaged, or edited; write it again (sediment sample --force)")
+
+
 def _what_changed(deck: Path, started: dict[str, str]) -> str:
     """Which of the files a run started with (the record's names and SHA-256) are gone or changed, and which
     the deck reads now that it did not, as a message's start."""
@@ -431,7 +444,8 @@ def run_deck(deck: Path, ranks: int = 1, variables: dict[str, str] | None = None
     variables = {k: str(v) for k, v in (variables or {}).items()}
     folder = deck.parent
     with folder_lock(folder, "run"):
-        if not resume:
+        if not resume:    # (a resumed run names what changed since it started)
+            _check_written(deck)
             launch = dict(variables, sediment_run_id=run_id(deck, variables))
             if force or _unresumable(deck, variables):
                 launch["overwrite"] = "yes"
@@ -680,7 +694,7 @@ def run_batch(deck: Path, variables: dict[str, object] | None = None, ranks: int
     if not deck.is_file():
         raise FileNotFoundError(f"{deck}: no such deck")
     cmd, env = _launch(str(deck), "none", ranks, variables)
-    if running is not None and running.stopped:
+    if getattr(running, "stopped", False):
         raise RunInterrupted("the runs were stopped before this one began")
     start = time.monotonic()
     proc = _start(cmd, env, cwd or deck.parent, stdout=subprocess.PIPE, stderr=subprocess.PIPE)
@@ -746,6 +760,7 @@ class Runs:
         self.stopped = False
 
     def add(self, proc: subprocess.Popen) -> None:
+        """A run under way (stopped at once if the runs were stopped)."""
         with self._lock:
             self._procs.add(proc)
             late = self.stopped
@@ -753,6 +768,7 @@ class Runs:
             _stop(proc, grace=2.0)
 
     def discard(self, proc: subprocess.Popen) -> None:
+        """A run that has ended."""
         with self._lock:
             self._procs.discard(proc)
 
