@@ -1,6 +1,6 @@
 #!/usr/bin/python3
 # SPDX-License-Identifier: GPL-2.0-or-later
-"""The Markdown of a hostile round's outcomes (round3.py --json FILE) for docs/hostile.md: the counts per
+"""The Markdown of a hostile round's outcomes (round4.py --json FILE: rounds 3 and 4) for docs/hostile.md: the counts per
 command and per outcome, then every case that is not ok, grouped by what is wrong.
 
     tests/hostile/report.py OUTCOMES.json > part.md
@@ -14,7 +14,9 @@ from collections import Counter, defaultdict
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-import round3  # noqa: E402
+import round4  # noqa: E402  (round 3's cases with round 4's added)
+
+round3 = round4.round3
 
 AREAS = [
     ("ownership", "One command's --out onto another's folder or onto an input"),

@@ -103,7 +103,7 @@ def readout_temperature_record(ctx: Ctx):
         ("wrong", f"the 24 h reading is missing ({times[-3:]})")
 
 
-add("round4/readout/temperature-record", "readout", "bad input", readout_temperature_record)
+add("round4/readout/temperature-record", "readout", "input", readout_temperature_record)
 
 
 # ---- invert: another sample's sheets, another unit, another budget, gravel ----------------------------------
@@ -140,11 +140,11 @@ def _budget_of_sample5(ctx: Ctx) -> Path:
                                                 "made_for": made_for}]))
 
 
-add("round4/invert/sieve-sheet-of-another-soil", "invert", "bad input",
+add("round4/invert/sieve-sheet-of-another-soil", "invert", "input",
     invert_noted([], ["pull the curve apart", "another sample"], _other_sieves, ("--particles", "4000")))
-add("round4/invert/151h-readings-as-152h", "invert", "bad input",
+add("round4/invert/151h-readings-as-152h", "invert", "input",
     invert_noted([], ["far closer to the fit", "151H"], _as_151h, ()))
-add("round4/invert/budget-of-another-sample", "invert", "bad input",
+add("round4/invert/budget-of-another-sample", "invert", "input",
     invert_noted(["--budget", _budget_of_sample5], ["sample5", "made for another test"]))
 
 
@@ -155,7 +155,7 @@ def invert_gravel_without_split(ctx: Ctx):
     return refusal(done, [("--split 2.0",), ("25 mm",)])
 
 
-add("round4/invert/gravel-without-split", "invert", "bad input", invert_gravel_without_split, quick=True)
+add("round4/invert/gravel-without-split", "invert", "input", invert_gravel_without_split, quick=True)
 
 
 # ---- a manifest edited by hand ---------------------------------------------------------------------------------
@@ -198,7 +198,7 @@ def run_floor_above(ctx: Ctx):
     return refusal(done, [("floor z 0.01 lies above",)])
 
 
-add("round4/run/floor-above-the-grains", "run", "bad input", run_floor_above, quick=True)
+add("round4/run/floor-above-the-grains", "run", "value", run_floor_above, quick=True)
 
 
 KNOWN_BAD: set[str] = set()    # not ok in the round of docs/hostile.md; take a case off when it is fixed
