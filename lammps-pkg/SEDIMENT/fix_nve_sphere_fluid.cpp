@@ -212,28 +212,40 @@ void FixNVESphereFluid::setup(int /*vflag*/)
   reported_vectors |= nonlinear;
 }
 
-// A sphere whose centre lies below the floor would be lifted onto it at its first step, through the
-// grains above it (and a shrink-wrapped box grown to it): a floor above the grains is a mistake in the
-// deck, refused here with the lowest such sphere. One that only reaches into it (created at random near
-// the bottom) is set on it at its first step, by less than its radius.
+// A sphere whose centre lies below the floor is lifted onto it at its first step, through the grains
+// above it (and a shrink-wrapped box grown to it). A floor above every sphere of the group (or above
+// the box) is a mistake in the deck, refused naming the lowest sphere; below some of them it is a
+// warning with their count (a scene may drop its grains onto a floor inside them on purpose).
 void FixNVESphereFluid::check_floor()
 {
   double **x = atom->x;
   int *mask = atom->mask;
   const double none = std::numeric_limits<double>::max();
   double lowest[2] = {none, 0.0};    // the lowest centre below the floor, and its atom's ID
-  for (int i = 0; i < atom->nlocal; ++i)
-    if ((mask[i] & groupbit) && x[i][floor_axis] < floor_level && x[i][floor_axis] < lowest[0]) {
+  bigint counts[2] = {0, 0};         // spheres of the group, and those below the floor
+  for (int i = 0; i < atom->nlocal; ++i) {
+    if (!(mask[i] & groupbit)) continue;
+    ++counts[0];
+    if (x[i][floor_axis] >= floor_level) continue;
+    ++counts[1];
+    if (x[i][floor_axis] < lowest[0]) {
       lowest[0] = x[i][floor_axis];
       lowest[1] = static_cast<double>(atom->tag[i]);
     }
+  }
   double all[2];
+  bigint total[2];
   MPI_Allreduce(lowest, all, 1, MPI_2DOUBLE_PRECISION, MPI_MINLOC, world);
-  if (all[0] < none)
-    error->all(FLERR, "Fix nve/sphere/fluid: floor {} {} lies above atom {}, whose centre is at {} {} (box {} to {}): "
-               "give a floor at or below the grains (the bottom of the column), not inside them",
-               "xyz"[floor_axis], floor_level, static_cast<tagint>(all[1]), "xyz"[floor_axis], all[0],
-               domain->boxlo[floor_axis], domain->boxhi[floor_axis]);
+  MPI_Allreduce(counts, total, 2, MPI_LMP_BIGINT, MPI_SUM, world);
+  const char axis = "xyz"[floor_axis];
+  if (total[1] > 0 && (total[1] == total[0] || floor_level > domain->boxhi[floor_axis]))
+    error->all(FLERR, "Fix nve/sphere/fluid: floor {} {} lies above every sphere (atom {}, the lowest, at {} {}; box {} "
+               "to {}): give a floor at or below the grains (the bottom of the column)",
+               axis, floor_level, static_cast<tagint>(all[1]), axis, all[0], domain->boxlo[floor_axis],
+               domain->boxhi[floor_axis]);
+  if (total[1] > 0 && comm->me == 0)
+    error->warning(FLERR, "Fix nve/sphere/fluid: {} of {} spheres lie below floor {} {}: they are set on it at their "
+                   "first step", total[1], total[0], axis, floor_level);
 }
 
 // A perfectly inelastic floor without a bed: a sphere reaching it stops with its lowest point on

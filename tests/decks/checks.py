@@ -1182,7 +1182,7 @@ BAD_INPUT = [
     ("compute c all concentration/grid layers z 10 bounds 2 3\nrun 0", "lie wholly outside the box"),
     # a floor above the grains would lift every one onto it at the first step (and grow a shrink-wrapped box)
     (ONE_SPHERE + "fix f all fluid density 1000 viscosity 1e-3\nfix d all fluid/drag f law stokes\ntimestep 1e-4\n"
-     "fix s all nve/sphere/fluid floor z 0.9\nrun 1", "floor z 0.9 lies above atom 1, whose centre is at z 0.5"),
+     "fix s all nve/sphere/fluid floor z 0.9\nrun 1", "floor z 0.9 lies above every sphere (atom 1, the lowest, at z 0.5"),
     ("fix f all fluid density 1000 viscosity 1e-3\ncompute c all concentration/grid layers z 10\n"
      "fix l all layers/hdf5 1 '' c_c", "'' names no file"),
     ("fix f all fluid density 1000 viscosity 1e-3\nfix d all fluid/drag f law difelice concentration c_x\nrun 0", "compute 'x' does not exist"),

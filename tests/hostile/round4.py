@@ -195,7 +195,7 @@ def run_floor_above(ctx: Ctx):
                     "fix grav all gravity 9.81 vector 0 0 -1\nfix step all nve/sphere/fluid floor z 1e-2\n"
                     "timestep 1e-4\nrun 100\n")
     done = sed("run", deck, "--quiet", timeout=60)
-    return refusal(done, [("floor z 0.01 lies above",)])
+    return refusal(done, [("floor z 0.01 lies above every sphere",)])
 
 
 add("round4/run/floor-above-the-grains", "run", "value", run_floor_above, quick=True)
