@@ -1573,7 +1573,7 @@ KNOWN_BAD: set[str] = {   # not ok in the round of docs/hostile.md; take a case 
     "paste-balls/unit--viscosity=279",
     "run/again-after-it-finished",
     "spheres/spheres/binary-garbage",
-    "spheres/spheres/eta-in-mPa-s",
+    
     "sweep/value-25-a-negative-step",
 }
 

@@ -24,6 +24,7 @@ from ..sim.paths import REPO_DIR
 from ..sim.run import run_batch
 
 DECK = REPO_DIR / "examples" / "valentik_whitmore" / "in.sphere"
+STOKES_MARGIN = 3.0    # a measured speed this many times Stokes' at eta_B: no plastic viscosity in Pa s
 COLUMNS = ("suspension", "rho_f", "eta_B", "tau_y", "d", "rho_p", "v_ter_measured")
 
 
@@ -84,6 +85,13 @@ def read_spheres(path: Path) -> list[Sphere]:
         if values["rho_p"] <= values["rho_f"]:
             raise ValueError(f"{where}: the sphere (rho_p {values['rho_p']:g}) does not sink in the suspension "
                              f"(rho_f {values['rho_f']:g})")
+        # the yield stress and inertia only slow a sphere: it falls at most at Stokes' speed for eta_B
+        stokes = (values["rho_p"] - values["rho_f"]) * GRAVITY * values["d"] ** 2 / (18 * values["eta_B"])
+        fell = values["v_ter_measured"]
+        if fell > STOKES_MARGIN * stokes:
+            raise ValueError(f"{where}: the sphere fell at {fell:g} m/s, {fell / stokes:.3g} times Stokes' speed at eta_B {values['eta_B']:g} Pa s ({stokes:.3g} m/s), which a yield "
+                             f"stress and inertia only lower: is eta_B in mPa s? ({values['eta_B']:g} mPa s is "
+                             f"{values['eta_B'] * 1e-3:g} Pa s)")
         spheres.append(Sphere(cells["suspension"].strip(), values["rho_f"], values["eta_B"], values["tau_y"], values["d"],
                               values["rho_p"], values["v_ter_measured"]))
     if not spheres:
