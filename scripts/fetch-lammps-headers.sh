@@ -17,11 +17,11 @@ mkdir -p "$downloads"
 exec 9>"$downloads/.lock"
 flock 9
 orig=$("$(dirname "$0")/fetch-lammps-source.sh" bookworm "$version" "$downloads")
-# The headers of src/ and its packages ('*/src/*.h' reaches into every package folder), the fmt they
-# include, and in full the packages the styles build on: GRANULAR, PLUGIN, and KSPACE's distributed FFT
-# (fft3d_wrap.h, fft3d.h, with the KISS FFT header they name), which fix fluid/flow solves its flow with.
-tar -xf "$orig" -C "$work" --wildcards '*/src/*.h' '*/src/fmt/*' '*/src/GRANULAR/*' '*/src/PLUGIN/*' \
-    '*/src/KSPACE/fft3d*.h' '*/src/KSPACE/kissfft.h'
+# The headers of src/ and of every package ('*/src/*.h' reaches into every package folder: KSPACE's
+# fft3d_wrap.h, fft3d.h and kissfft.h, which fix fluid/flow solves its flow with, among them; a pattern
+# naming them again matches no member of its own, and tar fails on it), the fmt they include, and in
+# full the packages the styles build on: GRANULAR, PLUGIN.
+tar -xf "$orig" -C "$work" --wildcards '*/src/*.h' '*/src/fmt/*' '*/src/GRANULAR/*' '*/src/PLUGIN/*'
 top=$(ls -d "$work"/*/src)
 cp -r "$top"/. "$dest"/
 touch "$dest/.complete"
