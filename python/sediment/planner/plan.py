@@ -20,6 +20,7 @@ decide the cheapest setting within the tolerance, verify it with a run, and repo
 from __future__ import annotations
 
 import itertools
+import sys
 import json
 import math
 from concurrent.futures import ThreadPoolExecutor, as_completed
@@ -462,6 +463,26 @@ def _screened(knob: Knob, screens: dict[str, Screen]) -> tuple | None:
     return knob.values[-1], estimate, "; ".join(reasons)
 
 
+STUCK_AFTER_STOP = 120.0    # s: a trial whose thread outlives its stopped run by this much is a bug
+
+
+def _trials_ended(futures) -> None:
+    """Waits for the trials' threads once their runs are stopped. One that does not end (once seen, under
+    load: a Ctrl-C the plan then waited on for ever) is a bug: every thread's stack goes to stderr, and
+    the process ends with 130 rather than hang (the next command in the folder clears its stage)."""
+    import faulthandler
+    import os
+    from concurrent.futures import wait
+
+    # (a trial cancelled before it began is never 'done' to wait(): only those that began are waited on)
+    if not wait([f for f in futures if not f.cancelled()], timeout=STUCK_AFTER_STOP).not_done:
+        return
+    print(f"sediment plan: a trial's thread did not end {STUCK_AFTER_STOP:g} s after its run was stopped; the "
+          "threads' stacks follow (please report them); exiting", file=sys.stderr, flush=True)
+    faulthandler.dump_traceback(file=sys.stderr, all_threads=True)
+    os._exit(130)
+
+
 def _run_all(scene, trials: list[Trial], runs: Path, jobs: int, progress: bool, what: str) -> None:
     """Runs the trials, `jobs` at a time, with a progress bar."""
     if not trials:
@@ -479,6 +500,7 @@ def _run_all(scene, trials: list[Trial], runs: Path, jobs: int, progress: bool, 
     except BaseException:             # Ctrl-C, SIGTERM or a failed trial: no run outlives the plan
         pool.shutdown(wait=False, cancel_futures=True)
         stop_all(scene.running)
+        _trials_ended(futures)
         raise
     finally:
         pool.shutdown(wait=True)
