@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field, replace
+from functools import cached_property
 from pathlib import Path
 
 import numpy as np
@@ -156,21 +157,30 @@ class Column:
             water = None    # one water throughout: the attributes say it
         return cls(edges, np.asarray(layers.time, float), fraction, suspension, attrs.get("slab_thickness", 0.0), water)
 
+    @cached_property
+    def _fall_rate(self) -> np.ndarray:
+        """Per frame, (rho_p - rho_f) / mu integrated over time from the start [s kg / (m3 Pa s)]: the water
+        linear between frames (the trapezoid), and the first frame's water before it."""
+        rate = (self.suspension.particle_density - self.water[:, 0]) / self.water[:, 1]
+        steps = 0.5 * (rate[1:] + rate[:-1]) * np.diff(self.time)
+        return self.time[0] * rate[0] + np.concatenate([[0.0], np.cumsum(steps)])
+
+    def fluid_density_at(self, t: float) -> float:
+        """The water's density at time t, as the frames recorded it (linear between frames)."""
+        if self.water is None:
+            return self.suspension.fluid_density
+        return float(np.interp(t, self.time, self.water[:, 0]))
+
     def suspension_at(self, t: float) -> Suspension:
-        """The suspension at time t: its water as the frames recorded it (linear between frames), with
-        the viscosity that gives Stokes' law the fall of a grain over 0..t in the water as it changed
-        (its speed goes as (rho_p - rho_f) / mu: the mean of that ratio over the time, weighted exactly),
-        so that `stokes_diameter(depth, t)` is the grain that fell `depth` by then."""
+        """The suspension at time t: its water's density then, with the viscosity that gives Stokes' law
+        the fall of a grain over 0..t in the water as it changed (its speed goes as (rho_p - rho_f) / mu:
+        that ratio's mean over the time), so that `stokes_diameter(depth, t)` is the grain that fell
+        `depth` by then."""
         if self.water is None:
             return self.suspension
-        density, viscosity = self.water[:, 0], self.water[:, 1]
-        excess = self.suspension.particle_density - density
-        rate = excess / viscosity    # the grains' speed over D^2 g / 18, frame by frame
-        # its time integral, the trapezoid between frames (the water is linear between them)
-        fallen = np.concatenate([[0.0], np.cumsum(0.5 * (rate[1:] + rate[:-1]) * np.diff(self.time))])
-        here = float(np.interp(t, self.time, density))
-        since = float(np.interp(t, self.time, fallen)) + self.time[0] * rate[0]    # before the first frame too
-        mean_rate = since / t if t > 0 else float(rate[0])
+        here = self.fluid_density_at(t)
+        mean_rate = float(np.interp(t, self.time, self._fall_rate)) / t if t > 0 else \
+            (self.suspension.particle_density - self.water[0, 0]) / self.water[0, 1]
         return replace(self.suspension, fluid_density=here,
                        viscosity=(self.suspension.particle_density - here) / mean_rate, temperature=None)
 
@@ -181,7 +191,8 @@ class Column:
         mu = self.water[:, 1]
         return (f"the water changed over the test (viscosity {mu.min():.4g}-{mu.max():.4g} Pa s, density "
                 f"{self.water[:, 0].min():.6g}-{self.water[:, 0].max():.6g} kg/m3, as the run's frames record it): "
-                "each reading is reduced at the water of its time, as a laboratory reads its thermometer")
+                "each reading is reduced with the water its grains fell through (the mean of (rho_p - rho_f) / mu "
+                "over its time), and the 152H's less its blank in the water of its time")
 
     @property
     def height(self) -> float:
@@ -205,7 +216,7 @@ class Column:
 
     def density(self, t: float) -> np.ndarray:
         """Suspension density rho_f + (rho_p - rho_f) phi per layer [kg/m3]."""
-        return self.suspension_at(t).mixture_density(self.at(t))
+        return _core.mixture_density(self.fluid_density_at(t), self.suspension.particle_density, self.at(t))
 
     def mass_profile(self, t: float):
         """The integral of the suspension density from the surface to a depth [kg/m2] at time t, as a
@@ -217,7 +228,7 @@ class Column:
             depth = np.asarray(depth, float)
             inside = np.interp(depth, self.depth_edges, cumulative)
             return inside + np.maximum(depth - self.height, 0.0) * fluid_density
-        fluid_density = self.suspension_at(t).fluid_density
+        fluid_density = self.fluid_density_at(t)
         return above
 
     def weighted_mean(self, t: float, centre: float, radius: float, disc: bool = False) -> float:
