@@ -148,7 +148,7 @@ def _measure_contacts(test, args: argparse.Namespace, tolerance: float) -> None:
     from ..planner.contacts import ReducedScene, measure_contacts
     from ..planner.scenes import prepare
     from ..results import write_text
-    from ..sim.run import Runs, stop_all
+    from ..sim.run import Runs
 
     largest = test.psd.span()[1]
     cut = largest / 3 if args.contact_cut is None else args.contact_cut * 1e-6
@@ -177,7 +177,7 @@ def _measure_contacts(test, args: argparse.Namespace, tolerance: float) -> None:
             try:
                 measured = [run.result() for run in runs]
             except BaseException:    # Ctrl-C or a failed run: stop the other one too
-                stop_all(running)
+                running.stop()
                 raise
     finally:
         for bar in bars:

@@ -15,10 +15,10 @@ from ..lab.psd import NOT_FITTING
 from ..lab.readout import SCALES, Scale, Suspension, gs_correction
 from ..lab.sheet import Reduction, Sheet, SieveSheet, SheetError, check_sheet, standard_reduction
 from ..results import Table, write_text
+from ..sim.scene import COLUMN_DIAMETERS
 from .breakdown import Breakdown, breakdown, breakdown_band
 from .fit import ROUGHNESS_DECADES, draw_placement, end_placement, fit, penalty
 from .grid import NEAR, TOP, SizeGrid, size_grid
-from ..sim.scene import COLUMN_DIAMETERS
 from .model import LabTest, cut_diameters, effective_times, linearise, psd_of, run_forward, solids_signal, \
     whole_sample_reading
 

@@ -20,9 +20,9 @@ decide the cheapest setting within the tolerance, verify it with a run, and repo
 from __future__ import annotations
 
 import itertools
-import sys
 import json
 import math
+import sys
 from concurrent.futures import ThreadPoolExecutor, as_completed
 from dataclasses import dataclass, field, replace
 from pathlib import Path
@@ -32,7 +32,6 @@ import numpy as np
 from .. import figures
 from ..progress import bar as progress_bar
 from ..results import Table, write_text
-from ..sim.run import stop_all
 from .scenes import Knob, Outcome, prepare
 from .screening import INCLUDE, MEASURE, Screen
 
@@ -499,7 +498,7 @@ def _run_all(scene, trials: list[Trial], runs: Path, jobs: int, progress: bool, 
                 bar.update()
     except BaseException:             # Ctrl-C, SIGTERM or a failed trial: no run outlives the plan
         pool.shutdown(wait=False, cancel_futures=True)
-        stop_all(scene.running)
+        scene.running.stop()
         _trials_ended(futures)
         raise
     finally:

@@ -542,11 +542,17 @@ def _finish_record(deck: Path, record: dict, layers: Path | None) -> None:
     from ..folders import signals_held
 
     with signals_held():
-        for partial in deck.parent.glob(f".log.lammps.{os.getpid()}.partial"):    # a stop before the log's move
+        partial = _partial_log(deck.parent)
+        if partial.exists():    # a stop before the log's move
             os.replace(partial, deck.parent / "log.lammps")
         if layers is not None and _finished(layers, record["run_id"]):
             record["layers"] = {"file": layers.name, "sha256": file_digest(layers)}
         _write_record(deck.parent, **record, state="finished")
+
+
+def _partial_log(folder: Path) -> Path:
+    """The log of this process's run while LAMMPS writes it."""
+    return folder / f".log.lammps.{os.getpid()}.partial"
 
 
 def _run(deck: Path, ranks: int, variables: dict[str, str], progress: bool) -> RunResult:
@@ -555,7 +561,7 @@ def _run(deck: Path, ranks: int, variables: dict[str, str], progress: bool) -> R
     log, failed_log = folder / "log.lammps", folder / "log.failed.lammps"
     # The log is written under a temporary name: log.lammps is always a complete log of a run
     # that succeeded, log.failed.lammps that of the last one that did not.
-    partial_log = folder / f".log.lammps.{os.getpid()}.partial"
+    partial_log = _partial_log(folder)
     for stale in folder.glob(".log.lammps.*.partial"):    # of a sediment killed outright (the folder is locked)
         stale.unlink(missing_ok=True)
     cmd, env = _launch(deck.name, partial_log.name, ranks, variables)
@@ -681,7 +687,7 @@ def run_batch(deck: Path, variables: dict[str, object] | None = None, ranks: int
         Raise RuntimeError with LAMMPS's message if the run fails.
     running : Runs, optional
         Holds the run's process while it runs, for a caller running several at once to stop them
-        (`stop_all`); a run started after they were stopped is refused (RunInterrupted).
+        (`Runs.stop`); a run started after they were stopped is refused (RunInterrupted).
     on_line : callable, optional
         Called with each line LAMMPS prints as it prints it (a progress bar follows the thermo rows).
 
@@ -772,9 +778,6 @@ class Runs:
         with self._lock:
             self._procs.discard(proc)
 
-    def __len__(self) -> int:
-        return len(self._procs)
-
     def stop(self) -> None:
         """Stops every run under way and every one added from now on, with their ranks."""
         with self._lock:
@@ -782,11 +785,6 @@ class Runs:
             procs = list(self._procs)
         for proc in procs:
             _stop(proc, grace=2.0)
-
-
-def stop_all(running: Runs) -> None:
-    """Stops every run in `running` (see run_batch), those started after included, and their ranks."""
-    running.stop()
 
 
 def _is_float(word: str) -> bool:
