@@ -105,3 +105,22 @@ def test_truncated_and_foreign_files_give_clear_errors(tmp_path):
         read_layers(tmp_path / "notes.h5")
     with pytest.raises(LayerFileError, match="no such layer file"):
         read_layers(tmp_path / "missing.h5")
+
+
+def test_the_fluid_of_each_frame_is_read_and_checked(tmp_path):
+    """The per-frame fluid (a deck that re-issues the water): read as written; in a finished file a frame
+    without it is damage; in one a run left unfinished, a frame whose fluid was never written (HDF5's fill
+    value 0) is not one of the frames."""
+    def with_fluid(name: str, fluid, complete: int) -> Path:
+        path = tmp_path / name
+        write_layer_file(path)
+        with h5py.File(path, "r+") as f:
+            f["fluid"] = np.asarray(fluid, float)
+            f.attrs["complete"] = complete
+        return path
+    water = [[998.2, 1.002e-3], [997.0, 0.89e-3], [996.0, 0.80e-3]]
+    layers = read_layers(with_fluid("whole.h5", water, 1))
+    np.testing.assert_array_equal(layers.fluid, water)
+    with pytest.raises(LayerFileError, match="not a density and a viscosity > 0 per frame"):
+        read_layers(with_fluid("damaged.h5", water[:2] + [[0.0, 0.0]], 1))
+    assert len(read_layers(with_fluid("cut.h5", water[:2] + [[0.0, 0.0]], 0)).time) == 2
