@@ -97,6 +97,12 @@ double gaussian_self_mobility(double viscosity, double sigma)
   return 1.0 / (6.0 * pi * viscosity * sigma * std::sqrt(pi));
 }
 
+double hard_sphere_structure_factor(double phi)
+{
+  const double p2 = phi * phi;
+  return std::pow(1.0 - phi, 4) / (1.0 + 4.0 * phi + 4.0 * p2 - 4.0 * p2 * phi + p2 * p2);
+}
+
 double cloud_speed(double us, int n, double a, double r)
 {
   return us * (1.0 + 1.2 * n * a / r);

@@ -75,15 +75,17 @@ class FixFluidFlow : public Fix {
   std::vector<double> field[3];   // this rank's planes, complex (re, im), one per component
   std::vector<double> flow;       // global velocity on the grid, [k][j][i][c]
   double origin[3], spacing[3], length[3];
-  double self_mobility;
+  double self_flow[3];    // per axis: the flow a unit force gives back where it is spread (images too)
   // Diagnostics of the last solve (compute_vector)
   enum { FX, FY, FZ, FLUX, PEAK, OUTSIDE, NDIAG };
   double diag[NDIAG];
 
   void solve();
+  void transform_solve();
+  void measure_self_flow();
   void spread_point(const double *x, const double *force);
   void read_point(const double *x, double *u) const;
-  void sphere_force(int i, double *force) const;
+  double sphere_force(int i, double *force) const;
 };
 
 }    // namespace LAMMPS_NS

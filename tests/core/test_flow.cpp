@@ -262,3 +262,12 @@ TEST(Flow, CloudSpeed)
   EXPECT_DOUBLE_EQ(cloud_speed(2.0, 100, 0.1, 1.0), 2.0 * (1.0 + 12.0));
   EXPECT_NEAR(hasimoto_mobility_correction(1.0, 1.0) * 6 * pi, -2.837297, 1e-12);
 }
+
+// Carnahan & Starling's S(0) of hard spheres: 1 at phi = 0, 1 - 8 phi to first order (the volume of
+// radius 2a each sphere keeps clear), and the value at 5 %, 0.8145 / 1.2095 (computed by hand).
+TEST(Flow, HardSphereStructureFactor)
+{
+  EXPECT_DOUBLE_EQ(hard_sphere_structure_factor(0.0), 1.0);
+  EXPECT_NEAR((1.0 - hard_sphere_structure_factor(1e-6)) / 1e-6, 8.0, 1e-4);
+  EXPECT_NEAR(hard_sphere_structure_factor(0.05), 0.81450625 / 1.20950625, 1e-12);
+}

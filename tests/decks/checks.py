@@ -942,6 +942,68 @@ def flow_column_mirror(np_ranks: int):
     assert column[:, 6].mean() > periodic[:, 6].mean()
 
 
+def hard_sphere_suspension(n: int, phi: float, d: float, seed: int) -> tuple[np.ndarray, float]:
+    """n spheres of diameter d at solid fraction phi in a periodic cube, placed one by one at random
+    where they overlap none placed before (random sequential addition): positions and the side."""
+    side = (n * math.pi / 6 * d ** 3 / phi) ** (1 / 3)
+    cells = max(1, int(side // d))
+    width = side / cells
+    rng = np.random.default_rng(seed)
+    placed: list[np.ndarray] = []
+    bins: dict[tuple[int, int, int], list[int]] = {}
+    offsets = [(a, b, c) for a in (-1, 0, 1) for b in (-1, 0, 1) for c in (-1, 0, 1)]
+    while len(placed) < n:
+        point = rng.uniform(0.0, side, 3)
+        home = tuple(int(v) % cells for v in point // width)
+        near = [j for o in offsets for j in bins.get(tuple((h + k) % cells for h, k in zip(home, o)), [])]
+        if near:
+            gap = np.asarray([placed[j] for j in near]) - point
+            gap -= side * np.round(gap / side)
+            if np.einsum("ij,ij->i", gap, gap).min() < d * d:
+                continue
+        bins.setdefault(home, []).append(len(placed))
+        placed.append(point)
+    return np.asarray(placed), side
+
+
+@check
+def suspension_flow(np_ranks: int):
+    """A homogeneous suspension (hard spheres at random, 0.5-5 % solids) under Richardson & Zaki's
+    hindrance settles as fast with the flow it drives (fix fluid/flow) as without: the grid's flow
+    averages to nothing over a homogeneous suspension but for each sphere's own force and images and
+    the neighbours kept clear of it, which the closure takes out (docs/physics.md section 8), so the
+    suspension is not hindered twice. Without the closure (the unbounded self-flow subtracted, as
+    before it) the same suspensions settled 2.6, 3.4, 4.4 and 8.1 % too slowly. One configuration's mean speed
+    varies by about 1.5 % with the box-scale fluctuation of its density (the flow of a box-scale
+    density wave, which the grid resolves); the mean over 6 configurations is within 1 % of the
+    hindered speed without flow, and each within 5 %."""
+    d, n, seeds = 2e-5, 2000, range(1, 7)
+    hindered = _core.DragModel("stokes", 1000.0, 1e-3, hindrance="richardson-zaki")
+    weight = 1650.0 * G * math.pi / 6 * d ** 3
+    with tempfile.TemporaryDirectory() as tmp:
+        tmp = Path(tmp)
+        for phi in (0.005, 0.01, 0.02, 0.05):
+            expected = hindered.steady_speed(d, weight, 1 - phi)[0]
+            ratios = []
+            for seed in seeds:
+                positions, side = hard_sphere_suspension(n, phi, d, seed)
+                data = tmp / "suspension.data"
+                atoms = np.column_stack([np.arange(1, n + 1), np.ones(n), np.full(n, d), np.full(n, 2650.0), positions])
+                with open(data, "w") as f:
+                    f.write(f"suspension\n\n{n} atoms\n1 atom types\n\n0 {side} xlo xhi\n0 {side} ylo yhi\n"
+                            f"0 {side} zlo zhi\n\nAtoms # sphere\n\n")
+                    np.savetxt(f, atoms, fmt=["%d", "%d", "%.17g", "%.17g", "%.17g", "%.17g", "%.17g"])
+                out = run_deck("suspension_flow.lmp", {"data": data, "cells": 8}, np_ranks, cwd=tmp)
+                assert abs(out.results["phi"] - phi) < 1e-9
+                ratios.append(out.results["speed"] / expected)
+            mean = float(np.mean(ratios))
+            report(f"suspension phi={phi}: speed with flow / Richardson & Zaki's {mean:.4f} over {len(ratios)} "
+                   f"configurations (each {min(ratios):.4f} to {max(ratios):.4f}, standard error "
+                   f"{np.std(ratios, ddof=1) / math.sqrt(len(ratios)):.4f})")
+            assert abs(mean - 1) < 0.01
+            assert max(abs(r - 1) for r in ratios) < 0.05
+
+
 @check
 def flow_restart(np_ranks: int):
     """2N steps in one run vs N steps + write_restart + read_restart in a new process + N steps: the

@@ -57,6 +57,13 @@ struct FlowKernel {
 // give it, so this is subtracted from what it reads on the grid.
 double gaussian_self_mobility(double viscosity, double sigma);
 
+// The long-wave structure factor of a suspension of hard spheres at solid fraction phi, S(0) = 1 + n
+// int (g - 1) dV, from Carnahan & Starling's equation of state: (1 - phi)^4 / (1 + 4 phi + 4 phi^2
+// - 4 phi^3 + phi^4); 1 - 8 phi at low phi, the volume of radius 2a each sphere keeps clear. On a grid
+// whose kernel is wider than the spheres' correlations, a sphere reads its neighbours' flow as if they
+// were spread with S(0) times their number minus itself: the closure of docs/physics.md section 8.
+double hard_sphere_structure_factor(double phi);
+
 // Nitsche & Batchelor (1997): a cloud of n spheres of radius a, terminal speed us alone, within a
 // sphere of radius r settles for n a / r >> 1 as a drop of the same viscosity, u = us (1 + 6/5 n a / r).
 double cloud_speed(double us, int n, double a, double r);
