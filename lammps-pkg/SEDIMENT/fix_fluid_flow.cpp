@@ -80,8 +80,11 @@ FixFluidFlow::FixFluidFlow(LAMMPS *lmp, int narg, char **arg) :
       args.need(1, "a value");
       relax = args.number(1);
       if (!(relax > 0.0 && relax <= 1.0)) args.fail("relax must be in (0, 1], not {}", relax);
+    } else if (args.is("every")) {
+      args.need(1, "a step count");
+      nevery = args.count(1, 1000000);
     } else {
-      args.unknown("grid, column, brinkman, width or relax");
+      args.unknown("grid, column, brinkman, width, relax or every");
     }
     args.next(nvalues);
   }
@@ -233,25 +236,38 @@ double FixFluidFlow::sphere_force(int i, double *force) const
   return 0.0;
 }
 
+// The kernel's nodes around x on each axis, wrapped onto the periodic transform grid, as offsets into
+// the grid's arrays ([k][j][i][c]: 3 doubles per node), and their weights; returns the counts.
+void FixFluidFlow::kernel_nodes(const double *x, int count[3], long node[3][sediment::FlowKernel::max_nodes],
+                                double w[3][sediment::FlowKernel::max_nodes]) const
+{
+  const int n[3] = {grid[0], grid[1], nzt};
+  const long stride[3] = {3, 3L * n[0], 3L * n[0] * n[1]};
+  for (int d = 0; d < 3; ++d) {
+    int first;
+    count[d] = kernel.weights((x[d] - origin[d]) / spacing[d] - 0.5, first, w[d]);
+    for (int m = 0; m < count[d]; ++m) node[d][m] = stride[d] * wrap(first + m, n[d]);
+  }
+}
+
 void FixFluidFlow::spread_point(const double *x, const double *force)
 {
-  int first[3], count[3];
+  int count[3];
+  long node[3][sediment::FlowKernel::max_nodes];
   double w[3][sediment::FlowKernel::max_nodes];
-  for (int d = 0; d < 3; ++d) count[d] = kernel.weights((x[d] - origin[d]) / spacing[d] - 0.5, first[d], w[d]);
+  kernel_nodes(x, count, node, w);
   const double per_volume = 1.0 / (spacing[0] * spacing[1] * spacing[2]);
-  const int n[3] = {grid[0], grid[1], nzt};
+  const double fx = force[0] * per_volume, fy = force[1] * per_volume, fz = force[2] * per_volume;
   for (int c = 0; c < count[2]; ++c) {
-    const int k = wrap(first[2] + c, n[2]);
     for (int b = 0; b < count[1]; ++b) {
-      const int j = wrap(first[1] + b, n[1]);
-      const double wzy = w[2][c] * w[1][b] * per_volume;
+      double *row = &spread[node[2][c] + node[1][b]];
+      const double wzy = w[2][c] * w[1][b];
       for (int a = 0; a < count[0]; ++a) {
-        const int i = wrap(first[0] + a, n[0]);
-        double *node = &spread[3 * ((static_cast<long>(k) * n[1] + j) * n[0] + i)];
+        double *at = row + node[0][a];
         const double weight = wzy * w[0][a];
-        node[0] += weight * force[0];
-        node[1] += weight * force[1];
-        node[2] += weight * force[2];
+        at[0] += weight * fx;
+        at[1] += weight * fy;
+        at[2] += weight * fz;
       }
     }
   }
@@ -259,26 +275,27 @@ void FixFluidFlow::spread_point(const double *x, const double *force)
 
 void FixFluidFlow::read_point(const double *x, double *u) const
 {
-  int first[3], count[3];
+  int count[3];
+  long node[3][sediment::FlowKernel::max_nodes];
   double w[3][sediment::FlowKernel::max_nodes];
-  for (int d = 0; d < 3; ++d) count[d] = kernel.weights((x[d] - origin[d]) / spacing[d] - 0.5, first[d], w[d]);
-  const int n[3] = {grid[0], grid[1], nzt};
-  u[0] = u[1] = u[2] = 0.0;
+  kernel_nodes(x, count, node, w);
+  double ux = 0.0, uy = 0.0, uz = 0.0;
   for (int c = 0; c < count[2]; ++c) {
-    const int k = wrap(first[2] + c, n[2]);
     for (int b = 0; b < count[1]; ++b) {
-      const int j = wrap(first[1] + b, n[1]);
+      const double *row = &flow[node[2][c] + node[1][b]];
       const double wzy = w[2][c] * w[1][b];
       for (int a = 0; a < count[0]; ++a) {
-        const int i = wrap(first[0] + a, n[0]);
-        const double *node = &flow[3 * ((static_cast<long>(k) * n[1] + j) * n[0] + i)];
+        const double *at = row + node[0][a];
         const double weight = wzy * w[0][a];
-        u[0] += weight * node[0];
-        u[1] += weight * node[1];
-        u[2] += weight * node[2];
+        ux += weight * at[0];
+        uy += weight * at[1];
+        uz += weight * at[2];
       }
     }
   }
+  u[0] = ux;
+  u[1] = uy;
+  u[2] = uz;
 }
 
 // What a unit force gives back on the grid at the point where it is spread, per axis: the kernel's

@@ -83,6 +83,8 @@ class FixFluidFlow : public Fix {
   void solve();
   void transform_solve();
   void measure_self_flow();
+  void kernel_nodes(const double *x, int count[3], long node[3][sediment::FlowKernel::max_nodes],
+                    double w[3][sediment::FlowKernel::max_nodes]) const;
   void spread_point(const double *x, const double *force);
   void read_point(const double *x, double *u) const;
   double sphere_force(int i, double *force) const;

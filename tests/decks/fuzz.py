@@ -86,6 +86,11 @@ STYLES = [
           (("water", "name"), ("inner", "kw"), ("0.01", "pos"), ("outer", "kw"), ("0.5", "pos"), ("repulsion", "kw"),
            ("1.0", "pos"), ("limit", "kw"), ("no", "word")),
           frozenset({1, 3, 5, 7, 9}), "pair_coeff * *\n" + STEP + RUN),
+    Style("fluid/flow", WATER, "fix u all fluid/flow",
+          (("water", "name"), ("grid", "kw"), ("8", "count"), ("8", "count"), ("40", "count"), ("column", "kw"),
+           ("-0.05", "real"), ("0.05", "real"), ("brinkman", "kw"), ("0", "nonneg"), ("width", "kw"), ("1", "pos"),
+           ("relax", "kw"), ("1", "pos"), ("every", "kw"), ("2", "count")),
+          frozenset({8, 10, 12, 14, 16}), "fix d all fluid/drag water law stokes\n" + STEP + RUN),
     Style("layers/hdf5", WATER + GRID, "fix layers all layers/hdf5",
           (("1", "count"), ("fuzz.h5", "file"), ("c_conc", "name"), ("fluid", "kw"), ("water", "name"),
            ("particle_density", "kw"), ("2650", "pos")),
@@ -117,6 +122,7 @@ CASES_2D = [
     ("concentration/grid", "three cell counts in 2d", "compute conc all concentration/grid cells 2 2 4\n"),
     ("concentration/grid", "layers along z in 2d", "compute conc all concentration/grid layers z 4\n" + RUN),
     ("concentration/grid", "six bounds in 2d", "compute conc all concentration/grid cells 2 2 bounds 0 1 0 1 0 1\n"),
+    ("fluid/flow", "a flow in 2d", "fix u all fluid/flow f grid 8 8 8\n"),
 ]
 
 
