@@ -42,7 +42,8 @@ static inline int wrap(int i, int n)
 
 FixFluidFlow::FixFluidFlow(LAMMPS *lmp, int narg, char **arg) :
     Fix(lmp, narg, arg), fluid_id(nullptr), fluid(nullptr), nzt(0), column(false), column_lo(0.0), column_hi(0.0),
-    relax(1.0), velocity(nullptr), solved(false), fft(nullptr), plane_lo(0), plane_hi(-1)
+    relax(1.0), velocity(nullptr), solved(false), fft(nullptr), plane_lo(0), plane_hi(-1), reversals(0),
+    reversal_growth(1.0)
 {
   if (narg < 8 || strcmp(arg[4], "grid") != 0)
     error->all(FLERR, "Fix fluid/flow: expected 'fix ID group fluid/flow FLUID-ID grid NX NY NZ keyword value ...'");
@@ -401,6 +402,7 @@ void FixFluidFlow::solve()
   // its own force and its periodic images give it, S(0) times over in a suspension (the neighbours
   // kept clear of it: what the hindrance law already holds; docs/physics.md section 8).
   const double *uniform = fluid->velocity();
+  double change[3] = {0.0, 0.0, 0.0};    // sums over the spheres: new . old, new . new, old . old
   for (int i = 0; i < nlocal; ++i) {
     if (!(mask[i] & groupbit)) continue;
     double u[3] = {0.0, 0.0, 0.0};
@@ -411,10 +413,37 @@ void FixFluidFlow::solve()
     }
     for (int c = 0; c < 3; ++c) {
       const double target = uniform[c] + u[c];
+      const double old = velocity[i][c] - uniform[c];
       velocity[i][c] = relax < 1.0 ? velocity[i][c] + relax * (target - velocity[i][c]) : target;
+      const double now = velocity[i][c] - uniform[c];
+      change[0] += now * old;
+      change[1] += now * now;
+      change[2] += old * old;
     }
   }
+  if (solved) check_stable(change);
   solved = true;
+}
+
+// The lagged solve's instability (doc page, Stability): the spheres' fluid velocities reverse from
+// solve to solve and grow. A flow the spheres drive does not keep reversing; once a run of reversals
+// has grown the velocities a hundredfold, the run stops before its results go wrong.
+void FixFluidFlow::check_stable(const double *local)
+{
+  double change[3];
+  MPI_Allreduce(local, change, 3, MPI_DOUBLE, MPI_SUM, world);
+  if (change[0] < 0.0 && change[1] > change[2]) {
+    ++reversals;
+    reversal_growth *= change[1] / change[2];    // of the squared speeds
+  } else {
+    reversals = 0;
+    reversal_growth = 1.0;
+  }
+  if (reversals >= 4 && reversal_growth > 1e4)
+    error->all(FLERR, "Fix fluid/flow: the fluid velocity reversed at each of the last {} solves and grew {:.3g} "
+               "times (step {}): the lagged flow is unstable at this time step; use relax W with W < 1/(1+K), K "
+               "the collective mobility over the single sphere's (about 6/5 N a/R for a cloud), a longer step, or "
+               "every N (see the doc page)", reversals, std::sqrt(reversal_growth), update->ntimestep);
 }
 
 double FixFluidFlow::compute_vector(int n)

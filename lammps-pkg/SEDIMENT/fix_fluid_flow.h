@@ -80,7 +80,10 @@ class FixFluidFlow : public Fix {
   enum { FX, FY, FZ, FLUX, PEAK, OUTSIDE, NDIAG };
   double diag[NDIAG];
 
+  int reversals;             // solves in a row whose fluid velocities reversed and grew (check_stable)
+  double reversal_growth;    // and how much the squared velocities grew over them
   void solve();
+  void check_stable(const double *change);
   void transform_solve();
   void measure_self_flow();
   void kernel_nodes(const double *x, int count[3], long node[3][sediment::FlowKernel::max_nodes],

@@ -942,6 +942,43 @@ def flow_column_mirror(np_ranks: int):
     assert column[:, 6].mean() > periodic[:, 6].mean()
 
 
+@check
+def flow_unstable_lag(np_ranks: int):
+    """A step far below the spheres' relaxation time with a strongly collective cloud (N a / R = 10,
+    K about 12) makes the lagged flow reverse and grow from solve to solve: the run stops with an
+    error naming relax (not a result gone wrong, nor atoms lost). relax below 1 / (1 + K) runs it."""
+    deck = """units si
+atom_style sphere
+atom_modify map array
+boundary p p p
+region box block 0 0.048 0 0.048 0 0.048
+create_box 1 box
+region cloud sphere 0.024 0.024 0.024 0.006
+create_atoms 1 random 1000 4321 cloud
+set group all diameter 1.2e-4 density 1100
+comm_modify cutoff 0.006
+fix grav all gravity 9.81 vector 0 0 -1
+fix water all fluid density 1000 viscosity 1e-3
+fix buoy all fluid/buoyancy water
+fix drag all fluid/drag water law stokes
+fix flow all fluid/flow water grid 32 32 32 relax ${relax}
+fix step all nve/sphere/fluid
+timestep 8e-5
+thermo 10
+run 200
+print "RESULT peak $(f_flow[5])"
+"""
+    with tempfile.TemporaryDirectory() as tmp:
+        path = Path(tmp) / "lag.lmp"
+        path.write_text(deck)
+        out = run_deck(path, {"relax": 1}, np_ranks, expect_failure=True, cwd=Path(tmp))
+        assert "the lagged flow is unstable at this time step; use relax" in out.text, out.error
+        stable = run_deck(path, {"relax": 0.05}, np_ranks, cwd=Path(tmp))
+        report(f"lagged flow at dt = tau / 10, K about 12: relax 1 stopped ({out.error.strip()[:90]}...); "
+               f"relax 0.05 ran, largest fluid velocity {stable.results['peak']:.3g} m/s")
+        assert 0 < stable.results["peak"] < 0.1
+
+
 def hard_sphere_suspension(n: int, phi: float, d: float, seed: int) -> tuple[np.ndarray, float]:
     """n spheres of diameter d at solid fraction phi in a periodic cube, placed one by one at random
     where they overlap none placed before (random sequential addition): positions and the side."""
