@@ -32,7 +32,7 @@ void StokesOperator::apply(const double k[3], const double *f, double *u, double
     for (int c = 0; c < 6; ++c) u[c] = 0.0;
     return;
   }
-  const double per = scale / (viscosity * k2 + brinkman);
+  const double per = scale * (smoothing > 0.0 ? std::exp(-k2 * smoothing) : 1.0) / (viscosity * k2 + brinkman);
   // the longitudinal part k (k . f) / k^2, real and imaginary parts apart
   const double kf_re = (k[0] * f[0] + k[1] * f[2] + k[2] * f[4]) / k2;
   const double kf_im = (k[0] * f[1] + k[1] * f[3] + k[2] * f[5]) / k2;
@@ -71,30 +71,14 @@ void stokes_apply_brick(const StokesOperator &op, const int n[3], const double l
 
 int FlowKernel::weights(double position, int &first, double *w) const
 {
-  const double reach = cutoff * width;
-  first = static_cast<int>(std::ceil(position - reach));
-  const int last = static_cast<int>(std::floor(position + reach));
-  const int count = std::min(last - first + 1, max_nodes);
-  const double per = 1.0 / (2.0 * width * width);
-  // exp(-r^2 per) at r = r0, r0 + 1, ...: each weight the last times a ratio that itself shrinks by
-  // exp(-2 per) from node to node, three exponentials instead of one per node (the spreading's cost)
-  const double r0 = first - position;
-  const double shrink = std::exp(-2.0 * per);
-  double weight = std::exp(-r0 * r0 * per), ratio = std::exp(-(2.0 * r0 + 1.0) * per), sum = 0.0;
-  for (int m = 0; m < count; ++m) {
-    w[m] = weight;
-    sum += weight;
-    weight *= ratio;
-    ratio *= shrink;
-  }
-  const double norm = 1.0 / sum;
-  for (int m = 0; m < count; ++m) w[m] *= norm;
-  return count;
-}
-
-int FlowKernel::max_count() const
-{
-  return std::min(static_cast<int>(std::floor(2.0 * cutoff * width)) + 1, max_nodes);
+  const double below = std::floor(position);
+  const double t = position - below, u = 1.0 - t;
+  first = static_cast<int>(below) - 1;
+  w[0] = u * u * u / 6.0;
+  w[1] = (3.0 * t * t * t - 6.0 * t * t + 4.0) / 6.0;
+  w[2] = (3.0 * u * u * u - 6.0 * u * u + 4.0) / 6.0;
+  w[3] = t * t * t / 6.0;
+  return max_nodes;
 }
 
 double gaussian_self_mobility(double viscosity, double sigma)

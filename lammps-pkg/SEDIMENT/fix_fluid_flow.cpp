@@ -75,8 +75,8 @@ FixFluidFlow::FixFluidFlow(LAMMPS *lmp, int narg, char **arg) :
       args.need(1, "a value");
       kernel.width = args.number(1);
       if (!(kernel.width >= 1.0 && kernel.width <= 2.0))
-        args.fail("width {} must be from 1 to 2 grid cells (the kernel's Gaussian is resolved from 1 on)",
-                  kernel.width);
+        args.fail("width {} must be from 1 to 2 grid cells (from 1 on, a Gaussian in Fourier space makes up what "
+                  "the grid's B-spline lacks)", kernel.width);
     } else if (args.is("relax")) {
       args.need(1, "a value");
       relax = args.number(1);
@@ -98,8 +98,8 @@ FixFluidFlow::FixFluidFlow(LAMMPS *lmp, int narg, char **arg) :
     error->all(FLERR, "Fix fluid/flow requires atom attributes radius and rmass (atom_style sphere)");
   for (int d = 0; d < 3; ++d)
     if (grid[d] < kernel.max_count())
-      error->all(FLERR, "Fix fluid/flow: grid size {} in {} is smaller than the kernel's {} nodes (width {})", grid[d],
-                 "xyz"[d], kernel.max_count(), kernel.width);
+      error->all(FLERR, "Fix fluid/flow: grid size {} in {} is smaller than the kernel's {} nodes", grid[d], "xyz"[d],
+                 kernel.max_count());
   nzt = column ? 2 * grid[2] : grid[2];
 
   restart_global = 1;
@@ -156,6 +156,7 @@ void FixFluidFlow::init()
     if (std::abs(spacing[d] - spacing[0]) > 1e-6 * spacing[0])
       error->all(FLERR, "Fix fluid/flow: the grid's cells must be cubes, not {} x {} x {} (grid counts in proportion "
                  "to the box{})", spacing[0], spacing[1], spacing[2], column ? " and the column" : "");
+  stokes.smoothing = kernel.fourier_variance() * spacing[0] * spacing[0];
 
   if (!fft) {
     const int nprocs = comm->nprocs, me = comm->me;

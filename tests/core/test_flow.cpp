@@ -176,37 +176,43 @@ TEST(Flow, SinusoidalForceDensityOnTheGrid)
   EXPECT_LT(worst, 1e-9 * A / (mu * kz * kz));
 }
 
+// The cubic B-spline on the grid: 4 nodes around the point, weights that sum to 1, centred on the
+// point (a linear field is read back exactly) with the variance 1/3 of a cell squared.
 TEST(Flow, KernelWeights)
 {
-  for (double width : {1.0, 1.5, 2.0}) {
-    const FlowKernel kernel{width, 3.5};
-    for (double p : {0.0, 0.25, 0.5, 3.999, -2.3, 17.71}) {
-      int first;
-      double w[FlowKernel::max_nodes];
-      const int count = kernel.weights(p, first, w);
-      EXPECT_LE(count, kernel.max_count());
-      double sum = 0.0, moment = 0.0;
-      for (int m = 0; m < count; ++m) {
-        sum += w[m];
-        moment += w[m] * (first + m);
-        EXPECT_LE(std::abs(first + m - p), 3.5 * width);
-      }
-      EXPECT_NEAR(sum, 1.0, 1e-15);
-      // the centre of the weights is the point (to the truncation's asymmetry, e^-6 of the weight)
-      EXPECT_NEAR(moment, p, 2e-2 * width) << width << " " << p;
+  const FlowKernel kernel{1.0};
+  for (double p : {0.0, 0.25, 0.5, 3.999, -2.3, 17.71}) {
+    int first;
+    double w[FlowKernel::max_nodes];
+    const int count = kernel.weights(p, first, w);
+    EXPECT_EQ(count, 4);
+    double sum = 0.0, moment = 0.0, variance = 0.0;
+    for (int m = 0; m < count; ++m) {
+      EXPECT_GE(w[m], 0.0);
+      EXPECT_LE(std::abs(first + m - p), 2.0);
+      sum += w[m];
+      moment += w[m] * (first + m);
+      variance += w[m] * (first + m - p) * (first + m - p);
     }
+    EXPECT_NEAR(sum, 1.0, 1e-15);
+    EXPECT_NEAR(moment, p, 1e-13) << p;
+    EXPECT_NEAR(variance, 1.0 / 3.0, 1e-13) << p;
   }
+  EXPECT_DOUBLE_EQ(FlowKernel{1.5}.fourier_variance(), 2.25 - 1.0 / 3.0);
 }
 
-// One point force in a periodic cube: what it reads back is the Gaussian blob's unbounded self-mobility
-// plus Hasimoto's correction for the images and the return flow, wherever the point lies between nodes:
+// One point force in a periodic cube: what it reads back is the kernel's unbounded self-mobility plus
+// Hasimoto's correction for the images and the return flow, wherever the point lies between nodes:
 // a sphere of radius a_h = sigma sqrt(pi) in a cubic array of volume fraction phi moves at
 // (1 - 1.7601 phi^1/3 + phi) / (6 pi mu a_h), the first two terms those of hasimoto_mobility_correction.
+// sigma sqrt(pi) is a Gaussian blob's radius; the kernel, a B-spline on the grid and a Gaussian in
+// Fourier space, is close to one of the same variance: 0.997-1.000 of it over the points tried (the
+// fix measures its own self-flow, so nothing hangs on this).
 TEST(Flow, SelfMobilityInAPeriodicBox)
 {
   const int n[3] = {16, 16, 16};
   const double length[3] = {1.0, 1.0, 1.0}, mu = 1e-3;
-  const Grid grid{{16, 16, 16}, {1.0, 1.0, 1.0}, FlowKernel{1.0, 3.5}};
+  const Grid grid{{16, 16, 16}, {1.0, 1.0, 1.0}, FlowKernel{1.0}};
   const double sigma = grid.h(0);
   const double a_h = sigma * std::sqrt(pi), phi = 4.0 * pi / 3.0 * a_h * a_h * a_h;
   EXPECT_NEAR(gaussian_self_mobility(mu, sigma) * 1.7601 * std::cbrt(phi), -hasimoto_mobility_correction(mu, 1.0),
@@ -222,10 +228,10 @@ TEST(Flow, SelfMobilityInAPeriodicBox)
       double force[3] = {0.0, 0.0, 0.0};
       force[axis] = 1.0;
       grid.spread(x, force, f);
-      solve(StokesOperator{mu, 0.0}, n, length, f);
+      solve(StokesOperator{mu, 0.0, grid.kernel.fourier_variance() * sigma * sigma}, n, length, f);
       double u[3];
       grid.read(x, f, u);
-      EXPECT_NEAR(u[axis] / expected, 1.0, 0.003) << "trial " << trial << " axis " << axis;
+      EXPECT_NEAR(u[axis] / expected, 1.0, 0.004) << "trial " << trial << " axis " << axis;
       EXPECT_LT(std::abs(u[2 - axis]) / expected, 0.01);
     }
   }
@@ -236,7 +242,7 @@ TEST(Flow, NoNetFluxThroughAnyPlane)
 {
   const int n[3] = {8, 8, 12};
   const double length[3] = {1.0, 1.0, 1.5};
-  const Grid grid{{8, 8, 12}, {1.0, 1.0, 1.5}, FlowKernel{1.0, 3.5}};
+  const Grid grid{{8, 8, 12}, {1.0, 1.0, 1.5}, FlowKernel{1.0}};
   std::vector<cplx> f[3];
   for (auto &field : f) field.assign(n[0] * n[1] * n[2], 0.0);
   std::mt19937 rng(11);

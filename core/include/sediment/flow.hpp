@@ -20,9 +20,13 @@ double grid_wavenumber(int m, int n, double length);
 // space u(k) = (I - k k / k^2) f(k) / (mu k^2 + brinkman): the pressure takes the longitudinal part
 // of the force. The k = 0 mode is set to zero: the mean force is held by the mean pressure gradient
 // of a closed column (or the periodic box's frame), so the net volume flux is zero (the return flow).
+// With `smoothing` s^2 > 0 every mode is also multiplied by exp(-k^2 s^2): a Gaussian of variance
+// s^2 / 2 applied to the force as it is spread and again to the velocity as it is read (the part of
+// the kernel's width the grid does not take, FlowKernel).
 struct StokesOperator {
   double viscosity = 1.0;
-  double brinkman = 0.0;    // 0: Stokes; > 0: the resistance per unit volume of a Brinkman medium
+  double brinkman = 0.0;     // 0: Stokes; > 0: the resistance per unit volume of a Brinkman medium
+  double smoothing = 0.0;    // s^2 [length^2]
   // u(k) from f(k), one mode, complex values as (re, im) pairs: f[2 c] + i f[2 c + 1], c = 0, 1, 2.
   // `scale` multiplies the result (1 / N for an unscaled inverse transform). u may be f.
   void apply(const double k[3], const double *f, double *u, double scale = 1.0) const;
@@ -35,19 +39,21 @@ struct StokesOperator {
 void stokes_apply_brick(const StokesOperator &op, const int n[3], const double length[3], const int lo[3],
                         const int hi[3], double *fx, double *fy, double *fz, double scale);
 
-// The spreading and interpolation kernel: a Gaussian of standard deviation `width` grid spacings,
-// cut at `cutoff` widths and normalised so that its weights sum to 1 on every axis (the spread force
-// is the sphere's force exactly: momentum is conserved to round-off). Nodes sit at integer positions
-// (a cell-centred grid: node k at lo + (k + 1/2) h has position k).
+// The spreading and interpolation kernel, split as PPPM splits its own: on the grid the cubic B-spline
+// (4 nodes per axis, variance 1/3 of a cell squared; its weights sum to 1 and centre on the point, so
+// the spread force is the sphere's force exactly and momentum is conserved to round-off), the rest of
+// a Gaussian of standard deviation `width` cells in Fourier space (StokesOperator::smoothing), where it
+// costs nothing per sphere and damps the B-spline's aliasing. Nodes sit at integer positions (a
+// cell-centred grid: node k at lo + (k + 1/2) h has position k).
 struct FlowKernel {
-  static constexpr int max_nodes = 16;    // per axis
-  double width = 1.0;
-  double cutoff = 3.5;
-  // Nodes first, ..., first + count - 1 (unwrapped: the caller wraps them onto a periodic axis) and
-  // their weights for a point at `position` (in grid spacings); returns count.
+  static constexpr int max_nodes = 4;    // per axis
+  double width = 1.0;                    // the whole kernel's standard deviation, in cells (>= 1)
+  // Nodes first, ..., first + 3 (unwrapped: the caller wraps them onto a periodic axis) and their
+  // weights for a point at `position` (in grid spacings); returns their count, 4.
   int weights(double position, int &first, double *w) const;
-  // The largest count weights() returns for this width and cutoff.
-  int max_count() const;
+  int max_count() const { return max_nodes; }
+  // The variance left to the Fourier-space Gaussian, in cells squared: width^2 - 1/3.
+  double fourier_variance() const { return width * width - 1.0 / 3.0; }
 };
 
 // The velocity a sphere's own spread force gives it back in unbounded fluid, per unit force: a
