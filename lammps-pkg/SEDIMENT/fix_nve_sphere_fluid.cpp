@@ -6,6 +6,7 @@
 
 #include "fix_nve_sphere_fluid.h"
 #include "sediment_args.h"
+#include "sediment_nve_sphere.h"
 #include "sediment_rows.h"
 
 #include "fix_fluid.h"
@@ -36,32 +37,6 @@ using namespace FixConst;
 using sediment::HalfKick;
 using sediment::state_sum;
 
-// The rotational half of fix nve/sphere's kick (below), which is also the rotation of a sphere in a
-// fluid without a rotational drag. Returns the torque's weight, dtf / I.
-static inline double nve_sphere_spin(double *omega, const double *torque, double radius, double rmass, HalfKick kick)
-{
-  const double dtirotate = sediment::spin_weight(kick, radius, rmass);
-  omega[0] += dtirotate * torque[0];
-  omega[1] += dtirotate * torque[1];
-  omega[2] += dtirotate * torque[2];
-  return dtirotate;
-}
-
-// The kick of fix nve/sphere, written as it does, so that a scene without fluid is bitwise the
-// same as with fix nve/sphere. Returns the new velocity: read back from v, it would wait for the
-// stores just made.
-static inline std::array<double, 3> nve_sphere_kick(double *v, double *omega, const double *f, const double *torque,
-                                                    double radius, double rmass, HalfKick kick)
-{
-  const double dtfm = kick.dtf / rmass;
-  const std::array<double, 3> kicked = {v[0] + dtfm * f[0], v[1] + dtfm * f[1], v[2] + dtfm * f[2]};
-  v[0] = kicked[0];
-  v[1] = kicked[1];
-  v[2] = kicked[2];
-  nve_sphere_spin(omega, torque, radius, rmass, kick);
-  return kicked;
-}
-
 // The per-atom arrays both halves of the step read, taken anew in each half (exchanges move them).
 // Rows of 3 (sediment_rows.h): found from the atom's index, not a row pointer.
 using Rows3 = double (*)[3];
@@ -78,20 +53,6 @@ static inline SphereArrays sphere_arrays(const Atom *atom)
   return {flat_rows<3>(atom->x),     flat_rows<3>(atom->v),      flat_rows<3>(atom->f),
           flat_rows<3>(atom->omega), flat_rows<3>(atom->torque), atom->radius,
           atom->rmass,               atom->mask,                 atom->nlocal};
-}
-
-// The first half of fix nve/sphere's step: kick, then drift over the whole step. Returns the sum of
-// the new position's components, for the check of a finite state: the position is x + dt v, so a
-// non-finite velocity makes it non-finite too, and summing the velocity as well would add nothing.
-static inline double nve_sphere_kick_drift(double *x, double *v, double *omega, const double *f,
-                                           const double *torque, double radius, double rmass, HalfKick kick, double dt)
-{
-  const std::array<double, 3> kicked = nve_sphere_kick(v, omega, f, torque, radius, rmass, kick);
-  const double new_x[3] = {x[0] + dt * kicked[0], x[1] + dt * kicked[1], x[2] + dt * kicked[2]};
-  x[0] = new_x[0];
-  x[1] = new_x[1];
-  x[2] = new_x[2];
-  return new_x[0] + new_x[1] + new_x[2];
 }
 
 // The exponentials of a linear drag F = c d w for a sphere of diameter d and 1 / m, z = c d dt / m
@@ -197,14 +158,16 @@ void FixNVESphereFluid::setup(int /*vflag*/)
     half_step = floor_axis < 0 ? HalfStep::Linear : HalfStep::LinearOnFloor;
   else
     half_step = HalfStep::General;
-  bool nonlinear = false, set_valued = false, atom_flow = false;
+  bool nonlinear = false, set_valued = false;
+  atom_flow = false;
   for (FixFluidDrag *drag : drags) {
     nonlinear |= drag->nonlinear();
     set_valued |= !drag->drag_model()->smooth();
     atom_flow |= drag->fluid_fix()->has_atom_flow();
   }
-  // A block steps its spheres in one flow: with a fix fluid/flow each sphere has its own (General).
-  if (nonlinear && !atom_flow) half_step = set_valued ? HalfStep::Blocked : HalfStep::Smooth;
+  // A block steps its spheres in one flow; with a fix fluid/flow each sphere has its own, and joins
+  // the block in its fluid's frame (the drag sees only the slip: first_half).
+  if (nonlinear) half_step = set_valued ? HalfStep::Blocked : HalfStep::Smooth;
   // Which vector copy of the block step runs here (benchmarks/cost.py records it with its figures).
   if (comm->me == 0 && nonlinear && !reported_vectors)
     utils::logmesg(lmp, "fix nve/sphere/fluid: nonlinear drag stepped in blocks, {} vectors\n",
@@ -345,6 +308,7 @@ void FixNVESphereFluid::first_half(Lookup lookup)
     int i;
     double spin_rate;
     double per_mass;
+    const double *flow;    // a fix fluid/flow's velocity at the sphere, stepped in its frame; nullptr: none
   };
   constexpr bool blocks = path == HalfStep::Smooth || path == HalfStep::Blocked;
   sediment::DragBlock block;
@@ -360,6 +324,11 @@ void FixNVESphereFluid::first_half(Lookup lookup)
         double dx[3];
         block.velocity(n, v[b.i]);
         block.displacement(n, dx);
+        if (b.flow)    // back from the fluid's frame
+          for (int c = 0; c < 3; ++c) {
+            v[b.i][c] += b.flow[c];
+            dx[c] += b.flow[c] * dt;
+          }
         sediment::StepCorrection corr = block.correction(n);
         if constexpr (!decltype(in_pieces)::value) corr.state = sediment::SlipState::Free;
         state += finish(b.i, corr, dx, b.spin_rate, b.per_mass);
@@ -412,15 +381,24 @@ void FixNVESphereFluid::first_half(Lookup lookup)
       continue;
     }
     if constexpr (blocks) {
+      // With a fix fluid/flow each sphere steps in the frame of its own fluid velocity (held over the
+      // step), where the block's flow is zero: the drag depends on the slip alone.
+      double slip[3];
+      const double *block_v = v[i], *block_flow = flow;
+      if (atom_flow) {
+        for (int c = 0; c < 3; ++c) slip[c] = v[i][c] - flow[c];
+        block_v = slip;
+        block_flow = no_flow;
+      }
       if (path == HalfStep::Smooth ? sediment::step_kind(sphere) == sediment::StepKind::Smooth
-                                   : sediment::steps_in_block(sphere, v[i], flow)) {
+                                   : sediment::steps_in_block(sphere, block_v, block_flow)) {
         if (sphere.model != block.law()) {    // a block per law, and so per fluid/drag fix and flow
           if (block.size() > 0) state += step_block();
-          block.set_law(*sphere.model, flow);
+          block.set_law(*sphere.model, block_flow);
         }
-        const int n = path == HalfStep::Smooth ? block.add_smooth(sphere, per_mass, a, v[i])
-                                                : block.add(sphere, per_mass, a, v[i]);
-        waiting[n] = {i, spin_rate, per_mass};
+        const int n = path == HalfStep::Smooth ? block.add_smooth(sphere, per_mass, a, block_v)
+                                                : block.add(sphere, per_mass, a, block_v);
+        waiting[n] = {i, spin_rate, per_mass, atom_flow ? flow : nullptr};
         if (block.full()) state += step_block();
         continue;
       }

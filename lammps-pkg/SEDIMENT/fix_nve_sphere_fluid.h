@@ -85,6 +85,7 @@ class FixNVESphereFluid : public Fix {
   // two divisions, instead of from the weights row, which is neither written nor read).
   enum class HalfStep { General, Blocked, Smooth, LinearOnFloor, Linear };
   HalfStep half_step;
+  bool atom_flow = false;    // some drag's fluid has a per-atom velocity (fix fluid/flow): setup()
   bool reported_vectors = false;    // the log names the vector copy of the block step once
   double linear_per_diameter;    // c of the Linear step
   // The first half of the step for every atom of the group, with the drag found by lookup(i, sphere,
