@@ -16,7 +16,8 @@ BRAVO_CYLINDER_WIDTH = 0.0635     # m, Bravo et al. (2015)
 BRAVO_CYLINDER_HEIGHT = 0.457     # m
 
 # Names the command line offers before the C++ core is loaded (its --help works before a build);
-# tests/python/test_cli.py checks them against the core's own lists.
+# tests/python/test_constants_core.py checks them against the core's list of drag laws
+# (core/include/sediment/drag.hpp), which a new law is added to.
 DRAG_LAWS = ("stokes", "schiller-naumann", "dallavalle", "zhang-li", "zhang-li/smooth", "difelice", "standard",
              "bingham")
 # The laws for a sphere in a Bingham fluid: SEDIMENT's (the default), the paper's and its continuous variant.
@@ -34,3 +35,12 @@ SCHEDULES = {              # hydrometer reading times [min]
     "d7928": [1, 2, 4, 15, 30, 60, 240, 1440],
     "bravo": [0.5, 1, 2, 4, 15, 30, 60, 120, 240, 480],
 }
+
+
+def __getattr__(name: str):
+    """BOLTZMANN [J/K], the core's (core/include/sediment/water.hpp), loaded when first asked for, so
+    that the names above work before a build."""
+    if name == "BOLTZMANN":
+        from . import _core
+        return _core.BOLTZMANN
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

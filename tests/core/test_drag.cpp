@@ -40,6 +40,19 @@ TEST(DragLaw, WhichLawsTakeAHindrance)
   EXPECT_FALSE(law_takes_hindrance(DragLaw::ZhangLi, Hindrance::DiFelice));
   EXPECT_FALSE(law_takes_hindrance(DragLaw::Bingham, Hindrance::RichardsonZaki));
   EXPECT_FALSE(law_takes_hindrance(DragLaw::DiFelice, Hindrance::Garside));    // Bravo et al.'s model is whole
+  // The refusals name what to use instead, from the list.
+  EXPECT_EQ(hindrance_refusal(DragLaw::SchillerNaumann, Hindrance::Garside),
+            "its jump in Cd at Re = 1000 would move with each sphere's fraction; use hindrance difelice, or law "
+            "stokes, dallavalle or standard");
+  EXPECT_EQ(hindrance_refusal(DragLaw::ZhangLi, Hindrance::DiFelice),
+            "the hindrances are for the Newtonian laws; hindrance difelice goes with law stokes, schiller-naumann, "
+            "dallavalle or standard");
+  EXPECT_EQ(hindrance_refusal(DragLaw::DiFelice, Hindrance::RichardsonZaki),
+            "law difelice carries hindrance difelice; hindrance richardson-zaki goes with law stokes, dallavalle or "
+            "standard");
+  EXPECT_EQ(hindrance_buoyancy_from_name(hindrance_buoyancy_name(HindranceBuoyancy::Mixture)),
+            HindranceBuoyancy::Mixture);
+  EXPECT_EQ(hindrance_buoyancy_names(), "plain or mixture");
   // law difelice is Dallavalle's curve under Di Felice's hindrance, named so for the paper.
   const DragModel bravo(DragLaw::DiFelice, water);
   EXPECT_EQ(bravo.single_law(), DragLaw::Dallavalle);

@@ -1169,7 +1169,7 @@ BAD_INPUT = [
     ("fix f all fluid density 1000 viscosity 1e-3\nfix d all fluid/drag f law schiller-naumann hindrance garside concentration c_x", "jump in Cd at Re = 1000"),
     ("fix f all fluid density 1000 bingham 10 0.01\nfix d all fluid/drag f law bingham hindrance richardson-zaki concentration c_x", "law bingham takes no hindrance richardson-zaki"),
     ("fix f all fluid density 1000 bingham 10 0.01\nfix d all fluid/drag f law Bingham", "unknown law 'Bingham'"),
-    ("fix f all fluid density 1000 viscosity 1e-3\nfix d all fluid/drag f law difelice hindrance garside concentration c_x", "law difelice is Dallavalle's drag with Di Felice's hindrance"),
+    ("fix f all fluid density 1000 viscosity 1e-3\nfix d all fluid/drag f law difelice hindrance garside concentration c_x", "law difelice is law dallavalle's drag with hindrance difelice"),
     ("fix f all fluid density 1000 viscosity 1e-3\nfix d all fluid/drag f law standart", "unknown law 'standart'"),
     ("fix f all fluid density 1000 viscosity 1e-3\nfix b all fluid/buoyancy f max_fraction 1", "max_fraction must be in (0, 1)"),
     # what the styles cannot honour
