@@ -16,8 +16,7 @@ BRAVO_CYLINDER_WIDTH = 0.0635     # m, Bravo et al. (2015)
 BRAVO_CYLINDER_HEIGHT = 0.457     # m
 
 # Names the command line offers before the C++ core is loaded (its --help works before a build);
-# tests/python/test_constants_core.py checks them against the core's list of drag laws
-# (core/include/sediment/drag.hpp), which a new law is added to.
+# tests/python/test_cli.py checks them against the core's own lists.
 DRAG_LAWS = ("stokes", "schiller-naumann", "dallavalle", "zhang-li", "zhang-li/smooth", "difelice", "standard",
              "bingham")
 # The laws for a sphere in a Bingham fluid: SEDIMENT's (the default), the paper's and its continuous variant.
