@@ -5,7 +5,7 @@ style headers: every FixStyle, ComputeStyle and PairStyle line of a header has i
 under the same name and class, and its header included; the table has no entry that no header
 declares. An in-tree build registers the styles from the headers alone, the driver and the plugin
 from the table, so a style added to one and not the other would exist on one route only.
-    tests/styles/style_table.py [PACKAGE_DIR]    (ctest: styles.table; default: lammps-pkg/SEDIMENT)
+    tests/decks/style_table.py [PACKAGE_DIR]    (ctest: styles.table; default: lammps-pkg/SEDIMENT)
 """
 from __future__ import annotations
 
@@ -20,13 +20,17 @@ ENTRY = re.compile(r'\{\s*"([^"]+)"\s*,\s*"[^"]*"\s*,\s*&create(?:_pair)?<(?:\w+
 INCLUDE = re.compile(r'^#include "([^"]+\.h)"', re.MULTILINE)
 
 
+def declared_styles(package: Path = PACKAGE) -> dict[tuple[str, str, str], str]:
+    """(kind, name, class) of every style a header of the package declares -> the header's name; kind
+    is Fix, Compute or Pair."""
+    return {style: header.name for header in sorted(package.glob("*.h"))
+            for style in DECLARED.findall(header.read_text())}
+
+
 def main() -> int:
     package = Path(sys.argv[1]) if len(sys.argv) > 1 else PACKAGE
-    declared, headers = set(), {}
-    for header in sorted(package.glob("*.h")):
-        for kind, name, cls in DECLARED.findall(header.read_text()):
-            declared.add((kind, name, cls))
-            headers[(kind, name, cls)] = header.name
+    headers = declared_styles(package)
+    declared = set(headers)
     source = (package / "sediment_styles.cpp").read_text()
     listed = {(kind, name, cls) for kind, body in TABLE.findall(source) for name, cls in ENTRY.findall(body)}
     included = set(INCLUDE.findall(source))
