@@ -37,6 +37,8 @@ def stub_text(core) -> str:
             for method in ["__init__"] + sorted(m for m in vars(item) if not m.startswith("_")):
                 doc = getattr(item, method).__doc__ or ""
                 lines.append(f"    def {_types(doc.splitlines()[0])}: ...")
+        elif not callable(item):    # a constant
+            lines += ["", f"{name}: {type(item).__name__}"]
         else:
             doc = item.__doc__ or ""
             lines += ["", f"def {_types(doc.splitlines()[0])}:", f'    """{_summary(doc)}"""']

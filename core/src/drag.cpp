@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 
 namespace sediment {
@@ -18,22 +19,39 @@ template <class Choice> struct Named {
 };
 
 constexpr Named<DragLaw> law_names[] = {
-    {DragLaw::Stokes, "stokes"},
-    {DragLaw::SchillerNaumann, "schiller-naumann"},
-    {DragLaw::Dallavalle, "dallavalle"},
-    {DragLaw::ZhangLi, "zhang-li"},
-    {DragLaw::ZhangLiSmooth, "zhang-li/smooth"},
-    {DragLaw::DiFelice, "difelice"},
-    {DragLaw::Standard, "standard"},
-    {DragLaw::Bingham, "bingham"},
+#define SEDIMENT_NAMED_LAW(Law, name, ...) {DragLaw::Law, name},
+    SEDIMENT_DRAG_LAWS(SEDIMENT_NAMED_LAW)
+#undef SEDIMENT_NAMED_LAW
 };
 
 constexpr Named<Hindrance> hindrance_names_table[] = {
-    {Hindrance::None, "none"},
-    {Hindrance::DiFelice, "difelice"},
-    {Hindrance::RichardsonZaki, "richardson-zaki"},
-    {Hindrance::Garside, "garside"},
+#define SEDIMENT_NAMED_HINDRANCE(Hindrance_, name) {Hindrance::Hindrance_, name},
+    SEDIMENT_HINDRANCES(SEDIMENT_NAMED_HINDRANCE)
+#undef SEDIMENT_NAMED_HINDRANCE
 };
+
+constexpr Named<HindranceBuoyancy> buoyancy_names[] = {
+#define SEDIMENT_NAMED_BUOYANCY(Buoyancy, name) {HindranceBuoyancy::Buoyancy, name},
+    SEDIMENT_HINDRANCE_BUOYANCIES(SEDIMENT_NAMED_BUOYANCY)
+#undef SEDIMENT_NAMED_BUOYANCY
+};
+
+// The table is indexed by the enumerator (drag_law_traits): its order is the enum's.
+constexpr bool table_in_enum_order()
+{
+  for (const auto &entry : law_names)
+    if (drag_law_table[static_cast<int>(entry.value)].name != entry.name) return false;
+  return true;
+}
+static_assert(table_in_enum_order(), "drag_law_table and DragLaw come from the same list");
+// The switches on a law's own curve (SEDIMENT_CURVE_BRANCH) have a branch for each law a curve column names.
+constexpr bool curves_are_their_own()
+{
+  for (const auto &law : drag_law_table)
+    if (drag_law_traits(law.curve).curve != law.curve) return false;
+  return true;
+}
+static_assert(curves_are_their_own(), "a law's curve column names a law whose curve is its own");
 
 template <class Choice, size_t n> std::optional<Choice> from_name(const Named<Choice> (&table)[n], std::string_view name)
 {
@@ -49,14 +67,32 @@ template <class Choice, size_t n> const char *name_of(const Named<Choice> (&tabl
   return "unknown";
 }
 
-template <class Choice, size_t n> std::string joined_names(const Named<Choice> (&table)[n])
+// The names of the table's entries that pass `keep`, separated by `comma` and the last by `last`.
+template <class Choice, size_t n, class Keep>
+std::string joined_names(const Named<Choice> (&table)[n], Keep keep, const char *comma = ", ", const char *last = ", ")
 {
   std::string names;
+  size_t kept = 0, count = 0;
+  for (const auto &entry : table) count += keep(entry.value);
   for (const auto &entry : table) {
-    if (!names.empty()) names += ", ";
+    if (!keep(entry.value)) continue;
+    if (kept > 0) names += kept + 1 == count ? last : comma;
     names += entry.name;
+    ++kept;
   }
   return names;
+}
+template <class Choice, size_t n> std::string joined_names(const Named<Choice> (&table)[n])
+{
+  return joined_names(table, [](Choice) { return true; });
+}
+
+// A number as a deck writes it (1000, 1.5).
+std::string number_text(double value)
+{
+  char text[32];
+  std::snprintf(text, sizeof text, "%g", value);
+  return text;
 }
 
 }    // namespace
@@ -64,41 +100,74 @@ template <class Choice, size_t n> std::string joined_names(const Named<Choice> (
 std::optional<DragLaw> drag_law_from_name(std::string_view name) { return from_name(law_names, name); }
 const char *drag_law_name(DragLaw law) { return name_of(law_names, law); }
 std::string drag_law_names() { return joined_names(law_names); }
+std::string drag_law_names(bool (*keep)(const DragLawTraits &))
+{
+  return joined_names(law_names, [&](DragLaw law) { return keep(drag_law_traits(law)); }, ", ", " or ");
+}
 
 std::optional<Hindrance> hindrance_from_name(std::string_view name) { return from_name(hindrance_names_table, name); }
 const char *hindrance_name(Hindrance hindrance) { return name_of(hindrance_names_table, hindrance); }
 std::string hindrance_names() { return joined_names(hindrance_names_table); }
 
-bool law_takes_hindrance(DragLaw law, Hindrance hindrance)
+std::optional<HindranceBuoyancy> hindrance_buoyancy_from_name(std::string_view name)
 {
-  if (hindrance == Hindrance::None) return true;
-  if (law == DragLaw::DiFelice) return hindrance == Hindrance::DiFelice;
-  if (law == DragLaw::ZhangLi || law == DragLaw::ZhangLiSmooth || law == DragLaw::Bingham) return false;
-  return law != DragLaw::SchillerNaumann || hindrance == Hindrance::DiFelice;
+  return from_name(buoyancy_names, name);
+}
+const char *hindrance_buoyancy_name(HindranceBuoyancy buoyancy) { return name_of(buoyancy_names, buoyancy); }
+std::string hindrance_buoyancy_names()
+{
+  return joined_names(buoyancy_names, [](HindranceBuoyancy) { return true; }, ", ", " or ");
 }
 
-double drag_coefficient(DragLaw law, double re) { return drag_curve(law, re).g / re; }
+bool law_takes_hindrance(DragLaw law, Hindrance hindrance)
+{
+  return (drag_law_traits(law).hindrances & hindrance_bit(hindrance)) != 0;
+}
+
+std::string hindrance_refusal(DragLaw law, Hindrance hindrance)
+{
+  const DragLawTraits &traits = drag_law_traits(law);
+  // The laws a deck may name with this hindrance (not those that carry one of their own).
+  const std::string laws = joined_names(
+      law_names,
+      [&](DragLaw other) {
+        return drag_law_traits(other).own_hindrance == Hindrance::None && law_takes_hindrance(other, hindrance);
+      },
+      ", ", " or ");
+  const std::string goes_with = "hindrance " + std::string(hindrance_name(hindrance)) + " goes with law " + laws;
+  if (traits.own_hindrance != Hindrance::None)
+    return "law " + std::string(drag_law_name(law)) + " carries hindrance " + hindrance_name(traits.own_hindrance) +
+           "; " + goes_with;
+  if (traits.bingham_fluid) return "the hindrances are for the Newtonian laws; " + goes_with;
+  const std::string taken = joined_names(
+      hindrance_names_table,
+      [&](Hindrance other) { return other != Hindrance::None && law_takes_hindrance(law, other); }, ", ", " or ");
+  std::string why;
+  if (traits.jumps.count > 0) {
+    why = "its jump in Cd at Re = ";
+    for (int k = 0; k < traits.jumps.count; ++k) why += (k > 0 ? " and " : "") + number_text(traits.jumps.reynolds[k]);
+    why += " would move with each sphere's fraction; ";
+  }
+  if (taken.empty()) return why + goes_with;
+  return why + "use hindrance " + taken + ", or law " + laws;
+}
+
+double drag_coefficient(DragLaw law, double re) { return drag_curve(drag_law_traits(law).curve, re).g / re; }
 
 DragModel::DragModel(DragLaw law, const Fluid &fluid, HindranceBuoyancy buoyancy, Hindrance hindrance,
                      bingham_law::Constants bingham) :
     law_(law),
-    single_law_(law == DragLaw::DiFelice ? DragLaw::Dallavalle : law == DragLaw::Bingham ? DragLaw::Standard : law),
-    hindrance_(law == DragLaw::DiFelice ? Hindrance::DiFelice : hindrance),
+    single_law_(drag_law_traits(law).curve),
+    hindrance_(drag_law_traits(law).own_hindrance != Hindrance::None ? drag_law_traits(law).own_hindrance : hindrance),
     exponent_fit_(hindrance == Hindrance::Garside ? garside_exponent : rowe_exponent),
     log_scale_(std::log(exponent_fit_.scale)), hindrance_offset_(buoyancy == HindranceBuoyancy::Plain ? 1.0 : 0.0),
     fluid_(fluid),
     density_per_viscosity_(fluid.viscosity > 0.0 ? fluid.density / fluid.viscosity : 0.0),
     yield_per_viscosity_(fluid.viscosity > 0.0 ? fluid.yield_stress / fluid.viscosity : 0.0),
     split_yield_(law == DragLaw::Bingham), yield_weight_(split_yield_ ? bingham.yield_weight : 1.0),
-    yield_rise_(bingham.rise), smooth_(false)
+    yield_rise_(bingham.rise), switches_(drag_law_traits(law).jumps),
+    smooth_(fluid_.yield_stress <= 0.0 && switches_.count == 0)
 {
-  if (law_ == DragLaw::ZhangLi) {
-    switches_.reynolds[switches_.count++] = zhang_li_low;
-    switches_.reynolds[switches_.count++] = zhang_li_high;
-  } else if (law_ == DragLaw::SchillerNaumann) {
-    switches_.reynolds[switches_.count++] = schiller_naumann_switch;
-  }
-  smooth_ = fluid_.yield_stress <= 0.0 && switches_.count == 0;
 }
 
 double DragModel::viscous_scale(double d, double speed) const

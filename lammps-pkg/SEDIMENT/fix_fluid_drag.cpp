@@ -62,9 +62,11 @@ FixFluidDrag::FixFluidDrag(LAMMPS *lmp, int narg, char **arg) :
       delete[] concentration_id;
       concentration_id = utils::strdup(args.text(1));
     } else if (args.is("buoyancy")) {
-      args.need(1, "plain or mixture");
-      hindrance_buoyancy = args.choice(1, {"plain", "mixture"}) == 0 ? sediment::HindranceBuoyancy::Plain
-                                                                      : sediment::HindranceBuoyancy::Mixture;
+      const std::string names = sediment::hindrance_buoyancy_names();
+      args.need(1, names.c_str());
+      const auto parsed = sediment::hindrance_buoyancy_from_name(args.text(1));
+      if (!parsed) args.fail("buoyancy must be {}, not '{}'", names, args.text(1));
+      hindrance_buoyancy = *parsed;
     } else if (args.is("max_fraction")) {
       args.need(1, "a value");
       max_fraction = args.number(1);
@@ -75,27 +77,28 @@ FixFluidDrag::FixFluidDrag(LAMMPS *lmp, int narg, char **arg) :
     args.next(1);
   }
   if (!has_law) error->all(FLERR, "Fix fluid/drag: keyword 'law' is required");
-  if (law == sediment::DragLaw::DiFelice) {
+  // The messages below name laws and hindrances from the core's list (sediment/drag.hpp).
+  const sediment::DragLawTraits &traits = sediment::drag_law_traits(law);
+  if (traits.own_hindrance != sediment::Hindrance::None) {
     if (has_hindrance)
-      error->all(FLERR, "Fix fluid/drag: law difelice is Dallavalle's drag with Di Felice's hindrance (Bravo "
-                        "et al.); for another hindrance name a law and 'hindrance NAME' (e.g. law dallavalle "
-                        "hindrance richardson-zaki)");
-    hindrance = sediment::Hindrance::DiFelice;
+      error->all(FLERR, "Fix fluid/drag: law {} is law {}'s drag with hindrance {}; for another hindrance name "
+                 "law {} and 'hindrance NAME'", sediment::drag_law_name(law), sediment::drag_law_name(traits.curve),
+                 sediment::hindrance_name(traits.own_hindrance), sediment::drag_law_name(traits.curve));
+    hindrance = traits.own_hindrance;
   }
   if (!sediment::law_takes_hindrance(law, hindrance))
     error->all(FLERR, "Fix fluid/drag: law {} takes no hindrance {} ({})", sediment::drag_law_name(law),
-               sediment::hindrance_name(hindrance),
-               law == sediment::DragLaw::SchillerNaumann
-                   ? "its jump in Cd at Re = 1000 would move with each sphere's fraction; use hindrance "
-                     "difelice, or law standard"
-                   : "the hindrances are for the Newtonian laws stokes, schiller-naumann, dallavalle and standard");
+               sediment::hindrance_name(hindrance), sediment::hindrance_refusal(law, hindrance));
   if (hindrance != sediment::Hindrance::None && !concentration_id)
     error->all(FLERR, "Fix fluid/drag: {} needs keyword 'concentration c_ID' (a compute concentration/grid)",
-               law == sediment::DragLaw::DiFelice ? "law difelice"
-                                                  : fmt::format("hindrance {}", sediment::hindrance_name(hindrance)));
+               traits.own_hindrance != sediment::Hindrance::None
+                   ? fmt::format("law {}", sediment::drag_law_name(law))
+                   : fmt::format("hindrance {}", sediment::hindrance_name(hindrance)));
   if (hindrance == sediment::Hindrance::None && concentration_id)
-    error->all(FLERR, "Fix fluid/drag: keyword 'concentration' goes with a hindrance (hindrance NAME, or law "
-                      "difelice)");
+    error->all(FLERR, "Fix fluid/drag: keyword 'concentration' goes with a hindrance (hindrance NAME, or law {})",
+               sediment::drag_law_names([](const sediment::DragLawTraits &other) {
+                 return other.own_hindrance != sediment::Hindrance::None;
+               }));
   if (!atom->radius_flag || !atom->rmass_flag)
     error->all(FLERR, "Fix fluid/drag requires atom attributes radius and rmass (atom_style sphere)");
   if (rotation && (!atom->omega_flag || !atom->torque_flag))

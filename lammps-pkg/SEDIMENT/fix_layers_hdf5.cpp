@@ -5,6 +5,7 @@
 
 #include "fix_layers_hdf5.h"
 #include "sediment_args.h"
+#include "sediment_hdf5.h"
 
 #include "compute_concentration_grid.h"
 #include "fix_fluid.h"
@@ -32,6 +33,7 @@
 
 using namespace LAMMPS_NS;
 using namespace FixConst;
+using namespace LAMMPS_NS::SedimentHDF5;
 
 namespace {
 
@@ -39,164 +41,10 @@ constexpr const char *SCHEMA = "sediment-layers";
 constexpr int SCHEMA_VERSION = 1;
 constexpr const char *SEDIMENT_VERSION = "0.1.0";
 
-// Closes an HDF5 handle when it goes out of scope.
-class Handle {
- public:
-  Handle(hid_t id, herr_t (*closer)(hid_t), const std::string &what) : id_(id), closer_(closer), what_(what)
-  {
-    if (id_ < 0) throw std::runtime_error(what);
-  }
-  // Closing a dataset writes its cached chunks: a full disk shows here, so a close after writing is checked.
-  void close()
-  {
-    const herr_t status = closer_(id_);
-    id_ = -1;
-    if (status < 0) throw std::runtime_error("writing " + what_ + " (disk full?)");
-  }
-  ~Handle()
-  {
-    if (id_ >= 0) closer_(id_);
-  }
-  Handle(const Handle &) = delete;
-  Handle &operator=(const Handle &) = delete;
-  operator hid_t() const { return id_; }
-
- private:
-  hid_t id_;
-  herr_t (*closer_)(hid_t);
-  std::string what_;
-};
-
-void check(herr_t status, const std::string &what)
-{
-  if (status < 0) throw std::runtime_error(what);
-}
-
-void write_attribute(hid_t where, const char *name, double value)
-{
-  Handle space(H5Screate(H5S_SCALAR), H5Sclose, "dataspace");
-  Handle attr(H5Acreate2(where, name, H5T_NATIVE_DOUBLE, space, H5P_DEFAULT, H5P_DEFAULT), H5Aclose,
-              std::string("attribute ") + name);
-  check(H5Awrite(attr, H5T_NATIVE_DOUBLE, &value), std::string("attribute ") + name);
-}
-
-double read_double_attribute(hid_t where, const char *name)
-{
-  double value = 0.0;
-  Handle attr(H5Aopen(where, name, H5P_DEFAULT), H5Aclose, std::string("attribute ") + name);
-  check(H5Aread(attr, H5T_NATIVE_DOUBLE, &value), std::string("attribute ") + name);
-  return value;
-}
-
-// Sets (or replaces) a scalar double attribute.
-void set_attribute(hid_t where, const char *name, double value)
-{
-  if (H5Aexists(where, name) > 0) check(H5Adelete(where, name), std::string("attribute ") + name);
-  write_attribute(where, name, value);
-}
-
-void write_attribute(hid_t where, const char *name, const std::string &value)
-{
-  Handle type(H5Tcopy(H5T_C_S1), H5Tclose, "string type");
-  check(H5Tset_size(type, value.empty() ? 1 : value.size()), "string size");
-  Handle space(H5Screate(H5S_SCALAR), H5Sclose, "dataspace");
-  Handle attr(H5Acreate2(where, name, type, space, H5P_DEFAULT, H5P_DEFAULT), H5Aclose,
-              std::string("attribute ") + name);
-  check(H5Awrite(attr, type, value.c_str()), std::string("attribute ") + name);
-}
-
-std::string read_string_attribute(hid_t where, const char *name)
-{
-  if (H5Aexists(where, name) <= 0) return "";
-  Handle attr(H5Aopen(where, name, H5P_DEFAULT), H5Aclose, std::string("attribute ") + name);
-  Handle type(H5Aget_type(attr), H5Tclose, "attribute type");
-  if (H5Tget_class(type) != H5T_STRING) return "";
-  std::vector<char> text(H5Tget_size(type) + 1, '\0');
-  check(H5Aread(attr, type, text.data()), std::string("attribute ") + name);
-  return text.data();
-}
-
-// Fixed array (1d) of doubles, checksummed: in its object header (whose checksum covers it) if it fits there,
-// else in one chunk with its own checksum.
-void write_array(hid_t where, const char *name, const std::vector<double> &values)
-{
-  const hsize_t dims[1] = {values.size()};
-  Handle space(H5Screate_simple(1, dims, nullptr), H5Sclose, "dataspace");
-  Handle props(H5Pcreate(H5P_DATASET_CREATE), H5Pclose, "properties");
-  if (values.size() * sizeof(double) <= 60000) {
-    check(H5Pset_layout(props, H5D_COMPACT), "compact layout");
-  } else {
-    check(H5Pset_chunk(props, 1, dims), "chunking");
-    check(H5Pset_fletcher32(props), "checksums");
-  }
-  Handle set(H5Dcreate2(where, name, H5T_NATIVE_DOUBLE, space, H5P_DEFAULT, props, H5P_DEFAULT),
-             H5Dclose, std::string("dataset ") + name);
-  if (!values.empty()) check(H5Dwrite(set, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, values.data()), name);
-}
-
-// Extendable dataset whose first dimension counts frames.
-void create_frames(hid_t where, const char *name, hid_t type, int rank, const hsize_t *frame_dims)
-{
-  hsize_t dims[3] = {0, 0, 0}, maxdims[3] = {H5S_UNLIMITED, 0, 0}, chunk[3] = {1, 1, 1};
-  for (int k = 1; k < rank; ++k) dims[k] = maxdims[k] = chunk[k] = frame_dims[k - 1];
-  if (rank == 1) chunk[0] = 256;
-  Handle space(H5Screate_simple(rank, dims, maxdims), H5Sclose, "dataspace");
-  Handle props(H5Pcreate(H5P_DATASET_CREATE), H5Pclose, "properties");
-  check(H5Pset_chunk(props, rank, chunk), "chunking");
-  check(H5Pset_fletcher32(props), "checksums");    // a damaged frame is refused on reading, not read as data
-  Handle set(H5Dcreate2(where, name, type, space, H5P_DEFAULT, props, H5P_DEFAULT), H5Dclose,
-             std::string("dataset ") + name);
-}
-
 // The frame datasets, in the order of FixLayersHDF5::frame_sets; the last, the fluid's density and
 // viscosity per frame, only in the files of a fix with a fluid.
 constexpr const char *FRAME_SETS[4] = {"time", "step", "fraction", "fluid"};
 constexpr int FLUID_SET = 3;
-
-bool has_dataset(hid_t handle, const char *name)
-{
-  return H5Lexists(handle, name, H5P_DEFAULT) > 0;
-}
-
-// Resizes an open frame dataset to `frames` and writes its last `count` frames from `data`.
-void put_frames(hid_t set, const char *name, hid_t type, hsize_t frames, hsize_t count, const void *data)
-{
-  hsize_t dims[3] = {frames, 0, 0};
-  {
-    Handle space(H5Dget_space(set), H5Sclose, "dataspace");
-    const int rank = H5Sget_simple_extent_ndims(space);
-    hsize_t current[3];
-    H5Sget_simple_extent_dims(space, current, nullptr);
-    for (int k = 1; k < rank; ++k) dims[k] = current[k];
-    check(H5Dset_extent(set, dims), std::string("resizing ") + name);
-  }
-  if (count == 0) return;
-  Handle space(H5Dget_space(set), H5Sclose, "dataspace");
-  const int rank = H5Sget_simple_extent_ndims(space);
-  hsize_t start[3] = {frames - count, 0, 0}, block[3] = {count, dims[1], dims[2]};
-  check(H5Sselect_hyperslab(space, H5S_SELECT_SET, start, nullptr, block, nullptr), "selection");
-  Handle memory(H5Screate_simple(rank, block, nullptr), H5Sclose, "dataspace");
-  check(H5Dwrite(set, type, memory, space, H5P_DEFAULT, data), std::string("writing ") + name + " (disk full?)");
-}
-
-bool file_exists(const std::string &name)
-{
-  FILE *probe = fopen(name.c_str(), "rb");
-  if (probe) fclose(probe);
-  return probe != nullptr;
-}
-
-// A one-value-per-frame dataset (time or step) whole.
-template <typename T> std::vector<T> read_frames(hid_t handle, const char *name, hid_t type)
-{
-  Handle set(H5Dopen2(handle, name, H5P_DEFAULT), H5Dclose, std::string("dataset ") + name);
-  Handle space(H5Dget_space(set), H5Sclose, "dataspace");
-  hsize_t count = 0;
-  H5Sget_simple_extent_dims(space, &count, nullptr);
-  std::vector<T> values(count);
-  if (count > 0) check(H5Dread(set, type, H5S_ALL, H5S_ALL, H5P_DEFAULT, values.data()), name);
-  return values;
-}
 
 long long frames_before(hid_t handle, LAMMPS_NS::bigint step)
 {
@@ -254,50 +102,6 @@ void read_back(hid_t handle, bool equal)
                                          sets == 4 ? fmt::format(" and {} fluids", counts[3]) : std::string()));
 }
 
-// CRC-32 (IEEE 802.3, as zlib's crc32 and Python's zlib.crc32) and size of a file; false if it cannot be read.
-bool file_crc32(const std::string &name, uint32_t &crc, long long &size)
-{
-  static uint32_t table[256];
-  if (table[1] == 0)
-    for (uint32_t n = 0; n < 256; ++n) {
-      uint32_t c = n;
-      for (int k = 0; k < 8; ++k) c = c & 1 ? 0xEDB88320u ^ (c >> 1) : c >> 1;
-      table[n] = c;
-    }
-  FILE *in = fopen(name.c_str(), "rb");
-  if (!in) return false;
-  std::vector<unsigned char> buffer(1 << 20);
-  crc = 0xFFFFFFFFu;
-  size = 0;
-  size_t n;
-  while ((n = fread(buffer.data(), 1, buffer.size(), in)) > 0) {
-    for (size_t k = 0; k < n; ++k) crc = table[(crc ^ buffer[k]) & 0xFF] ^ (crc >> 8);
-    size += static_cast<long long>(n);
-  }
-  const bool ok = !ferror(in);
-  fclose(in);
-  crc ^= 0xFFFFFFFFu;
-  return ok;
-}
-
-void copy_file(const std::string &from, const std::string &to)
-{
-  FILE *in = fopen(from.c_str(), "rb");
-  if (!in) throw std::runtime_error(from + " cannot be read");
-  FILE *out = fopen(to.c_str(), "wb");
-  if (!out) {
-    fclose(in);
-    throw std::runtime_error(to + " cannot be written");
-  }
-  std::vector<char> buffer(1 << 20);
-  size_t n;
-  bool ok = true;
-  while (ok && (n = fread(buffer.data(), 1, buffer.size(), in)) > 0) ok = fwrite(buffer.data(), 1, n, out) == n;
-  ok = ok && !ferror(in);
-  fclose(in);
-  ok = (fclose(out) == 0) && ok;
-  if (!ok) throw std::runtime_error("copying to " + to + " failed (disk full?)");
-}
 
 }    // namespace
 

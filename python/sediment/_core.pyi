@@ -6,6 +6,8 @@ from __future__ import annotations
 import numpy
 
 
+BOLTZMANN: float
+
 class DragModel:
     """Resisting-force curve of a sphere under one drag law."""
     def __init__(self: DragModel, law: str, density: float, viscosity: float, yield_stress: float = ..., buoyancy: str = ..., hindrance: str = ..., yield_weight: Optional[float] = ..., yield_rise: Optional[float] = ...) -> None: ...
@@ -25,6 +27,9 @@ def drag_coefficient(law: str, reynolds: float) -> float:
 def drag_law_names() -> list[str]:
     """Names of the drag laws."""
 
+def drag_laws() -> list:
+    """The core's list of drag laws, in its order: each law's name, the hindrances a deck may name for it ('none' included) and whether it is a law for a sphere in a Bingham fluid (else a Newtonian law)."""
+
 def explicit_step_limit(law: str, density: float, viscosity: float, yield_stress: float, d: float, particle_density: float, speed: float = ...) -> float:
     """Largest step [s] at which explicit drag is stable at a slip speed (2 tau for Stokes)."""
 
@@ -39,6 +44,9 @@ def hertz_modulus_for_load(pressure: float, overlap: float, poisson_ratio: float
 
 def hertz_modulus_for_overlap(impact: str, density: float, speed: float, overlap: float, poisson_ratio: float) -> float:
     """Young's modulus [Pa] whose impacts at `speed` reach `overlap` (relative to the diameter)."""
+
+def hindrance_names() -> list[str]:
+    """Names of the hindrances ('none' included)."""
 
 def mixture_density(fluid_density: numpy.ndarray, solid_density: numpy.ndarray, fraction: numpy.ndarray) -> object:
     """Suspension density rho_f + (rho_s - rho_f) phi [kg/m3] (numpy arrays too)."""

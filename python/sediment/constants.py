@@ -34,3 +34,12 @@ SCHEDULES = {              # hydrometer reading times [min]
     "d7928": [1, 2, 4, 15, 30, 60, 240, 1440],
     "bravo": [0.5, 1, 2, 4, 15, 30, 60, 120, 240, 480],
 }
+
+
+def __getattr__(name: str):
+    """BOLTZMANN [J/K], the core's (core/include/sediment/water.hpp), loaded when first asked for, so
+    that the names above work before a build."""
+    if name == "BOLTZMANN":
+        from . import _core
+        return _core.BOLTZMANN
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

@@ -13,6 +13,7 @@
 #include <pybind11/stl.h>
 
 #include <cmath>
+#include <iterator>
 #include <optional>
 #include <stdexcept>
 
@@ -21,11 +22,25 @@ using namespace sediment;
 
 namespace {
 
+// The core's lists (sediment/drag.hpp) as Python sees them.
+constexpr Hindrance hindrances[] = {
+#define SEDIMENT_HINDRANCE_VALUE(Value, name) Hindrance::Value,
+    SEDIMENT_HINDRANCES(SEDIMENT_HINDRANCE_VALUE)
+#undef SEDIMENT_HINDRANCE_VALUE
+};
+constexpr const char *buoyancy_names[] = {
+#define SEDIMENT_BUOYANCY_NAME(Value, name) name,
+    SEDIMENT_HINDRANCE_BUOYANCIES(SEDIMENT_BUOYANCY_NAME)
+#undef SEDIMENT_BUOYANCY_NAME
+};
+
 HindranceBuoyancy parse_buoyancy(const std::string &name)
 {
-  if (name == "plain") return HindranceBuoyancy::Plain;
-  if (name == "mixture") return HindranceBuoyancy::Mixture;
-  throw py::value_error("buoyancy must be 'plain' or 'mixture', not '" + name + "'");
+  const auto buoyancy = hindrance_buoyancy_from_name(name);
+  if (buoyancy) return *buoyancy;
+  std::string quoted;    // 'plain' or 'mixture'
+  for (const char *choice : buoyancy_names) quoted += (quoted.empty() ? "'" : " or '") + std::string(choice) + "'";
+  throw py::value_error("buoyancy must be " + quoted + ", not '" + name + "'");
 }
 
 DragScale voidage_scale(double voidage)
@@ -47,7 +62,8 @@ Hindrance parse_hindrance(const std::string &name, DragLaw law)
   if (!hindrance)
     throw py::value_error("unknown hindrance '" + name + "' (expected one of " + hindrance_names() + ")");
   if (!law_takes_hindrance(law, *hindrance))
-    throw py::value_error(std::string("law ") + drag_law_name(law) + " does not take hindrance " + name);
+    throw py::value_error(std::string("law ") + drag_law_name(law) + " does not take hindrance " + name + " (" +
+                          hindrance_refusal(law, *hindrance) + ")");
   return *hindrance;
 }
 
@@ -85,12 +101,31 @@ PYBIND11_MODULE(_core, m)
 
   m.def("drag_law_names", [] {
     std::vector<std::string> names;
-    for (auto law : {DragLaw::Stokes, DragLaw::SchillerNaumann, DragLaw::Dallavalle, DragLaw::ZhangLi,
-                     DragLaw::ZhangLiSmooth, DragLaw::DiFelice, DragLaw::Standard, DragLaw::Bingham})
-      names.emplace_back(drag_law_name(law));
+    for (const DragLawTraits &law : drag_law_table) names.emplace_back(law.name);
     return names;
   }, "Names of the drag laws.");
+  m.def("drag_laws", [] {
+    py::list laws;
+    for (int k = 0; k < static_cast<int>(std::size(drag_law_table)); ++k) {
+      py::list taken;
+      for (Hindrance hindrance : hindrances)
+        if (law_takes_hindrance(static_cast<DragLaw>(k), hindrance)) taken.append(hindrance_name(hindrance));
+      py::dict law;
+      law["name"] = drag_law_table[k].name;
+      law["hindrances"] = taken;
+      law["bingham_fluid"] = drag_law_table[k].bingham_fluid;
+      laws.append(law);
+    }
+    return laws;
+  }, "The core's list of drag laws, in its order: each law's name, the hindrances a deck may name for it "
+     "('none' included) and whether it is a law for a sphere in a Bingham fluid (else a Newtonian law).");
+  m.def("hindrance_names", [] {
+    std::vector<std::string> names;
+    for (Hindrance hindrance : hindrances) names.emplace_back(hindrance_name(hindrance));
+    return names;
+  }, "Names of the hindrances ('none' included).");
 
+  m.attr("BOLTZMANN") = boltzmann;
   m.def("water_density", [](double celsius) { return water_density(checked_temperature(celsius)); },
         py::arg("celsius"), "Density of water [kg/m3] at 0-40 C (Tanaka et al. 2001).");
   m.def("water_viscosity", [](double celsius) { return water_viscosity(checked_temperature(celsius)); },

@@ -40,6 +40,22 @@ TEST(DragLaw, WhichLawsTakeAHindrance)
   EXPECT_FALSE(law_takes_hindrance(DragLaw::ZhangLi, Hindrance::DiFelice));
   EXPECT_FALSE(law_takes_hindrance(DragLaw::Bingham, Hindrance::RichardsonZaki));
   EXPECT_FALSE(law_takes_hindrance(DragLaw::DiFelice, Hindrance::Garside));    // Bravo et al.'s model is whole
+  // The refusals say why and name what to use instead, from the list (whichever laws it holds).
+  const auto has = [](const std::string &text, const char *part) { return text.find(part) != std::string::npos; };
+  const std::string jump = hindrance_refusal(DragLaw::SchillerNaumann, Hindrance::Garside);
+  EXPECT_EQ(jump.rfind("its jump in Cd at Re = 1000 would move with each sphere's fraction; use hindrance difelice, "
+                       "or law stokes, dallavalle", 0), 0u) << jump;
+  EXPECT_FALSE(has(jump, "schiller-naumann")) << jump;
+  const std::string bingham = hindrance_refusal(DragLaw::ZhangLi, Hindrance::DiFelice);
+  EXPECT_EQ(bingham.rfind("the hindrances are for the Newtonian laws; hindrance difelice goes with law stokes, "
+                          "schiller-naumann, dallavalle", 0), 0u) << bingham;
+  EXPECT_FALSE(has(bingham, "zhang-li") || has(bingham, "bingham") || has(bingham, "law difelice")) << bingham;
+  const std::string carried = hindrance_refusal(DragLaw::DiFelice, Hindrance::RichardsonZaki);
+  EXPECT_EQ(carried.rfind("law difelice carries hindrance difelice; hindrance richardson-zaki goes with law stokes, "
+                          "dallavalle", 0), 0u) << carried;
+  EXPECT_EQ(hindrance_buoyancy_from_name(hindrance_buoyancy_name(HindranceBuoyancy::Mixture)),
+            HindranceBuoyancy::Mixture);
+  EXPECT_EQ(hindrance_buoyancy_names(), "plain or mixture");
   // law difelice is Dallavalle's curve under Di Felice's hindrance, named so for the paper.
   const DragModel bravo(DragLaw::DiFelice, water);
   EXPECT_EQ(bravo.single_law(), DragLaw::Dallavalle);

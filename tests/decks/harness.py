@@ -57,5 +57,20 @@ def _run_with_plugin(plugin: Path, deck: Path, variables, np_ranks: int, cwd: Pa
     return out
 
 
+G = 9.81    # the decks' gravity [m/s2]
+# name -> (function of the rank count, rank counts ctest runs it with: () once without --np; None:
+# not in the standard list, registered by tests/decks/CMakeLists.txt for a LAMMPS with PLUGIN only)
+CHECKS: dict = {}
+
+
+def check(fn=None, *, ranks=(1, 2)):
+    """Registers a check (of checks.py or the modules it imports); ctest asks `checks.py --list` for
+    the names and their rank counts."""
+    def register(fn):
+        CHECKS[fn.__name__] = (fn, None if ranks is None else tuple(ranks))
+        return fn
+    return register(fn) if fn is not None else register
+
+
 def report(message: str) -> None:
     print(message, flush=True)

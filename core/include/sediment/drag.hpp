@@ -24,21 +24,61 @@
 
 namespace sediment {
 
-// The single-sphere laws; DiFelice is Bravo et al.'s model, Dallavalle's curve under Di Felice's
-// hindrance, kept under its own name to reproduce the paper (DragModel splits it into the two).
-enum class DragLaw { Stokes, SchillerNaumann, Dallavalle, ZhangLi, ZhangLiSmooth, DiFelice, Standard, Bingham };
-
 // How the local solid fraction phi = 1 - eps hinders the drag of any Newtonian law (docs/physics.md 3):
-// - DiFelice: the force times eps^-(chi(Re) + 1) (Di Felice 1994's voidage function);
-// - RichardsonZaki, Garside: the single-sphere force at the speed s eps^-n(Re), so that a uniform
+// - difelice: the force times eps^-(chi(Re) + 1) (Di Felice 1994's voidage function);
+// - richardson-zaki, garside: the single-sphere force at the speed s eps^-n(Re), so that a uniform
 //   suspension settles at u_t eps^n under any law (n from Rowe's 1987 fit of Richardson & Zaki's data,
 //   4.7 at low Re, or Garside & Al-Dibouni's 1977 fit of theirs, 5.1 at low Re).
-enum class Hindrance { None, DiFelice, RichardsonZaki, Garside };
+// One line each: the enumerator and the name in decks and on the command line.
+#define SEDIMENT_HINDRANCES(HINDRANCE)         \
+  HINDRANCE(None, "none")                      \
+  HINDRANCE(DiFelice, "difelice")              \
+  HINDRANCE(RichardsonZaki, "richardson-zaki") \
+  HINDRANCE(Garside, "garside")
+
+#define SEDIMENT_ENUMERATOR(Enumerator, ...) Enumerator,
+enum class Hindrance { SEDIMENT_HINDRANCES(SEDIMENT_ENUMERATOR) };
+
+// Which hindrances a law takes, one bit per hindrance: none, Di Felice's alone (a law with a jump in
+// Cd: a speed-scaled hindrance would move the jump with each sphere's fraction), or any.
+using HindranceSet = unsigned;
+constexpr HindranceSet hindrance_bit(Hindrance hindrance) { return 1u << static_cast<unsigned>(hindrance); }
+constexpr HindranceSet no_hindrance = hindrance_bit(Hindrance::None);
+constexpr HindranceSet di_felice_hindrance = no_hindrance | hindrance_bit(Hindrance::DiFelice);
+constexpr HindranceSet any_hindrance =
+    di_felice_hindrance | hindrance_bit(Hindrance::RichardsonZaki) | hindrance_bit(Hindrance::Garside);
+
+// The drag laws, one line each; adding one is a line here and its curve (LawCurve below; the recipe:
+// docs/recipes-cpp.md). The columns:
+// - the enumerator and the name in decks and on the command line;
+// - the law whose single-sphere curve it takes (LawCurve): its own, or another's it is built on:
+//   difelice is Bravo et al.'s model, Dallavalle's curve under Di Felice's hindrance, kept under its
+//   own name to reproduce the paper; bingham takes the standard curve for its plastic viscosity's part
+//   (and bingham_law's for its yield stress's);
+// - the hindrance it always carries (None: the one a deck names);
+// - the hindrances a deck may name for it (a law that carries one takes that one, or none);
+// - whether it is a law for a sphere in a Bingham fluid (with a yield stress) or a Newtonian law.
+#define SEDIMENT_DRAG_LAWS(LAW)                                                                                   \
+  LAW(Stokes, "stokes", Stokes, None, any_hindrance, false)                                                       \
+  LAW(SchillerNaumann, "schiller-naumann", SchillerNaumann, None, di_felice_hindrance, false)                     \
+  LAW(Dallavalle, "dallavalle", Dallavalle, None, any_hindrance, false)                                           \
+  LAW(ZhangLi, "zhang-li", ZhangLi, None, no_hindrance, true)                                                     \
+  LAW(ZhangLiSmooth, "zhang-li/smooth", ZhangLiSmooth, None, no_hindrance, true)                                  \
+  LAW(DiFelice, "difelice", Dallavalle, DiFelice, di_felice_hindrance, false)                                     \
+  LAW(Standard, "standard", Standard, None, any_hindrance, false)                                                 \
+  LAW(Bingham, "bingham", Standard, None, no_hindrance, true)
+
+enum class DragLaw { SEDIMENT_DRAG_LAWS(SEDIMENT_ENUMERATOR) };
 
 // Which buoyancy the hindrance goes with (docs/physics.md 3.1): plain Archimedes buoyancy or buoyancy
 // from the mixture density, which already carries a factor eps of the net weight (Di Felice: eps^-chi
 // instead of eps^-(chi+1); the speed-scaled hindrances: the force times eps).
-enum class HindranceBuoyancy { Plain, Mixture };
+#define SEDIMENT_HINDRANCE_BUOYANCIES(BUOYANCY) \
+  BUOYANCY(Plain, "plain")                      \
+  BUOYANCY(Mixture, "mixture")
+
+enum class HindranceBuoyancy { SEDIMENT_HINDRANCE_BUOYANCIES(SEDIMENT_ENUMERATOR) };
+#undef SEDIMENT_ENUMERATOR
 
 std::optional<DragLaw> drag_law_from_name(std::string_view name);
 const char *drag_law_name(DragLaw law);
@@ -47,9 +87,15 @@ std::string drag_law_names();
 std::optional<Hindrance> hindrance_from_name(std::string_view name);
 const char *hindrance_name(Hindrance hindrance);
 std::string hindrance_names();
-// Whether a law takes a hindrance of its own choice: the Newtonian single-sphere laws without a jump
-// in Cd (a speed-scaled hindrance would move the jump with each sphere's fraction).
+std::optional<HindranceBuoyancy> hindrance_buoyancy_from_name(std::string_view name);
+const char *hindrance_buoyancy_name(HindranceBuoyancy buoyancy);
+// "plain or mixture" (for error messages).
+std::string hindrance_buoyancy_names();
+// Whether a deck may name this hindrance for this law (the list's hindrances column).
 bool law_takes_hindrance(DragLaw law, Hindrance hindrance);
+// Why a law does not take a hindrance and what to name instead, for an error message that starts
+// "law L takes no hindrance H" (law_takes_hindrance must be false).
+std::string hindrance_refusal(DragLaw law, Hindrance hindrance);
 
 struct Fluid {
   double density = 0.0;         // rho_f
@@ -178,35 +224,99 @@ constexpr Constants fitted{0.0101, 8.05};
 }
 }    // namespace bingham_law
 
-// Always inline: the integrator's per-atom loops evaluate it with the law fixed for the whole run, in
-// the vectors of their instruction set (GCC 12 kept it out of line, a call per sphere into SSE code).
+// The Reynolds numbers Re' at which a curve's Cd jumps (where a step may have to stop), in increasing order.
+constexpr int max_curve_jumps = 2;
+struct CurveJumps {
+  int count = 0;
+  double reynolds[max_curve_jumps] = {0.0, 0.0};
+};
+
+// Each law's own single-sphere curve: Cd Re and Re (Cd Re)' at Re (at()), and where Cd jumps. Always
+// inline: the integrator's per-atom loops evaluate it with the law fixed for the whole run, in the
+// vectors of their instruction set (GCC 12 kept it out of line, a call per sphere into SSE code).
+// A law that takes another's curve (the list's third column) has none of its own.
+template <DragLaw law> struct LawCurve;
+template <> struct LawCurve<DragLaw::Stokes> {
+  static constexpr CurveJumps jumps{};
+  [[gnu::always_inline]] static DragCurve at(double) { return {24.0, 0.0}; }
+};
+template <> struct LawCurve<DragLaw::SchillerNaumann> {
+  static constexpr CurveJumps jumps{1, {schiller_naumann_switch}};
+  [[gnu::always_inline]] static DragCurve at(double re)
+  {
+    return schiller_naumann_curve(re, re <= schiller_naumann_switch ? std::pow(re, schiller_naumann_exponent) : 0.0);
+  }
+};
+template <> struct LawCurve<DragLaw::Standard> {
+  static constexpr CurveJumps jumps{};
+  [[gnu::always_inline]] static DragCurve at(double re) { return standard_curve::curve(re); }
+};
+template <> struct LawCurve<DragLaw::Dallavalle> {
+  static constexpr CurveJumps jumps{};
+  [[gnu::always_inline]] static DragCurve at(double re)
+  {
+    // Cd = (0.63 + 4.8 / sqrt(Re))^2  =>  Cd Re = (0.63 sqrt(Re) + 4.8)^2
+    const double root = std::sqrt(re);
+    const double inner = 0.63 * root + 4.8;
+    return {inner * inner, 0.63 * inner * root};
+  }
+};
+template <> struct LawCurve<DragLaw::ZhangLi> {
+  static constexpr CurveJumps jumps{2, {zhang_li_low, zhang_li_high}};
+  [[gnu::always_inline]] static DragCurve at(double re)
+  {
+    if (re < zhang_li_low) return {24.0, 0.0};
+    if (re <= zhang_li_high) return {29.12 + 0.195 * re, 0.195 * re};
+    return {0.4 * re, 0.4 * re};
+  }
+};
+template <> struct LawCurve<DragLaw::ZhangLiSmooth> {
+  static constexpr CurveJumps jumps{};
+  // Continuous variant: a linear ramp of Cd Re from 24 to 29.315 over Re' < 1, then
+  // Cd = max(29.12 / Re' + 0.195, 0.4). Same static force and same law for 1 <= Re' <= 142.
+  [[gnu::always_inline]] static DragCurve at(double re)
+  {
+    if (re < zhang_li_low) return {24.0 + 5.315 * re, 5.315 * re};
+    if (29.12 + 0.195 * re >= 0.4 * re) return {29.12 + 0.195 * re, 0.195 * re};
+    return {0.4 * re, 0.4 * re};
+  }
+};
+
+// The list's columns of one law, and where its curve jumps.
+struct DragLawTraits {
+  const char *name;
+  DragLaw curve;               // the law whose LawCurve it takes
+  Hindrance own_hindrance;     // None: the deck's
+  HindranceSet hindrances;     // those a deck may name
+  bool bingham_fluid;          // a law for a sphere in a Bingham fluid
+  CurveJumps jumps;
+};
+inline constexpr DragLawTraits drag_law_table[] = {
+#define SEDIMENT_LAW_TRAITS(Law, name, Curve, own_hindrance, hindrances, bingham_fluid) \
+  {name, DragLaw::Curve, Hindrance::own_hindrance, hindrances, bingham_fluid, LawCurve<DragLaw::Curve>::jumps},
+    SEDIMENT_DRAG_LAWS(SEDIMENT_LAW_TRAITS)
+#undef SEDIMENT_LAW_TRAITS
+};
+constexpr const DragLawTraits &drag_law_traits(DragLaw law) { return drag_law_table[static_cast<int>(law)]; }
+// The names of the laws whose traits pass `keep`, the last after " or " (for error messages).
+std::string drag_law_names(bool (*keep)(const DragLawTraits &));
+
+// A branch per law for the switches on a law chosen at run time (drag_curve, DragModel::single_curves),
+// which are given a law whose curve is its own: a law built on another's curve takes none, so that
+// each curve's code is there once, as the per-block loops want it (drag_law_table's static_assert).
+#define SEDIMENT_CURVE_BRANCH(Law, Curve, ...)                               \
+  case DragLaw::Law:                                                         \
+    if constexpr (DragLaw::Law != DragLaw::Curve) __builtin_unreachable(); \
+    return __VA_ARGS__;
+
+// Cd Re' and Re' (Cd Re')' of a law's own curve (a DragModel's single_law(); of any law:
+// drag_law_traits(law).curve).
 [[gnu::always_inline]] inline DragCurve drag_curve(DragLaw law, double re)
 {
   switch (law) {
-    case DragLaw::Stokes:
-      return {24.0, 0.0};
-    case DragLaw::SchillerNaumann:
-      return schiller_naumann_curve(re, re <= schiller_naumann_switch ? std::pow(re, schiller_naumann_exponent) : 0.0);
-    case DragLaw::Standard:
-    case DragLaw::Bingham:    // the plastic viscosity's part; yield_curve() gives the yield stress's
-      return standard_curve::curve(re);
-    case DragLaw::Dallavalle:
-    case DragLaw::DiFelice: {    // the single-sphere curve; hindrance is applied per sphere
-      // Cd = (0.63 + 4.8 / sqrt(Re))^2  =>  Cd Re = (0.63 sqrt(Re) + 4.8)^2
-      const double root = std::sqrt(re);
-      const double inner = 0.63 * root + 4.8;
-      return {inner * inner, 0.63 * inner * root};
-    }
-    case DragLaw::ZhangLi:
-      if (re < zhang_li_low) return {24.0, 0.0};
-      if (re <= zhang_li_high) return {29.12 + 0.195 * re, 0.195 * re};
-      return {0.4 * re, 0.4 * re};
-    case DragLaw::ZhangLiSmooth:
-      // Continuous variant: a linear ramp of Cd Re from 24 to 29.315 over Re' < 1, then
-      // Cd = max(29.12 / Re' + 0.195, 0.4). Same static force and same law for 1 <= Re' <= 142.
-      if (re < zhang_li_low) return {24.0 + 5.315 * re, 5.315 * re};
-      if (29.12 + 0.195 * re >= 0.4 * re) return {29.12 + 0.195 * re, 0.195 * re};
-      return {0.4 * re, 0.4 * re};
+#define SEDIMENT_LAW_CURVE(Law, name, Curve, ...) SEDIMENT_CURVE_BRANCH(Law, Curve, LawCurve<DragLaw::Curve>::at(re))
+    SEDIMENT_DRAG_LAWS(SEDIMENT_LAW_CURVE)
+#undef SEDIMENT_LAW_CURVE
   }
   return {24.0, 0.0};
 }
@@ -268,16 +378,16 @@ inline Exponent richardson_zaki_exponent_at(const ExponentFit &fit, double re)
 
 class DragModel {
  public:
-  static constexpr int max_jumps = 2;
+  static constexpr int max_jumps = max_curve_jumps;
 
-  // law DiFelice is Dallavalle's curve with the Di Felice hindrance, whatever `hindrance` says;
-  // any other law takes `hindrance` (law_takes_hindrance must hold). `bingham` takes its fitted
+  // A law that carries a hindrance (difelice) takes it whatever `hindrance` says; any other law
+  // takes `hindrance` (law_takes_hindrance must hold). `bingham` takes its fitted
   // constants (another set: benchmarks/fit_bingham.py trying them).
   DragModel(DragLaw law, const Fluid &fluid, HindranceBuoyancy buoyancy = HindranceBuoyancy::Plain,
             Hindrance hindrance = Hindrance::None, bingham_law::Constants bingham = bingham_law::fitted);
 
   DragLaw law() const { return law_; }
-  DragLaw single_law() const { return single_law_; }    // the single-sphere curve (Dallavalle's for DiFelice)
+  DragLaw single_law() const { return single_law_; }    // whose single-sphere curve (Dallavalle's for DiFelice)
   Hindrance hindrance() const { return hindrance_; }
   const Fluid &fluid() const { return fluid_; }
 
@@ -321,10 +431,7 @@ class DragModel {
   }
   double yield_speed(double d) const { return yield_per_viscosity_ * d; }
   // The Reynolds numbers Re' at which Cd jumps (where a step may have to stop: jumps()), in increasing order.
-  struct Switches {
-    int count = 0;
-    double reynolds[max_jumps] = {0.0, 0.0};
-  };
+  using Switches = CurveJumps;
   const Switches &switches() const { return switches_; }
   // Cd Re' of the law at this sphere, with the hindrance when it applies.
   DragCurve curve(double re, double voidage) const
@@ -359,38 +466,10 @@ class DragModel {
   [[gnu::always_inline]] void single_curves(const double *re, DragCurve *out, int n, BatchMath kind) const
   {
     switch (single_law_) {
-      case DragLaw::Dallavalle:
-      case DragLaw::DiFelice:
-        return curves_of<DragLaw::Dallavalle>(re, out, n);
-      case DragLaw::ZhangLi:
-        return curves_of<DragLaw::ZhangLi>(re, out, n);
-      case DragLaw::ZhangLiSmooth:
-        return curves_of<DragLaw::ZhangLiSmooth>(re, out, n);
-      case DragLaw::Stokes:
-        return curves_of<DragLaw::Stokes>(re, out, n);
-      case DragLaw::SchillerNaumann: {
-        constexpr int chunk = 64;
-        double power[chunk];
-        for (int start = 0; start < n; start += chunk) {
-          const int m = std::min(n - start, chunk);
-          log_many(re + start, power, m, kind);    // Re = 0: ln 0 = -inf, and e^-inf = 0 = 0^0.687
-          for (int j = 0; j < m; ++j) power[j] *= schiller_naumann_exponent;
-          exp_many(power, power, m, kind);
-          for (int j = 0; j < m; ++j) out[start + j] = schiller_naumann_curve(re[start + j], power[j]);
-        }
-        return;
-      }
-      case DragLaw::Standard:
-      case DragLaw::Bingham: {
-        constexpr int chunk = 64;
-        double log_re[chunk];
-        for (int start = 0; start < n; start += chunk) {
-          const int m = std::min(n - start, chunk);
-          log_many(re + start, log_re, m, kind);
-          standard_curves(re + start, log_re, out + start, m, kind);
-        }
-        return;
-      }
+#define SEDIMENT_LAW_CURVES(Law, name, Curve, ...) \
+  SEDIMENT_CURVE_BRANCH(Law, Curve, curves_of<DragLaw::Curve>(re, out, n, kind))
+      SEDIMENT_DRAG_LAWS(SEDIMENT_LAW_CURVES)
+#undef SEDIMENT_LAW_CURVES
     }
   }
   // The standard curve of m <= 64 spheres from their Re and ln Re (log_re is overwritten).
@@ -511,10 +590,31 @@ class DragModel {
   int jumps(double d, std::array<ForceJump, max_jumps> &out, DragScale scale = {}) const;
 
  private:
-  // single_curves' loop for one law, fixed at compile time.
-  template <DragLaw law> [[gnu::always_inline]] static void curves_of(const double *re, DragCurve *out, int n)
+  // single_curves' loops for one law's curve, fixed at compile time: a sphere at a time, or for the
+  // curves with a power of Re, the powers of a chunk from exp_many and log_many of this kind.
+  template <DragLaw law>
+  [[gnu::always_inline]] static void curves_of(const double *re, DragCurve *out, int n, BatchMath kind)
   {
-    for (int k = 0; k < n; ++k) out[k] = drag_curve(law, re[k]);
+    constexpr int chunk = 64;
+    if constexpr (law == DragLaw::SchillerNaumann) {
+      double power[chunk];
+      for (int start = 0; start < n; start += chunk) {
+        const int m = std::min(n - start, chunk);
+        log_many(re + start, power, m, kind);    // Re = 0: ln 0 = -inf, and e^-inf = 0 = 0^0.687
+        for (int j = 0; j < m; ++j) power[j] *= schiller_naumann_exponent;
+        exp_many(power, power, m, kind);
+        for (int j = 0; j < m; ++j) out[start + j] = schiller_naumann_curve(re[start + j], power[j]);
+      }
+    } else if constexpr (law == DragLaw::Standard) {
+      double log_re[chunk];
+      for (int start = 0; start < n; start += chunk) {
+        const int m = std::min(n - start, chunk);
+        log_many(re + start, log_re, m, kind);
+        standard_curves(re + start, log_re, out + start, m, kind);
+      }
+    } else {
+      for (int k = 0; k < n; ++k) out[k] = LawCurve<law>::at(re[k]);
+    }
   }
   bool hindered(double voidage) const { return hindrance_ != Hindrance::None && !(voidage >= 1.0); }
   // G eps^-(chi(Re) + offset), factor = eps^-(chi + offset): the exponent depends on Re, so the

@@ -4,6 +4,10 @@
 
 namespace sediment {
 
+// Boltzmann's constant [J/K], exact in the SI since 2019: the water's thermal agitation, which moves
+// the finest grains (Stokes-Einstein diffusion; Python reads it as sediment.constants.BOLTZMANN).
+constexpr double boltzmann = 1.380649e-23;
+
 // The range of temperatures [deg C] over which both correlations hold.
 constexpr double water_min_temperature = 0.0;
 constexpr double water_max_temperature = 40.0;

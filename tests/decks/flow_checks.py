@@ -1,0 +1,238 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
+"""Deck tests of the two-way coupling (fix fluid/flow): registered with the others of checks.py
+(harness.check), run as `python3 checks.py NAME [--np N]`."""
+from __future__ import annotations
+
+import math
+import tempfile
+from pathlib import Path
+
+import numpy as np
+
+from harness import HERE, G, check, report, run_deck
+
+try:    # (the harness puts python/ on the path)
+    from sediment import _core
+except ImportError:    # listing the checks, at configure time before the build, needs none
+    _core = None
+
+
+# ---- two-way coupling: fix fluid/flow ------------------------------------------------------------
+CLOUD_DECK = HERE.parents[1] / "examples" / "falling_cloud" / "in.falling_cloud"
+
+
+def cloud_result(np_ranks: int, tmp: Path, **variables) -> dict:
+    out = run_deck(CLOUD_DECK, variables, np_ranks, cwd=tmp)
+    line = next(line for line in out.text.splitlines() if line.startswith("RESULT "))
+    words = line.split()[1:]
+    return {key: float(value) for key, value in zip(words[::2], words[1::2])}
+
+
+@check
+def falling_cloud(np_ranks: int):
+    """A spherical cloud of N spheres settles for N a / R >> 1 as a drop, U = U_s (1 + 6/5 N a / R)
+    (Nitsche & Batchelor 1997), in the periodic box less Hasimoto's return flow, -2.837 N a U_s / L:
+    the example deck, for N a / R = 5, 20 and 50 (a = R / 100: a dilute cloud, 0.5 % solids at most).
+    The kernel (sigma = one cell) smooths the cloud's edge and its pair interactions, which slows it
+    by about 2.2 (sigma / R)^2 (measured at R / sigma = 4, 6, 8, 12: 13.9, 6.3, 3.2, 0.8 % for N a / R = 20);
+    the check extrapolates R / sigma = 4 and 6 (32 and 48 cells, box L = 8 R) to sigma -> 0 as
+    (sigma / R)^2 and asks that within 3 % of the prediction: what remains is the random cloud's
+    own spread (one seed), O((R / L)^3) = 0.4 % of the box and the O(a / d) discreteness."""
+    worst = 0.0
+    with tempfile.TemporaryDirectory() as tmp:
+        for n, na_r in ((500, 5), (2000, 20), (5000, 50)):
+            coarse = cloud_result(np_ranks, Path(tmp), n=n, na_r=na_r, cells=32)
+            fine = cloud_result(np_ranks, Path(tmp), n=n, na_r=na_r, cells=48)
+            extrapolated = fine["speed"] + (fine["speed"] - coarse["speed"]) / (1.5 ** 2 - 1)
+            ratio = extrapolated / fine["predicted"]
+            report(f"cloud N={n} Na/R={na_r}: U/U_s {coarse['speed'] / fine['us']:.3f} (R/sigma 4), "
+                   f"{fine['speed'] / fine['us']:.3f} (R/sigma 6), extrapolated {extrapolated / fine['us']:.3f}; "
+                   f"Nitsche & Batchelor {fine['drop'] / fine['us']:.3f}, with the box's return flow "
+                   f"{fine['predicted'] / fine['us']:.3f}: ratio {ratio:.4f}; largest mean u_z over a plane "
+                   f"{fine['flux']:.1e} m/s (grid's largest {fine['peak']:.1e})")
+            worst = max(worst, abs(ratio - 1))
+            # converging from below (the smoothing slows the cloud), and no net flux through any plane
+            assert coarse["speed"] < fine["speed"] < 1.03 * fine["predicted"]
+            assert abs(ratio - 1) < 0.03
+            assert fine["flux"] < 1e-12 * fine["peak"] and coarse["flux"] < 1e-12 * coarse["peak"]
+    report(f"falling cloud: worst extrapolated speed {worst:.2%} off the prediction")
+
+
+def flow_data(path: Path, positions: np.ndarray, types: np.ndarray, box: tuple[float, float, float]) -> None:
+    n = len(positions)
+    atoms = np.column_stack([np.arange(1, n + 1), types, np.full(n, 2e-4), np.full(n, 1100.0), positions])
+    with open(path, "w") as f:
+        f.write(f"settling cloud\n\n{n} atoms\n2 atom types\n\n0 {box[0]} xlo xhi\n0 {box[1]} ylo yhi\n"
+                f"0 {box[2]} zlo zhi\n\nAtoms # sphere\n\n")
+        np.savetxt(f, atoms, fmt=["%d", "%d", "%.17g", "%.17g", "%.17g", "%.17g", "%.17g"])
+
+
+def cloud_positions(n: int, centre: tuple[float, float, float], radius: float, seed: int) -> np.ndarray:
+    rng = np.random.default_rng(seed)
+    points = rng.uniform(-1, 1, (4 * n, 3))
+    points = points[np.einsum("ij,ij->i", points, points) < 1][:n]
+    return np.asarray(centre) + radius * points
+
+
+@check
+def flow_column_mirror(np_ranks: int):
+    """The closed column (free slip at bottom and top by mirror images) is the periodic box twice as
+    tall holding the spheres and their mirror images (which rise): the same state to round-off. The
+    cloud sits near the bottom, so the bottom's image matters (it slows the cloud)."""
+    height, side = 0.016, 0.016
+    real = cloud_positions(300, (side / 2, side / 2, 0.25 * height), 0.003, 7)
+    with tempfile.TemporaryDirectory() as tmp:
+        tmp = Path(tmp)
+        flow_data(tmp / "column.data", real, np.ones(len(real)), (side, side, height))
+        mirrored = real * [1, 1, -1] + [0, 0, 2 * height]
+        flow_data(tmp / "mirror.data", np.vstack([real, mirrored]), np.r_[np.ones(len(real)), 2 * np.ones(len(real))],
+                  (side, side, 2 * height))
+        states = {}
+        for mode in ("column", "mirror", "periodic"):
+            data = tmp / ("column.data" if mode != "mirror" else "mirror.data")
+            if mode == "periodic":    # the same cloud in a periodic box as tall as the column
+                flow_data(tmp / "periodic.data", real, np.ones(len(real)), (side, side, height))
+                data = tmp / "periodic.data"
+            run_deck("fluid_flow.lmp", {"data": data, "mode": mode, "state": tmp / f"{mode}.txt", "phase": "whole"},
+                     np_ranks, cwd=tmp)
+            states[mode] = np.loadtxt(tmp / f"{mode}.txt", skiprows=9)
+    column, mirror, periodic = states["column"], states["mirror"][: len(real)], states["periodic"]
+    scale = np.abs(column[:, 4:10]).max()
+    diff = float(np.abs(column[:, 4:10] - mirror[:, 4:10]).max() / scale)
+    images = states["mirror"][len(real):]
+    image_vz = float(images[:, 6].mean())
+    report(f"column vs its explicit mirror image, {len(real)} spheres: max difference in v and u {diff:.1e} "
+           f"(of {scale:.2e} m/s); mean v_z: column {column[:, 6].mean():.4e}, images {image_vz:.4e} (rising), "
+           f"periodic box {periodic[:, 6].mean():.4e} m/s")
+    assert diff < 1e-9
+    assert abs(image_vz + column[:, 6].mean()) < 1e-9 * scale
+    # the bottom slows the cloud against the periodic box of the same height
+    assert column[:, 6].mean() > periodic[:, 6].mean()
+
+
+@check
+def flow_unstable_lag(np_ranks: int):
+    """A step far below the spheres' relaxation time with a strongly collective cloud (N a / R = 10,
+    K about 12) makes the lagged flow reverse and grow from solve to solve: the run stops with an
+    error naming relax (not a result gone wrong, nor atoms lost). relax below 1 / (1 + K) runs it."""
+    deck = """units si
+atom_style sphere
+atom_modify map array
+boundary p p p
+region box block 0 0.048 0 0.048 0 0.048
+create_box 1 box
+region cloud sphere 0.024 0.024 0.024 0.006
+create_atoms 1 random 1000 4321 cloud
+set group all diameter 1.2e-4 density 1100
+comm_modify cutoff 0.006
+fix grav all gravity 9.81 vector 0 0 -1
+fix water all fluid density 1000 viscosity 1e-3
+fix buoy all fluid/buoyancy water
+fix drag all fluid/drag water law stokes
+fix flow all fluid/flow water grid 32 32 32 relax ${relax}
+fix step all nve/sphere/fluid
+timestep 8e-5
+thermo 10
+run 200
+print "RESULT peak $(f_flow[5])"
+"""
+    with tempfile.TemporaryDirectory() as tmp:
+        path = Path(tmp) / "lag.lmp"
+        path.write_text(deck)
+        out = run_deck(path, {"relax": 1}, np_ranks, expect_failure=True, cwd=Path(tmp))
+        assert "the lagged flow is unstable at this time step; use relax" in out.text, out.error
+        stable = run_deck(path, {"relax": 0.05}, np_ranks, cwd=Path(tmp))
+        report(f"lagged flow at dt = tau / 10, K about 12: relax 1 stopped ({out.error.strip()[:90]}...); "
+               f"relax 0.05 ran, largest fluid velocity {stable.results['peak']:.3g} m/s")
+        assert 0 < stable.results["peak"] < 0.1
+
+
+def hard_sphere_suspension(n: int, phi: float, d: float, seed: int) -> tuple[np.ndarray, float]:
+    """n spheres of diameter d at solid fraction phi in a periodic cube, placed one by one at random
+    where they overlap none placed before (random sequential addition): positions and the side."""
+    side = (n * math.pi / 6 * d ** 3 / phi) ** (1 / 3)
+    cells = max(1, int(side // d))
+    width = side / cells
+    rng = np.random.default_rng(seed)
+    placed: list[np.ndarray] = []
+    bins: dict[tuple[int, int, int], list[int]] = {}
+    offsets = [(a, b, c) for a in (-1, 0, 1) for b in (-1, 0, 1) for c in (-1, 0, 1)]
+    while len(placed) < n:
+        point = rng.uniform(0.0, side, 3)
+        home = tuple(int(v) % cells for v in point // width)
+        near = [j for o in offsets for j in bins.get(tuple((h + k) % cells for h, k in zip(home, o)), [])]
+        if near:
+            gap = np.asarray([placed[j] for j in near]) - point
+            gap -= side * np.round(gap / side)
+            if np.einsum("ij,ij->i", gap, gap).min() < d * d:
+                continue
+        bins.setdefault(home, []).append(len(placed))
+        placed.append(point)
+    return np.asarray(placed), side
+
+
+@check
+def suspension_flow(np_ranks: int):
+    """A homogeneous suspension (hard spheres at random, 0.5-5 % solids) under Richardson & Zaki's
+    hindrance settles as fast with the flow it drives (fix fluid/flow) as without: the grid's flow
+    averages to nothing over a homogeneous suspension but for each sphere's own force and images and
+    the neighbours kept clear of it, which the closure takes out (docs/physics.md section 8), so the
+    suspension is not hindered twice. Without the closure (the unbounded self-flow subtracted, as
+    before it) the same suspensions settled 2.6, 3.4, 4.4 and 8.1 % too slowly. One configuration's mean speed
+    varies by about 1.5 % with the box-scale fluctuation of its density (the flow of a box-scale
+    density wave, which the grid resolves); the mean over 6 configurations is within 1 % of the
+    hindered speed without flow, and each within 5 %."""
+    d, n, seeds = 2e-5, 2000, range(1, 7)
+    hindered = _core.DragModel("stokes", 1000.0, 1e-3, hindrance="richardson-zaki")
+    weight = 1650.0 * G * math.pi / 6 * d ** 3
+    with tempfile.TemporaryDirectory() as tmp:
+        tmp = Path(tmp)
+        for phi in (0.005, 0.01, 0.02, 0.05):
+            expected = hindered.steady_speed(d, weight, 1 - phi)[0]
+            ratios = []
+            for seed in seeds:
+                positions, side = hard_sphere_suspension(n, phi, d, seed)
+                data = tmp / "suspension.data"
+                atoms = np.column_stack([np.arange(1, n + 1), np.ones(n), np.full(n, d), np.full(n, 2650.0), positions])
+                with open(data, "w") as f:
+                    f.write(f"suspension\n\n{n} atoms\n1 atom types\n\n0 {side} xlo xhi\n0 {side} ylo yhi\n"
+                            f"0 {side} zlo zhi\n\nAtoms # sphere\n\n")
+                    np.savetxt(f, atoms, fmt=["%d", "%d", "%.17g", "%.17g", "%.17g", "%.17g", "%.17g"])
+                out = run_deck("suspension_flow.lmp", {"data": data, "cells": 8}, np_ranks, cwd=tmp)
+                assert abs(out.results["phi"] - phi) < 1e-9
+                ratios.append(out.results["speed"] / expected)
+            mean = float(np.mean(ratios))
+            report(f"suspension phi={phi}: speed with flow / Richardson & Zaki's {mean:.4f} over {len(ratios)} "
+                   f"configurations (each {min(ratios):.4f} to {max(ratios):.4f}, standard error "
+                   f"{np.std(ratios, ddof=1) / math.sqrt(len(ratios)):.4f})")
+            assert abs(mean - 1) < 0.01
+            assert max(abs(r - 1) for r in ratios) < 0.05
+
+
+@check
+def flow_restart(np_ranks: int):
+    """2N steps in one run vs N steps + write_restart + read_restart in a new process + N steps: the
+    per-atom fluid velocity comes back with the restart, so the flow carries on as if never stopped."""
+    with tempfile.TemporaryDirectory() as tmp:
+        tmp = Path(tmp)
+        flow_data(tmp / "cloud.data", cloud_positions(400, (0.008, 0.008, 0.008), 0.003, 3), np.ones(400),
+                  (0.016, 0.016, 0.016))
+        common = {"data": tmp / "cloud.data", "restart": tmp / "flow.restart"}
+        run_deck("fluid_flow.lmp", {**common, "phase": "whole", "state": tmp / "whole.txt"}, np_ranks, cwd=tmp)
+        run_deck("fluid_flow.lmp", {**common, "phase": "first"}, np_ranks, cwd=tmp)
+        run_deck("fluid_flow.lmp", {**common, "phase": "second", "state": tmp / "split.txt"}, np_ranks, cwd=tmp)
+        whole, split = np.loadtxt(tmp / "whole.txt", skiprows=9), np.loadtxt(tmp / "split.txt", skiprows=9)
+    scale = np.abs(whole[:, 4:10]).max()
+    diff = float(np.abs(whole[:, 1:] - split[:, 1:]).max())
+    report(f"flow restart: {len(whole)} spheres, split vs whole max difference {diff:.1e} (speeds up to {scale:.1e} m/s)")
+    assert whole.shape == split.shape and diff <= 1e-12 * max(scale, 1e-3)
+
+
+@check(ranks=())
+def flow_ranks(np_ranks: int):
+    """The falling cloud on 1 and 2 ranks: the same speed to round-off (the reduce-scatter and the
+    FFT's remaps sum in another order)."""
+    with tempfile.TemporaryDirectory() as tmp:
+        one, two = (cloud_result(ranks, Path(tmp), n=1000, cells=32)["speed"] for ranks in (1, 2))
+    report(f"cloud speed on 1 rank {one!r}, on 2 ranks {two!r}: relative difference {abs(one - two) / one:.1e}")
+    assert abs(one - two) < 1e-10 * one
