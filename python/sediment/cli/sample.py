@@ -103,7 +103,8 @@ def cylinder_of(args: argparse.Namespace):
 def run(args: argparse.Namespace) -> int:
     """Plans the scene, prints it and writes its data file, deck and PSD tables."""
     from ..lab.psd import read_psd
-    from ..sim.scene import describe, plan, runs_replaced, write
+    from ..sim.scene import plan
+    from ..sim.scenefiles import describe, runs_replaced, write
 
     psd = read_psd(args.psd)
     record = ()

@@ -249,7 +249,8 @@ class Column:
 
 @dataclass
 class Readings:
-    """What one instrument read at its reading times, and the PSD points it gives."""
+    """What one instrument read at its reading times, and the PSD points it gives (named, with its
+    table's heading, by the instrument's class in lab/instruments.py)."""
 
     instrument: str
     time: np.ndarray        # s
@@ -258,13 +259,13 @@ class Readings:
     diameter: np.ndarray    # m
     percent_finer: np.ndarray
     band: float = 0.0       # pp either side that the physics' uncertainty puts around each reading (error budget)
+    heading: str = "reading"    # the table's column of the readings, with their unit
 
     def table(self) -> Table:
         """Time [min], depth [cm], reading, diameter [um] and percent finer per reading (with a band: its
         low and high ends)."""
-        unit = {"hydrometer": "R [g/L]", "buoyancy": "m_app [g]", "pipette": "c [g/L]"}[self.instrument]
         banded = ["low", "high"] if self.band > 0 else []
-        table = Table(["time_min", "depth_cm", unit, "diameter_um", "percent_finer", *banded])
+        table = Table(["time_min", "depth_cm", self.heading, "diameter_um", "percent_finer", *banded])
         for row in zip(self.time / 60, self.depth * 100, self.reading, self.diameter * 1e6, self.percent_finer):
             ends = [row[-1] - self.band, row[-1] + self.band] if self.band > 0 else []
             table.add(*map(float, row), *ends)
@@ -444,7 +445,7 @@ class Hydrometer:
             # takes it less its companion cylinder's
             rows.append((t, depth, reading, water.stokes_diameter(depth, t),
                          _percent((reading - self.blank(water.fluid_density)) * a, c0)))
-        return _readings("hydrometer", rows)
+        return _readings(rows)
 
 
 @dataclass(frozen=True)
@@ -481,7 +482,7 @@ class BuoyancySphere:
             concentration = self.solids(apparent, suspension.fluid_density, suspension.specific_gravity)
             rows.append((t, self.depth, apparent * 1e3, suspension.stokes_diameter(self.depth, t),
                          _percent(concentration, c0)))
-        return _readings("buoyancy", rows)
+        return _readings(rows)
 
 
 @dataclass(frozen=True)
@@ -504,7 +505,7 @@ class Pipette:
             concentration = suspension.particle_density * column.weighted_mean(t, self.depth, radius, disc=disc)
             rows.append((t, self.depth, concentration, suspension.stokes_diameter(self.depth, t),
                          _percent(concentration, c0)))
-        return _readings("pipette", rows)
+        return _readings(rows)
 
     def default_times(self, suspension: Suspension) -> np.ndarray:
         """Stokes times of 50, 20, 10, 5 and 2 um at the pipette depth."""
@@ -520,9 +521,9 @@ def _percent(concentration: float, initial: float) -> float:
     return 100 * concentration / initial if initial > 0 else float("nan")    # no solids: undefined
 
 
-def _readings(name: str, rows: list[tuple]) -> Readings:
+def _readings(rows: list[tuple]) -> Readings:
     data = np.array(rows, float).reshape(-1, 5)
-    return Readings(name, *(data[:, k] for k in range(5)))
+    return Readings("", *(data[:, k] for k in range(5)))    # the registry names them (lab/instruments.py)
 
 
 def _fits(column: Column, depth: float, radius: float, what: str) -> None:
