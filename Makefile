@@ -53,8 +53,10 @@ test-cpp: build
 
 # The test files in $(JOBS) workers (pytest-xdist): most tests wait on one single-rank LAMMPS run or on
 # Python, so one worker leaves a core idle. No test's outcome depends on the clock or the load; the
-# tests of the installed package share one worker and its venv.
+# tests of the installed package share one worker and its venv. First the package's imports point one
+# way (scripts/check-imports.py, docs/layout.md).
 test-python: build
+	$(PYTHON) scripts/check-imports.py
 	PYTHONPATH=python SEDIMENT_LMP=$(abspath $(BUILD))/lmp_sediment $(PYTHON) -m pytest -q -n $(JOBS) --dist loadgroup \
 	  tests/python
 
