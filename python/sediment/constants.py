@@ -14,6 +14,7 @@ SOIL_PARTICLE_DENSITY = 2650.0    # kg/m3, Gs = 2.65: what the 152H hydrometer i
 D422_CYLINDER_AREA = 27.8e-4      # m2, ASTM D422 cylinder (inner diameter 5.95 cm)
 D422_CYLINDER_HEIGHT = 0.36       # m, the 1000 mL mark
 SUSPENSION_VOLUME = 1e-3          # m3, the sedimentation tests' 1000 mL
+SPECIMEN_MASS = 0.060             # kg, the dry sample of a test unless one is given (60 g/L)
 NOMINAL_BULB_LENGTH = 0.140       # m, the 152H of D422
 NOMINAL_BULB_VOLUME = 67.0e-6     # m3
 BRAVO_CYLINDER_WIDTH = 0.0635     # m, Bravo et al. (2015)
@@ -35,6 +36,7 @@ HYDROMETER_NOISE = 0.25           # g/L
 BALANCE_NOISE = 1e-3              # g
 PIPETTE_NOISE = 1e-4              # g of a sample
 SIEVE_NOISE = 0.5                 # points
+THERMOMETER_NOISE = 0.5           # C, of the temperature record
 
 # Names the command line offers before the C++ core is loaded (its --help works before a build);
 # tests/python/test_cli.py checks them against the core's own lists.

@@ -9,7 +9,7 @@ from pathlib import Path
 
 from ..constants import (BALANCE_NOISE, D422_CYLINDER_AREA, HYDROMETER_NOISE, HYDROMETER_TYPES, NOMINAL_BULB_LENGTH,
                          NOMINAL_BULB_VOLUME, PIPETTE_NOISE, PIPETTE_VOLUME, SIEVE_NOISE, SOIL_PARTICLE_DENSITY,
-                         SPHERE_DIAMETER, SPHERE_MASS, SUSPENSION_VOLUME)
+                         SPECIMEN_MASS, SPHERE_DIAMETER, SPHERE_MASS, SUSPENSION_VOLUME, THERMOMETER_NOISE)
 from ..results import write_text
 from .types import count, finite, quantity, quantity_list
 
@@ -115,7 +115,7 @@ def add_parser(commands) -> argparse.ArgumentParser:
     parser.add_argument("--sieve-noise", type=quantity("sieve_noise"), default=SIEVE_NOISE,
                         help="standard uncertainty of a sieve's percent passing [points] (default 0.5)")
     parser.add_argument("--thermometer", type=quantity("thermometer"),
-                        default=0.5, help="of the temperature record [C]")
+                        default=THERMOMETER_NOISE, help="of the temperature record [C]")
     parser.add_argument("--budget", type=Path, help="budget.json of `sediment budget` for this test: its physical "
                         "total widens the band")
     parser.add_argument("--budget-sample", metavar="NAME", help="the sample of a budget.json that holds several")
@@ -161,11 +161,12 @@ def run(args: argparse.Namespace) -> int:
         raise ValueError(sphere)
     scale = SCALES[args.hydrometer_type]
     hydrometer_noise, zero_correction, meniscus = (
-        hydrometer_step(args, "hydrometer_noise", "hydrometer_noise", HYDROMETER_NOISE), hydrometer_step(args, "zero_correction"),
+        hydrometer_step(args, "hydrometer_noise", "hydrometer_noise", HYDROMETER_NOISE),
+        hydrometer_step(args, "zero_correction"),
         hydrometer_step(args, "meniscus"))
     noise = {"hydrometer": hydrometer_noise, "buoyancy": args.balance_noise,
              "pipette": args.pipette_noise / (args.pipette_volume * 1e3), "sieve": args.sieve_noise}
-    test = LabTest(0.060 if mass is None else mass, args.particle_density, args.cylinder_area, height,
+    test = LabTest(SPECIMEN_MASS if mass is None else mass, args.particle_density, args.cylinder_area, height,
                    hydrometer=hydrometer(args), zero_correction=zero_correction, meniscus=meniscus,
                    sphere_depth=args.sphere_depth, sphere_diameter=args.sphere_diameter, sphere_mass=args.sphere_mass,
                    noise=noise, thermometer=args.thermometer)

@@ -8,8 +8,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ..constants import (D422_CYLINDER_AREA, D422_CYLINDER_HEIGHT, INSTRUMENTS, PIPETTE_DEPTH, PIPETTE_VOLUME, SCHEDULES,
-                         SOIL_PARTICLE_DENSITY)
+from ..constants import (D422_CYLINDER_AREA, D422_CYLINDER_HEIGHT, INSTRUMENTS, PIPETTE_DEPTH, PIPETTE_VOLUME,
+                         SCHEDULES, SOIL_PARTICLE_DENSITY)
 from .types import positive, quantity, temperature
 
 

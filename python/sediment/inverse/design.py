@@ -9,7 +9,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..constants import LAB_TEMPERATURE, PIPETTE_DEPTH, SCHEDULES
+from ..constants import LAB_TEMPERATURE, PIPETTE_DEPTH, SCHEDULES, SPECIMEN_MASS
 from ..lab.instruments import instrument
 from ..lab.psd import PSD
 from ..lab.readout import Pipette, Suspension, gs_correction
@@ -32,7 +32,7 @@ DESIGNS = {
 
 
 def design_test(psd: PSD, folder: Path, masses=(0.030, 0.045, 0.060, 0.080), designs: dict = DESIGNS,
-                test: LabTest = LabTest(0.060), bins: int = 12, draws: int = 24, particles: int = 20000,
+                test: LabTest = LabTest(SPECIMEN_MASS), bins: int = 12, draws: int = 24, particles: int = 20000,
                 seed: int = 1) -> list[tuple[str, float, int, float, float]]:
     """Which instrument, reading times and sample mass recover `psd` best: for each mass a forward run of
     the test, each design's readings of it with their noise drawn `draws` times and fitted as `invert`

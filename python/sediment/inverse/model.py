@@ -12,7 +12,7 @@ import numpy as np
 
 from .. import _core
 from ..constants import (D422_CYLINDER_AREA, D422_CYLINDER_HEIGHT, SIEVE_NOISE, SOIL_PARTICLE_DENSITY,
-                         SPHERE_DEPTH_SHARE, SPHERE_DIAMETER, SPHERE_MASS)
+                         SPHERE_DEPTH_SHARE, SPHERE_DIAMETER, SPHERE_MASS, THERMOMETER_NOISE)
 from ..lab.instruments import INSTRUMENTS, instrument
 from ..lab.psd import PSD
 from ..lab.readout import BuoyancySphere, Column, Hydrometer, Suspension
@@ -40,7 +40,7 @@ class LabTest:
     # reading noise per instrument, in the unit the inverse takes its readings in (the instruments' defaults)
     noise: dict = field(default_factory=lambda: {name: i.noise for name, i in INSTRUMENTS.items()}
                                                 | {"sieve": SIEVE_NOISE})
-    thermometer: float = 0.5             # C, standard uncertainty of the temperature record
+    thermometer: float = THERMOMETER_NOISE    # C, standard uncertainty of the temperature record
 
     @property
     def initial_concentration(self) -> float:

@@ -198,8 +198,8 @@ class HydrometerTest(Instrument):
         return out
 
     def linear(self, test, temperature):
-        n = len(temperature)
-        return np.zeros(n), np.full(n, test.initial_concentration / (100 * gs_correction(test.particle_density / 1000.0)))
+        per_percent = test.initial_concentration / (100 * gs_correction(test.particle_density / 1000.0))
+        return np.zeros(len(temperature)), np.full(len(temperature), per_percent)
 
     def sheet_unit(self, scale):
         return scale.unit

@@ -18,7 +18,7 @@ import numpy as np
 from .. import _core
 from ..results import Table, write_text
 from ..constants import (D422_CYLINDER_AREA, GRAVITY, LAB_TEMPERATURE, NOMINAL_BULB_LENGTH, NOMINAL_BULB_VOLUME,
-                         SCHEDULES, SOIL_PARTICLE_DENSITY,
+                         PIPETTE_VOLUME, SCHEDULES, SOIL_PARTICLE_DENSITY, SPHERE_DIAMETER, SPHERE_MASS,
                          WATER_20C_DENSITY, WATER_20C_VISCOSITY)
 
 R_FACTOR = 1 - 1 / 2.65    # 152H: R = (rho_s - rho_w) / 0.6226 in g/L, calibrated for Gs = 2.65
@@ -454,8 +454,8 @@ class BuoyancySphere:
     Teflon sphere of 25 mm and 20 g, so the apparent mass is what the balance shows (11.8 g in water)."""
 
     depth: float
-    diameter: float = 0.025
-    mass: float = 0.020     # its own mass [kg]; shifts the apparent mass, not the percent finer
+    diameter: float = SPHERE_DIAMETER
+    mass: float = SPHERE_MASS    # its own mass [kg]; shifts the apparent mass, not the percent finer
 
     @property
     def volume(self) -> float:
@@ -491,7 +491,7 @@ class Pipette:
     slab (the cylinder's axial section) its section through the axis, a circle of the same radius."""
 
     depth: float
-    volume: float = 25e-6
+    volume: float = PIPETTE_VOLUME
 
     def read(self, column: Column, times_s) -> Readings:
         """Solids concentration [g/L] drawn at each time, with the diameter and percent finer it gives."""

@@ -17,7 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .. import _core
-from ..constants import INSTRUMENTS, LAB_TEMPERATURE, PIPETTE_DEPTH
+from ..constants import INSTRUMENTS, LAB_TEMPERATURE, PIPETTE_DEPTH, SPECIMEN_MASS
 from ..lab.granulometry import read_all
 from ..lab.instruments import instrument
 from ..lab.psd import PSD, log_classes
@@ -46,7 +46,7 @@ class SedimentationTest:
     psd: PSD
     suspension: Suspension = Suspension()
     cylinder: Cylinder = Cylinder()
-    mass: float = 0.060
+    mass: float = SPECIMEN_MASS
     instruments: tuple[str, ...] = INSTRUMENTS
 
     @property

@@ -17,7 +17,7 @@ import numpy as np
 
 from .. import _core
 from ..constants import (BRAVO_CYLINDER_HEIGHT, BRAVO_CYLINDER_WIDTH, D422_CYLINDER_AREA, D422_CYLINDER_HEIGHT,
-                         DRAGS, HINDRANCES)
+                         DRAGS, HINDRANCES, SPECIMEN_MASS)
 from ..lab.psd import PSD, SizeClasses, discretise
 from ..lab.readout import Suspension
 from ..lab.settling import terminal_speed
@@ -268,7 +268,7 @@ def meeting_modulus(suspension: Suspension, diameter: np.ndarray, speed: np.ndar
 COLUMN_DIAMETERS = 20    # a column is at least this many of its largest grains tall
 
 
-def plan(psd: PSD, *, geometry: str = "column", cylinder: Cylinder = Cylinder(), mass: float = 0.060,
+def plan(psd: PSD, *, geometry: str = "column", cylinder: Cylinder = Cylinder(), mass: float = SPECIMEN_MASS,
          suspension: Suspension = Suspension(), width: float | None = None, classes: int | np.ndarray = 40,
          particles: int | None = 20000, effects: Effects = Effects(), layers: int = 400, t_end: float = 86400.0,
          courant: float = 4.0, seed: int = 1) -> Scene:

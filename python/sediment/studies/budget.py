@@ -26,7 +26,8 @@ from pathlib import Path
 import numpy as np
 
 from .. import figures
-from ..constants import D422_CYLINDER_HEIGHT, INSTRUMENTS, LAB_TEMPERATURE, PIPETTE_DEPTH, SPHERE_DEPTH_SHARE
+from ..constants import (D422_CYLINDER_HEIGHT, INSTRUMENTS, LAB_TEMPERATURE, PIPETTE_DEPTH, SPECIMEN_MASS,
+                         SPHERE_DEPTH_SHARE)
 from ..lab.granulometry import read_all
 from ..lab.psd import PSD
 from ..lab.readout import SCHEDULES, Column, Suspension
@@ -168,7 +169,7 @@ def wall_change(psd: PSD, lab: Suspension, cylinder: Cylinder) -> float:
 
 
 def error_budget(psd: PSD, folder: Path, *, particles: int = 20000, courant: float = 2.0, replicas: int = 3,
-                 temperature: float = 20.0, mass: float = 0.060, cylinder: Cylinder = Cylinder(),
+                 temperature: float = LAB_TEMPERATURE, mass: float = SPECIMEN_MASS, cylinder: Cylinder = Cylinder(),
                  seed: int = 1, jobs: int = 2, progress: bool = True, choices=CHOICES, name: str = "",
                  **options) -> Budget:
     """Runs the reference and every choice of one test under `folder` and returns its budget.
