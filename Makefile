@@ -15,7 +15,7 @@ export OMP_NUM_THREADS := 1
 # A rank that stops with an error: mpirun kills the others at once, not a second later (the tests
 # stop many runs on purpose; tests/decks/CMakeLists.txt)
 export OMPI_MCA_odls_base_sigkill_timeout := 0
-# Open MPI's ob1 layer, as the sediment command chooses it (python/sediment/sim/run.py): no fabric
+# Open MPI's ob1 layer, as the sediment command chooses it (python/sediment/sim/process.py): no fabric
 # library loaded at each start (Omni-Path's spends 0.1 s per core timing the clock), 0.35 s -> 0.16 s
 # per start of a serial run; the tests start some thousands
 export OMPI_MCA_pml := ob1

@@ -38,12 +38,15 @@ class Setup(Protocol):
     particle_density: float
 
     @property
-    def initial_concentration(self) -> float: ...
+    def initial_concentration(self) -> float:
+        """c0 [g/L]."""
 
     @property
-    def sphere(self) -> BuoyancySphere: ...
+    def sphere(self) -> BuoyancySphere:
+        """The buoyancy sphere as hung."""
 
-    def correction(self, sheet) -> np.ndarray: ...
+    def correction(self, sheet) -> np.ndarray:
+        """A hydrometer sheet's composite correction at each reading [g/L]."""
 
 
 @dataclass(frozen=True)
@@ -147,17 +150,21 @@ class HydrometerTest(Instrument):
     on_hydrometer_scale = True
 
     def physical(self, column, setup):
+        """The hydrometer (default the nominal 152H) on the schedule's times."""
         read = partial((setup.hydrometer or Hydrometer.astm_152h()).read, cylinder_area=setup.cylinder_area)
         return read, np.array(SCHEDULES[setup.schedule]) * 60.0
 
     def deepest(self, height):
+        """The nominal 152H's bulb bottom at a zero reading."""
         h = Hydrometer.astm_152h()
         return h.scale_zero + h.bulb_length
 
     def nominal_depth(self, test):
+        """The 152H's bulb centre, nominally."""
         return 0.15
 
     def sheet_readings(self, path, lines, values, scale, pipette_volume):
+        """Readings and blanks on the sheet's scale (152H or 151H) as the 152H's g/L."""
         reading = values["reading"]
         gravities = bool(np.all((reading > 0.95) & (reading < 1.15)))
         if gravities != (scale.name == "151H"):
@@ -177,13 +184,16 @@ class HydrometerTest(Instrument):
         return scale.grams(reading), np.empty(0), blank
 
     def reduce(self, sheet, waters, gs, c0, hydrometer, cylinder_area, sphere, meniscus, applied):
+        """D7928: H_m at the reading plus the meniscus; 100 a (R - correction) / c0."""
         depth = hydrometer.effective_depth(sheet.reading + meniscus, cylinder_area)
         return depth, 100 * gs_correction(gs) * (sheet.reading - applied) / c0
 
     def whole_sample(self, test, water):
+        """c0 / a, the whole sample's reading in the 152H's g/L."""
         return test.initial_concentration / gs_correction(test.particle_density / 1000.0)
 
     def modelled(self, column, sheet, times, test, water):
+        """The 152H floating in the companion cylinder's liquid with the column's solids."""
         # The instrument floats in the companion cylinder's liquid (water and dispersant at the reading's
         # temperature: what the composite correction and the meniscus read there) with the solids, so its
         # bulb sits where the sheet's reading puts it (D7928's H_m at the reading as read plus the meniscus).
@@ -198,13 +208,16 @@ class HydrometerTest(Instrument):
         return out
 
     def linear(self, test, temperature):
+        """R = c0 P / (100 a)."""
         per_percent = test.initial_concentration / (100 * gs_correction(test.particle_density / 1000.0))
         return np.zeros(len(temperature)), np.full(len(temperature), per_percent)
 
     def sheet_unit(self, scale):
+        """The scale's unit (g/L or specific gravity)."""
         return scale.unit
 
     def noise_text(self, noise, scale):
+        """The noise on the sheet's scale."""
         return scale.quoted_step(noise)
 
 
@@ -223,33 +236,41 @@ class BuoyancyTest(Instrument):
                          "clear water follows from them)")
 
     def physical(self, column, setup):
+        """The sphere at its depth (default a share of the height) on Bravo et al.'s times with D422's."""
         depth = SPHERE_DEPTH_SHARE * column.height if setup.sphere_depth is None else setup.sphere_depth
         # D422's schedule leaves its first hour nearly unread: the sphere reads on Bravo et al.'s times with it
         schedule = "bravo" if setup.schedule == "d422" else setup.schedule
         return BuoyancySphere(depth).read, np.array(SCHEDULES[schedule]) * 60.0
 
     def deepest(self, height):
+        """The default sphere's bottom."""
         return SPHERE_DEPTH_SHARE * height + 0.0125
 
     def nominal_depth(self, test):
+        """The sphere's centre."""
         return test.sphere.depth
 
     def sheet_readings(self, path, lines, values, scale, pipette_volume):
+        """The balance's apparent masses [g]."""
         plausible(path, lines, values, "apparent_mass_g", "apparent_mass_g")
         return values["apparent_mass_g"], np.empty(0), np.empty(0)
 
     def reduce(self, sheet, waters, gs, c0, hydrometer, cylinder_area, sphere, meniscus, applied):
+        """The sphere's depth; the solids around it from its apparent mass in the reading's water."""
         water = np.array([w.fluid_density for w in waters])
         return np.full(len(sheet.time), sphere.depth), 100 * sphere.solids(sheet.reading * 1e-3, water, gs) / c0
 
     def whole_sample(self, test, water):
+        """The apparent mass [g] in the whole sample's suspension."""
         rho = water.mixture_density(test.initial_concentration / test.particle_density)
         return (test.sphere.mass - rho * test.sphere.volume) * 1e3
 
     def clear_water(self, test, water):
+        """The apparent mass [g] in clear water."""
         return (test.sphere.mass - water.fluid_density * test.sphere.volume) * 1e3
 
     def modelled(self, column, sheet, times, test, water):
+        """The sphere read in the column, weighed in the water at each reading's temperature."""
         # the balance reads the sphere in the water at each reading's temperature
         sphere = test.sphere
         recorded = np.where(np.isfinite(sheet.temperature), sheet.temperature, water.temperature or LAB_TEMPERATURE)
@@ -257,6 +278,7 @@ class BuoyancyTest(Instrument):
         return sphere.read(column, times).reading - (density - water.fluid_density) * sphere.volume * 1e3
 
     def linear(self, test, temperature):
+        """The apparent mass falls with the solids around the sphere, from its clear-water value."""
         sphere, c0, gs = test.sphere, test.initial_concentration, test.particle_density / 1000.0
         fluid = np.array([_core.water_density(t) for t in temperature])
         return ((sphere.mass - fluid * sphere.volume) * 1e3,
@@ -276,34 +298,43 @@ class PipetteTest(Instrument):
     noise_as_read = False    # the option is in g of a sample, the inverse reads g/L
 
     def physical(self, column, setup):
+        """The pipette at its depth on the Stokes times of 50 to 2 um there."""
         pipette = Pipette(setup.pipette_depth, setup.pipette_volume)
         return pipette.read, pipette.default_times(column.suspension)
 
     def deepest(self, height):
+        """The default sample's bottom."""
         return PIPETTE_DEPTH + (3 * PIPETTE_VOLUME / (4 * math.pi)) ** (1 / 3)
 
     def nominal_depth(self, test):
+        """The default tip depth."""
         return PIPETTE_DEPTH
 
     def sheet_readings(self, path, lines, values, scale, pipette_volume):
+        """The samples' dry masses as g/L of the sample, and their depths."""
         plausible(path, lines, values, "depth_cm", "depth_cm")
         plausible(path, lines, values, "mass_g", pipette_mass(pipette_volume))
         return values["mass_g"] / (pipette_volume * 1e3), values["depth_cm"] / 100.0, np.empty(0)
 
     def reduce(self, sheet, waters, gs, c0, hydrometer, cylinder_area, sphere, meniscus, applied):
+        """Each sample's depth; 100 c / c0."""
         return sheet.depth, 100 * sheet.reading / c0
 
     def whole_sample(self, test, water):
+        """c0 [g/L]."""
         return test.initial_concentration
 
     def modelled(self, column, sheet, times, test, water):
+        """The column sampled at each reading's depth."""
         return np.array([Pipette(z).read(column, [t]).reading[0] for z, t in zip(sheet.depth, times)])
 
     def linear(self, test, temperature):
+        """c = c0 P / 100."""
         n = len(temperature)
         return np.zeros(n), np.full(n, test.initial_concentration / 100)
 
     def check_sheet(self, sheet, values, whole):
+        """Refuses masses far below what any sample holds (kg for g); samples compare at one depth only."""
         if values.max() < 0.005 * whole:
             raise SheetError(f"{sheet.label}: every sample weighs under 0.5 % of what the whole sample in suspension "
                              f"gives ({whole:.4g} g): mass_g is in grams (masses in kg?), or the sample mass is wrong")

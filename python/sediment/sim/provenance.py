@@ -172,6 +172,7 @@ def read_record(folder: Path) -> dict | None:
 
 
 def write_record(folder: Path, **record) -> None:
+    """Writes the folder's run record (RECORD), replacing the one before."""
     write_text(folder / RECORD, json.dumps(record, indent=1) + "\n")
 
 
