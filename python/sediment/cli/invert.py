@@ -209,10 +209,10 @@ def hydrometer_step(args: argparse.Namespace, option: str, quantity: str = "", d
         return default
     scale = SCALES[args.hydrometer_type]
     grams = value * scale.per_unit
-    named = f"--{option.replace('_', '-')}" + ("" if scale.name == "152H" else f" {value:g} (151H) as a 152H's:")
+    named = f"--{option.replace('_', '-')}" + ("" if scale.in_grams else f" {value:g} ({scale.name}) as a 152H's:")
     quantity = quantity or option.replace("zero_", "")
     reason = refusal(grams, quantity)
-    if scale.name != "152H" and reason is not None and refusal(value, quantity) is None:
+    if not scale.in_grams and reason is not None and refusal(value, quantity) is None:
         raise ValueError(f"{named} {reason}; written in a 152H's g/L? with --hydrometer-type 151H "
                          f"give it in specific gravity: {value / scale.per_unit:.3g}")
     return check(grams, quantity, named)

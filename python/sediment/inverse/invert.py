@@ -511,7 +511,7 @@ def _inputs_line(test: LabTest, inputs: dict) -> str:
     scale = SCALES[inputs["hydrometer_type"]]
     correction = "; ".join(f"{Path(k).name}: {v if isinstance(v, str) else scale.quoted_step(v)}"
                            for k, v in inputs["composite_correction"].items()) or "none"
-    read = "" if scale.name == "152H" else " (its specific gravity R read as 1000 (R - 1) / 0.6226 g/L of a 152H)"
+    read = "" if scale.in_grams else " (its specific gravity R read as 1000 (R - 1) / 0.6226 g/L of a 152H)"
     temperatures = inputs["temperatures_C"]
     return (f"inputs: specimen {test.mass * 1e3:.5g} g (oven-dry), particle density {test.particle_density:g} kg/m3, "
             f"suspension {test.cylinder_area * test.height * 1e6:.4g} mL in a cylinder of {test.cylinder_area * 1e4:.4g} "

@@ -167,11 +167,11 @@ class HydrometerTest(Instrument):
         """Readings and blanks on the sheet's scale (152H or 151H) as the 152H's g/L."""
         reading = values["reading"]
         gravities = bool(np.all((reading > 0.95) & (reading < 1.15)))
-        if gravities != (scale.name == "151H"):
+        if gravities == scale.in_grams:
             raise SheetError(f"{path}: the readings ({reading.min():g}-{reading.max():g}) look like "
                              + ("specific gravities: a 151H's sheet needs --hydrometer-type 151H" if gravities else
                                 "a 152H's g/L, not the specific gravities of a 151H (--hydrometer-type 151H)"))
-        plausible(path, lines, values, "reading", "reading" if scale.name == "152H" else "reading_151h")
+        plausible(path, lines, values, "reading", scale.reading_range)
         blank = np.empty(0)
         if "blank" in values:
             blank = values["blank"]
@@ -179,7 +179,7 @@ class HydrometerTest(Instrument):
                 missing = ", ".join(str(lines[k]) for k in np.flatnonzero(~np.isfinite(blank)))
                 raise SheetError(f"{path}: no blank on line(s) {missing}: give the composite correction beside every "
                                  "reading, or drop the column and give --zero-correction")
-            plausible(path, lines, values, "blank", "correction" if scale.name == "152H" else "blank_151h")
+            plausible(path, lines, values, "blank", scale.blank_range)
             blank = scale.grams(blank)
         return scale.grams(reading), np.empty(0), blank
 

@@ -35,6 +35,13 @@ class Scale:
     unit: str
     water: float       # what the scale reads in water at 20 C
     per_unit: float    # 152H g/L per unit of the scale
+    reading_range: str = "reading"       # sediment.plausible's ranges of its readings and blanks
+    blank_range: str = "correction"
+
+    @property
+    def in_grams(self) -> bool:
+        """Whether it reads the 152H's g/L itself (the unit everything after the sheet works in)."""
+        return self.water == 0.0 and self.per_unit == 1.0
 
     def grams(self, reading):
         """A reading of this scale as the 152H's g/L."""
@@ -46,19 +53,20 @@ class Scale:
 
     def quoted(self, grams: float) -> str:
         """A reading [152H g/L] as a message quotes it: on this scale, and in g/L where that differs."""
-        if self.name == "152H":
+        if self.in_grams:
             return f"{grams:g}"
         return f"{float(self.as_read(grams)):.5g} ({grams:.3g} g/L of a 152H)"
 
     def quoted_step(self, grams: float) -> str:
         """A difference of readings [152H g/L] (a noise, a correction) as a message quotes it."""
-        if self.name == "152H":
+        if self.in_grams:
             return f"{grams:g} g/L"
         return f"{grams / self.per_unit:.3g} in {self.unit} ({grams:.3g} g/L of a 152H)"
 
 
 SCALES = {"152H": Scale("152H", "g/L", 0.0, 1.0),
-          "151H": Scale("151H", "specific gravity", 1.0, 1000.0 / R_FACTOR)}
+          "151H": Scale("151H", "specific gravity", 1.0, 1000.0 / R_FACTOR, "reading_151h", "blank_151h")}
+GRAMS = SCALES["152H"]    # the scale of the 152H's g/L, which every sheet's readings become
 
 @dataclass(frozen=True)
 class Suspension:
@@ -382,10 +390,10 @@ class Hydrometer:
         meniscus), less the rise of the surface as the bulb enters, V_B / 2A."""
         return self.centre_distance(reading) - self.bulb_volume / (2 * cylinder_area)
 
-    def describe(self, scale: Scale = SCALES["152H"]) -> str:
+    def describe(self, scale: Scale = GRAMS) -> str:
         """The instrument as the console echoes it, its readings on `scale`."""
         def at(grams: float) -> str:
-            return f"{float(scale.as_read(grams)):.5g}{' g/L' if scale.name == '152H' else ''}"
+            return f"{float(scale.as_read(grams)):.5g}{' g/L' if scale.in_grams else ''}"
         points = self.calibration or ((0.0, float(self.centre_distance(0.0))),
                                       (50.0, float(self.centre_distance(50.0))))
         where = "calibrated" if self.calibration else f"nominal {scale.name} of D422"

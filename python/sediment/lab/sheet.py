@@ -26,7 +26,7 @@ import numpy as np
 from ..constants import LAB_TEMPERATURE, PIPETTE_VOLUME
 from ..csvfile import CsvError, CsvFile, read_csv
 from .instruments import INSTRUMENTS
-from .readout import SCALES, BuoyancySphere, Hydrometer, Scale, Suspension
+from .readout import GRAMS, BuoyancySphere, Hydrometer, Scale, Suspension
 from .sheetcheck import SheetError, plausible
 
 # The sheets' kinds by their columns: the instruments' and the sieves'
@@ -48,7 +48,7 @@ class Sheet:
     depth: np.ndarray = field(default_factory=lambda: np.empty(0))
     blank: np.ndarray = field(default_factory=lambda: np.empty(0))    # 152H composite correction per reading
     lines: tuple[int, ...] = ()    # each reading's line in the file, for messages
-    scale: Scale = SCALES["152H"]    # a hydrometer's scale as read (its readings and blank are the 152H's g/L)
+    scale: Scale = GRAMS    # a hydrometer's scale as read (its readings and blank are the 152H's g/L)
 
     def where(self, k: int) -> str:
         """Reading k as a message names it: its line in the file, and its time."""
@@ -78,7 +78,7 @@ class SieveSheet:
 
 
 def read_sheet(path: str | Path, pipette_volume: float = PIPETTE_VOLUME, stirred: str | None = None,
-               scale: Scale = SCALES["152H"]) -> Sheet | SieveSheet:
+               scale: Scale = GRAMS) -> Sheet | SieveSheet:
     """Reads and checks one sheet (its kind from its header); a pipette's masses become g/L of the sample,
     a hydrometer's readings on `scale` the 152H's g/L. A `clock` column (HH:MM of each reading) stands for
     `time_min`, counted from `stirred` (HH:MM)."""
@@ -119,7 +119,7 @@ def read_sheet(path: str | Path, pipette_volume: float = PIPETTE_VOLUME, stirred
     plausible(path, lines, values, "temperature_C", "temperature")
     reading, depth, blank = INSTRUMENTS[kind].sheet_readings(path, lines, values, scale, pipette_volume)
     return Sheet(kind, path, time, reading, temperature, depth, blank, tuple(lines),
-                 scale if INSTRUMENTS[kind].on_hydrometer_scale else SCALES["152H"])
+                 scale if INSTRUMENTS[kind].on_hydrometer_scale else GRAMS)
 
 
 def clock_minutes(text: str, where: str) -> float:
@@ -256,7 +256,7 @@ def check_sheet(sheet: Sheet, whole: float, resolution: float, corrected: np.nda
 
     def named(k: int) -> str:
         after = "" if corrected is None or corrected[k] == sheet.reading[k] else \
-            f", {values[k]:g}{'' if sheet.scale.name == '152H' else ' g/L'} after its correction"
+            f", {values[k]:g}{'' if sheet.scale.in_grams else ' g/L'} after its correction"
         return f"{sheet.scale.quoted(sheet.reading[k])} on the sheet{after}"
     # the solids signal, falling with time: the sphere's apparent mass rises as the suspension thins
     kind = INSTRUMENTS[sheet.instrument]
@@ -295,7 +295,7 @@ class Reduction:
     depth: np.ndarray           # m
     diameter: np.ndarray        # m
     percent: np.ndarray         # of the specimen (the inverse scales it to the whole sample)
-    scale: Scale = SCALES["152H"]    # a hydrometer's scale as read (reading, correction and meniscus are in g/L)
+    scale: Scale = GRAMS    # a hydrometer's scale as read (reading, correction and meniscus are in g/L)
 
     def scaled(self, share: float) -> "Reduction":
         """The same reduction with its percent finer of a sample of which the specimen is `share`."""
@@ -325,7 +325,7 @@ def standard_reduction(sheet: Sheet, suspension: Suspension, initial_concentrati
                      diameter, percent, sheet.scale)
 
 
-def read_hydrometer_calibration(path: str | Path, scale: Scale = SCALES["152H"]) -> tuple[np.ndarray, np.ndarray]:
+def read_hydrometer_calibration(path: str | Path, scale: Scale = GRAMS) -> tuple[np.ndarray, np.ndarray]:
     """A hydrometer's calibration (D7928's H_r): CSV ``reading,distance_cm``, the distance from the
     graduation of each reading (on `scale`) to the bulb's centre. Returns the readings [152H g/L] and the
     distances [m]."""
@@ -338,7 +338,7 @@ def read_hydrometer_calibration(path: str | Path, scale: Scale = SCALES["152H"])
     values = {name: np.array(_numbers(table, name)) for name in ("reading", "distance_cm")}
     if len(lines) < 2:
         raise SheetError(f"{path}: a calibration needs at least two readings with their distances")
-    plausible(path, lines, values, "reading", "reading" if scale.name == "152H" else "reading_151h")
+    plausible(path, lines, values, "reading", scale.reading_range)
     plausible(path, lines, values, "distance_cm", "calibration_cm")
     readings, distances = values["reading"], values["distance_cm"]
     order = np.argsort(readings, kind="stable")
