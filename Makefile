@@ -15,7 +15,7 @@ export OMP_NUM_THREADS := 1
 # A rank that stops with an error: mpirun kills the others at once, not a second later (the tests
 # stop many runs on purpose; tests/decks/CMakeLists.txt)
 export OMPI_MCA_odls_base_sigkill_timeout := 0
-# Open MPI's ob1 layer, as the sediment command chooses it (python/sediment/sim/run.py): no fabric
+# Open MPI's ob1 layer, as the sediment command chooses it (python/sediment/sim/process.py): no fabric
 # library loaded at each start (Omni-Path's spends 0.1 s per core timing the clock), 0.35 s -> 0.16 s
 # per start of a serial run; the tests start some thousands
 export OMPI_MCA_pml := ob1
@@ -53,8 +53,10 @@ test-cpp: build
 
 # The test files in $(JOBS) workers (pytest-xdist): most tests wait on one single-rank LAMMPS run or on
 # Python, so one worker leaves a core idle. No test's outcome depends on the clock or the load; the
-# tests of the installed package share one worker and its venv.
+# tests of the installed package share one worker and its venv. First the package's imports point one
+# way (scripts/check-imports.py, docs/layout.md).
 test-python: build
+	$(PYTHON) scripts/check-imports.py
 	PYTHONPATH=python SEDIMENT_LMP=$(abspath $(BUILD))/lmp_sediment $(PYTHON) -m pytest -q -n $(JOBS) --dist loadgroup \
 	  tests/python
 

@@ -27,7 +27,8 @@ from sediment.lab.readout import Column, Suspension  # noqa: E402
 from sediment.planner.scenes import SampleScene  # noqa: E402
 from sediment.sim.layers import read_layers  # noqa: E402
 from sediment.sim.run import run_batch  # noqa: E402
-from sediment.sim.scene import Cylinder, Effects, plan, write  # noqa: E402
+from sediment.sim.scene import Cylinder, Effects, plan  # noqa: E402
+from sediment.sim.scenefiles import write  # noqa: E402
 
 INSTRUMENTS = ["hydrometer", "buoyancy", "pipette"]
 

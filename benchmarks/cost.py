@@ -45,7 +45,8 @@ sys.path.insert(0, str(HERE.parent / "python"))
 from sediment import _core  # noqa: E402
 from sediment.cli.types import count  # noqa: E402
 from sediment.sim.paths import lmp_executable  # noqa: E402
-from sediment.sim.run import run_batch, run_environment  # noqa: E402
+from sediment.sim.process import run_environment  # noqa: E402
+from sediment.sim.run import run_batch  # noqa: E402
 
 SCENES = {"plain": "nve/sphere + gravity (reference)",
           "peer": "nve/sphere + fix viscous + reduced gravity (LAMMPS's own fixes, same Stokes physics)",

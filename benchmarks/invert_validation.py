@@ -41,7 +41,8 @@ from sediment.lab.readout import R_FACTOR, SCHEDULES, BuoyancySphere, Column, Hy
 from sediment.lab.sheet import read_sheet  # noqa: E402
 from sediment.sim.layers import read_layers  # noqa: E402
 from sediment.sim.run import run_batch  # noqa: E402
-from sediment.sim.scene import plan, write  # noqa: E402
+from sediment.sim.scene import plan  # noqa: E402
+from sediment.sim.scenefiles import write  # noqa: E402
 
 PSDS = [HERE.parent / "examples" / "granulometry" / "psd" / f"sample{k}.csv" for k in range(1, 6)] + \
        [HERE.parent / "examples" / "inverse" / "psd" / f"{name}.csv"

@@ -39,7 +39,8 @@ def main() -> None:
     from sediment.planner.scenes import decided_options
     from sediment.sim.layers import read_layers
     from sediment.sim.run import run_batch
-    from sediment.sim.scene import Effects, plan, write
+    from sediment.sim.scene import Effects, plan
+    from sediment.sim.scenefiles import write
 
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--plan", type=Path, help="a plan's report.json (default: plan sample 5 here first)")
@@ -99,7 +100,8 @@ def breakdown(text: str) -> dict[str, tuple[float, float]]:
 def scaling(decided: dict, tmp: Path, ranks: int, repeats: int) -> None:
     from sediment.lab.psd import read_psd
     from sediment.sim.run import run_batch
-    from sediment.sim.scene import Effects, plan, write
+    from sediment.sim.scene import Effects, plan
+    from sediment.sim.scenefiles import write
 
     folder = tmp / "decision"
     write(plan(read_psd(PSD), particles=decided["particles"], courant=decided["courant"],

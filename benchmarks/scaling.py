@@ -24,7 +24,8 @@ HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE.parent / "python"))
 from sediment.lab.psd import read_psd  # noqa: E402
 from sediment.sim.run import run_batch  # noqa: E402
-from sediment.sim.scene import Effects, plan, write  # noqa: E402
+from sediment.sim.scene import Effects, plan  # noqa: E402
+from sediment.sim.scenefiles import write  # noqa: E402
 
 PSD = HERE.parent / "examples" / "granulometry" / "psd" / "sample5.csv"
 

@@ -10,7 +10,7 @@ LAMMPS, scenes, layer files), `sediment.studies` (validation and accuracy studie
 The names below are loaded when first used, so that the parts that need no compiled code (running
 decks, reading layer files) import before the extension is built.
 """
-__version__ = "0.1.0"
+from .constants import VERSION as __version__    # noqa: F401  (sediment.__version__)
 
 _CORE = ("DragModel", "critical_yield_number", "drag_coefficient", "drag_law_names", "explicit_step_limit",
          "mixture_density", "rayleigh_time", "relaxation_time", "rotation_drag_rate", "sphere_inertia",

@@ -2,6 +2,10 @@
 """Physical constants and laboratory defaults, in SI units, defined once for the whole package."""
 from __future__ import annotations
 
+# The release (the one source: tests/python/test_repository.py checks pyproject.toml, CITATION.cff,
+# CMakeLists.txt and the layer files' writer against it)
+VERSION = "0.1.0"
+
 GRAVITY = 9.81                    # m/s2
 WATER_20C_DENSITY = 998.2067      # kg/m3 (Tanaka et al. 2001; sediment._core.water_density(20))
 WATER_20C_VISCOSITY = 1.0016e-3   # Pa s (IAPWS 2008; sediment._core.water_viscosity(20))
@@ -10,10 +14,29 @@ SOIL_PARTICLE_DENSITY = 2650.0    # kg/m3, Gs = 2.65: what the 152H hydrometer i
 D422_CYLINDER_AREA = 27.8e-4      # m2, ASTM D422 cylinder (inner diameter 5.95 cm)
 D422_CYLINDER_HEIGHT = 0.36       # m, the 1000 mL mark
 SUSPENSION_VOLUME = 1e-3          # m3, the sedimentation tests' 1000 mL
+SPECIMEN_MASS = 0.060             # kg, the dry sample of a test unless one is given (60 g/L)
 NOMINAL_BULB_LENGTH = 0.140       # m, the 152H of D422
 NOMINAL_BULB_VOLUME = 67.0e-6     # m3
 BRAVO_CYLINDER_WIDTH = 0.0635     # m, Bravo et al. (2015)
 BRAVO_CYLINDER_HEIGHT = 0.457     # m
+
+# The sedimentation tests' instruments (sediment.lab.instruments holds one class each; the command line
+# offers these names before the C++ core is loaded, and tests/python/test_instruments.py checks them
+# against the registry), and the hydrometer's two scales (D422 3.2).
+INSTRUMENTS = ("hydrometer", "buoyancy", "pipette")
+HYDROMETER_TYPES = ("152H", "151H")
+PIPETTE_DEPTH = 0.10              # m, the tip below the surface
+PIPETTE_VOLUME = 25e-6            # m3, one sample
+SPHERE_DIAMETER = 0.025           # m, Bardet & Young's Teflon sphere
+SPHERE_MASS = 0.020               # kg
+SPHERE_DEPTH_SHARE = 0.3          # its centre's depth, as a share of the suspension's height
+# Reading errors: a 152H read to 0.5 g/L; a balance to 1 mg; a pipette sample's dry mass to 0.1 mg;
+# a sieve's percent passing to 0.5 points
+HYDROMETER_NOISE = 0.25           # g/L
+BALANCE_NOISE = 1e-3              # g
+PIPETTE_NOISE = 1e-4              # g of a sample
+SIEVE_NOISE = 0.5                 # points
+THERMOMETER_NOISE = 0.5           # C, of the temperature record
 
 # Names the command line offers before the C++ core is loaded (its --help works before a build);
 # tests/python/test_cli.py checks them against the core's own lists.

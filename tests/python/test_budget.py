@@ -105,7 +105,8 @@ def test_mixture_buoyancy_leaves_the_deposit_on_the_floor(tmp_path):
     from sediment.lab.readout import Column
     from sediment.sim.layers import read_layers
     from sediment.sim.run import run_batch
-    from sediment.sim.scene import plan, write
+    from sediment.sim.scene import plan
+    from sediment.sim.scenefiles import write
 
     scene = plan(read_psd(PSDS / "sample1.csv"), particles=20000, courant=2.0, effects=Effects(buoyancy="mixture"))
     write(scene, tmp_path)

@@ -237,7 +237,7 @@ def test_two_runs_in_one_folder_and_signals(tmp_path):
 def test_a_signal_while_the_run_is_launched_stops_it(tmp_path, monkeypatch):
     # The signal comes after LAMMPS was spawned but before the launch returned its process: the run is
     # stopped all the same and the caller hears RunInterrupted, not a bare KeyboardInterrupt
-    from sediment.sim import run as run_module
+    from sediment.sim import process
 
     spawned = []
 
@@ -247,9 +247,9 @@ def test_a_signal_while_the_run_is_launched_stops_it(tmp_path, monkeypatch):
         os.kill(os.getpid(), signal.SIGINT)
         return spawned[-1]
 
-    monkeypatch.setattr(run_module, "_start", start_then_signal)
-    with pytest.raises(run_module.RunInterrupted, match="stopped by SIGINT"):
-        with run_module._signals_stop() as launch:
+    monkeypatch.setattr(process, "start_process", start_then_signal)
+    with pytest.raises(process.RunInterrupted, match="stopped by SIGINT"):
+        with process.signals_stop() as launch:
             launch.start(["sleep"], {}, tmp_path)
             pytest.fail("the launch returned despite the signal")
     assert spawned[0].poll() is not None    # stopped, not left running
@@ -362,7 +362,7 @@ def test_a_signal_as_the_run_finishes_keeps_its_complete_result(tmp_path, monkey
     from sediment.sim import run as sim_run
 
     deck = sample(tmp_path / "s", "--particles", 1000)
-    real_run, real_write = sim_run._run, sim_run._write_record
+    real_run, real_write = sim_run._run, sim_run.write_record
 
     def then_interrupted(*args, **kwargs):
         real_run(*args, **kwargs)
@@ -375,7 +375,7 @@ def test_a_signal_as_the_run_finishes_keeps_its_complete_result(tmp_path, monkey
     if where == "after LAMMPS ended":
         monkeypatch.setattr(sim_run, "_run", then_interrupted)
     else:
-        monkeypatch.setattr(sim_run, "_write_record", interrupted_while_written)
+        monkeypatch.setattr(sim_run, "write_record", interrupted_while_written)
     from sediment import cli
 
     with pytest.raises(sim_run.RunInterrupted, match="its results are complete"):
@@ -394,7 +394,7 @@ def test_resume_names_what_changed_since_the_interrupted_run(tmp_path):
     deck now includes (it blamed sample.data for an edited deck, and said '(none) changed' once it was gone)."""
     import json
 
-    from sediment.sim.run import RECORD
+    from sediment.sim.provenance import RECORD
 
     deck = sample(tmp_path / "r", "--particles", 1000)
     assert sediment("run", deck, "--quiet").returncode == 0
@@ -419,11 +419,12 @@ def test_a_run_that_starts_after_the_stop_is_stopped_at_once(tmp_path):
     """The planner stops its trials together on Ctrl-C; a trial whose thread had started its LAMMPS but not yet
     added it to the runs under way was missed, and the plan waited for it (for ever, were it paused). A run
     added after the stop is stopped as soon as it is known, and none starts after it."""
-    from sediment.sim.run import RunInterrupted, Runs, _start, run_batch
+    from sediment.sim.process import RunInterrupted, Runs, start_process
+    from sediment.sim.run import run_batch
 
     runs = Runs()
     runs.stop()
-    proc = _start(["sleep", "600"], dict(os.environ), tmp_path)
+    proc = start_process(["sleep", "600"], dict(os.environ), tmp_path)
     runs.add(proc)
     assert proc.poll() is not None
     deck = tmp_path / "in.none"

@@ -329,7 +329,7 @@ def test_8_messages_name_the_problem(tmp_path):
 
 
 def test_8_the_layer_file_a_deck_writes_and_whether_a_run_finished(tmp_path):
-    from sediment.sim.run import _finished, input_files, layer_file_of
+    from sediment.sim.provenance import finished, input_files, layer_file_of
 
     deck = sample(tmp_path / "x", "--particles", 2000)
     assert layer_file_of(deck, {}) == deck.parent / "layers.h5"
@@ -340,10 +340,10 @@ def test_8_the_layer_file_a_deck_writes_and_whether_a_run_finished(tmp_path):
     assert record["state"] == "finished" and record["deck"] == "in.sedimentation"
     assert read_layers(deck.parent / "layers.h5").identity["run_id"] == record["run_id"]
     # a stop that came as LAMMPS finished: the file is this run's and complete
-    assert _finished(deck.parent / "layers.h5", record["run_id"])
-    assert not _finished(deck.parent / "layers.h5", record["run_id"][:-1] + "x")
+    assert finished(deck.parent / "layers.h5", record["run_id"])
+    assert not finished(deck.parent / "layers.h5", record["run_id"][:-1] + "x")
     shutil.copy(deck.parent / "layers.h5", deck.parent / "layers.h5.partial")
-    assert not _finished(deck.parent / "layers.h5", record["run_id"])
+    assert not finished(deck.parent / "layers.h5", record["run_id"])
 
 
 FLOATING = """units si

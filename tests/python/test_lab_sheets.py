@@ -12,7 +12,8 @@ import numpy as np
 import pytest
 
 from sediment.cli import main
-from sediment.inverse.model import ForwardRun, LabTest
+from sediment.inverse.model import LabTest
+from sediment.lab.instruments import INSTRUMENTS
 from sediment.lab.readout import SCALES, Column, Hydrometer, Suspension
 from sediment.lab.sheet import SheetError, read_hydrometer_calibration, read_sheet, standard_reduction
 
@@ -60,8 +61,7 @@ def test_the_forward_152h_reads_nothing_in_the_companion_cylinders_liquid():
     test, _ = _lab_test(SAMPLES[0], 1.0)
     water = Suspension.at_temperature(22.0, 2700.0)
     column = Column(np.linspace(0.0, test.height, 41), np.array([0.0, 2e5]), np.zeros((2, 40)), water)
-    run = ForwardRun(None, np.zeros((1, 2, 40)), np.ones(1), water, test)
-    assert np.allclose(run.hydrometer_readings(column, sheet, sheet.time), 0.0, atol=1e-9)
+    assert np.allclose(INSTRUMENTS["hydrometer"].modelled(column, sheet, sheet.time, test, water), 0.0, atol=1e-9)
 
 
 @pytest.mark.parametrize("text, message", [

@@ -30,3 +30,18 @@ def test_the_notes_the_code_cites_are_in_the_repository():
     assert [c for c in sorted(cited) if not (REPO / c).is_file()] == []
     outside = ("../" + "shared", "shared/" + "spec", "shared/" + "data")    # spelled apart: not a hit here
     assert [f for f in _tracked() if any(word in (REPO / f).read_text() for word in outside)] == []
+
+
+def test_the_version_is_one():
+    """sediment.constants.VERSION is the release; every other file that states it agrees."""
+    from sediment.constants import VERSION
+
+    stated = {"pyproject.toml": r'^version = "([^"]+)"', "CITATION.cff": r"^version: (\S+)",
+              "CMakeLists.txt": r"project\(sediment VERSION (\S+)"}
+    for name, pattern in stated.items():
+        found = re.search(pattern, (REPO / name).read_text(), re.MULTILINE)
+        assert found and found.group(1) == VERSION, f"{name} states {found and found.group(1)}, not {VERSION}"
+    # the version the layer files record (fix layers/hdf5), wherever the package defines it
+    written = [m.group(1) for f in sorted((REPO / "lammps-pkg" / "SEDIMENT").glob("*.[ch]*"))
+               for m in re.finditer(r'SEDIMENT_VERSION\s*=\s*"([^"]+)"', f.read_text())]
+    assert written and set(written) == {VERSION}, f"the layer files' writer states {written}, not {VERSION}"

@@ -12,7 +12,9 @@ import pytest
 from sediment import _core, cli
 from sediment.lab.psd import discretise, read_psd
 from sediment.sim.run import run_batch
-from sediment.sim.scene import Cylinder, Effects, meeting_modulus, plan, terminal_speed, write
+from sediment.lab.settling import terminal_speed
+from sediment.sim.scene import Cylinder, Effects, meeting_modulus, plan
+from sediment.sim.scenefiles import write
 
 PSDS = Path(__file__).resolve().parents[2] / "examples" / "granulometry" / "psd"
 
@@ -259,6 +261,6 @@ def test_end_to_end_sample5_hydrometer_follows_the_simulated_psd(tmp_path, capsy
 def test_a_table_not_spanning_0_to_100_percent_is_said_to_be_renormalised(tmp_path):
     table = tmp_path / "psd.csv"
     table.write_text("diameter_um,percent_finer\n5,10\n20,50\n60,90\n")
-    from sediment.sim.scene import describe
+    from sediment.sim.scenefiles import describe
     text = describe(plan(read_psd(table), particles=2000))
     assert "runs from 10 to 90 % finer; the 20 % of the mass outside its diameters is not simulated" in text

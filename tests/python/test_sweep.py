@@ -11,7 +11,8 @@ from sediment import cli
 from sediment.studies import sweep
 from sediment.lab.psd import read_psd
 from sediment.sim.layers import read_layers
-from sediment.sim.scene import plan, write
+from sediment.sim.scene import plan
+from sediment.sim.scenefiles import write
 
 PSDS = Path(__file__).resolve().parents[2] / "examples" / "granulometry" / "psd"
 

@@ -14,7 +14,7 @@ import sys
 import threading
 from pathlib import Path
 
-from .. import __version__
+from ..constants import VERSION
 from . import budget, calibrate, case_a, invert, paste, plan, readout, run, sample, spheres, sweep, terminal
 
 # In the order of the work: plan a test, sample it, run it, read it; the physics' uncertainty; a
@@ -42,7 +42,7 @@ def build_parser() -> argparse.ArgumentParser:
                                      epilog="a test end to end:\n" + "\n".join(f"  {line}" for line in (
                                          plan.EXAMPLES[0], sample.EXAMPLES[1], run.EXAMPLES[0], readout.EXAMPLES[0])) +
                                      "\n\n`sediment COMMAND --help` for a command's options and examples")
-    parser.add_argument("--version", action="version", version=f"sediment {__version__}")
+    parser.add_argument("--version", action="version", version=f"sediment {VERSION}")
     commands = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
     for command in COMMANDS:
         sub = command.add_parser(commands)
@@ -74,7 +74,7 @@ def main(argv: list[str] | None = None) -> int:
 
 def _command(argv: list[str] | None) -> int:
     """`main` with the signals taken."""
-    from ..sim.run import RunInterrupted
+    from ..sim.process import RunInterrupted
 
     args = build_parser().parse_args(argv)
     args.argv = list(sys.argv[1:] if argv is None else argv)    # as given: a batch passes its options on

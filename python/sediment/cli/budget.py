@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from ..constants import LAB_TEMPERATURE
+from ..constants import LAB_TEMPERATURE, SPECIMEN_MASS
 from .types import count, positive, quantity, temperature
 
 
@@ -33,7 +33,7 @@ def add_parser(commands) -> argparse.ArgumentParser:
     parser.add_argument("--temperature", type=temperature, default=LAB_TEMPERATURE,
                         help="recorded water temperature [C] (default 20)")
     parser.add_argument("--mass", type=quantity("specimen_mass"),
-                        default=0.060, help="dry sample mass [kg] (default 0.06)")
+                        default=SPECIMEN_MASS, help="dry sample mass [kg] (default 0.06)")
     parser.add_argument("--seed", type=int, default=1, help="placement seed of the reference")
     parser.add_argument("--jobs", type=count, default=2, help="runs at once, one core each (default 2)")
     parser.add_argument("--out", type=Path, default=Path("out/budget"), help="output folder")

@@ -7,8 +7,9 @@ import os
 import sys
 from pathlib import Path
 
-from ..constants import (D422_CYLINDER_AREA, NOMINAL_BULB_LENGTH, NOMINAL_BULB_VOLUME, SOIL_PARTICLE_DENSITY,
-                         SUSPENSION_VOLUME)
+from ..constants import (BALANCE_NOISE, D422_CYLINDER_AREA, HYDROMETER_NOISE, HYDROMETER_TYPES, NOMINAL_BULB_LENGTH,
+                         NOMINAL_BULB_VOLUME, PIPETTE_NOISE, PIPETTE_VOLUME, SIEVE_NOISE, SOIL_PARTICLE_DENSITY,
+                         SPECIMEN_MASS, SPHERE_DIAMETER, SPHERE_MASS, SUSPENSION_VOLUME, THERMOMETER_NOISE)
 from ..results import write_text
 from .types import count, finite, quantity, quantity_list
 
@@ -77,7 +78,7 @@ def add_parser(commands) -> argparse.ArgumentParser:
     parser.add_argument("--height", type=quantity("suspension_height"),
                         help="instead of --volume: the suspension's height [m] (the volume is then --cylinder-area x "
                         "--height)")
-    parser.add_argument("--hydrometer-type", choices=("152H", "151H"), default="152H",
+    parser.add_argument("--hydrometer-type", choices=HYDROMETER_TYPES, default=HYDROMETER_TYPES[0],
                         help="the hydrometer's scale: 152H (g/L of soil, the default) or 151H (specific gravity, 0.995 "
                         "to 1.038); the two have the same dimensions. The sheets' readings and blanks, the "
                         "calibration's readings, --zero-correction, --meniscus and --hydrometer-noise are in its unit")
@@ -100,20 +101,21 @@ def add_parser(commands) -> argparse.ArgumentParser:
                         "0.0006]")
     parser.add_argument("--sphere-depth", type=quantity("instrument_depth"),
                         help="buoyancy sphere centre depth [m] (default 0.3 H)")
-    parser.add_argument("--sphere-diameter", type=quantity("sphere_diameter"), default=0.025, help="[m]")
-    parser.add_argument("--sphere-mass", type=quantity("sphere_mass"), default=0.020, help="[kg]")
-    parser.add_argument("--pipette-volume", type=quantity("pipette_volume"), default=25e-6, help="[m3] (default 25 mL)")
+    parser.add_argument("--sphere-diameter", type=quantity("sphere_diameter"), default=SPHERE_DIAMETER, help="[m]")
+    parser.add_argument("--sphere-mass", type=quantity("sphere_mass"), default=SPHERE_MASS, help="[kg]")
+    parser.add_argument("--pipette-volume", type=quantity("pipette_volume"), default=PIPETTE_VOLUME,
+                        help="[m3] (default 25 mL)")
     parser.add_argument("--hydrometer-noise", type=finite,
                         help="standard uncertainty of a hydrometer reading [152H g/L, default 0.25: read to 0.5 g/L; "
                         "151H default 0.00016, the same]")
     parser.add_argument("--balance-noise", type=quantity("balance_noise"),
-                        default=1e-3, help="of a sphere's apparent mass [g]")
+                        default=BALANCE_NOISE, help="of a sphere's apparent mass [g]")
     parser.add_argument("--pipette-noise", type=quantity("pipette_noise"),
-                        default=1e-4, help="of a pipette sample's mass [g]")
-    parser.add_argument("--sieve-noise", type=quantity("sieve_noise"), default=0.5,
+                        default=PIPETTE_NOISE, help="of a pipette sample's mass [g]")
+    parser.add_argument("--sieve-noise", type=quantity("sieve_noise"), default=SIEVE_NOISE,
                         help="standard uncertainty of a sieve's percent passing [points] (default 0.5)")
     parser.add_argument("--thermometer", type=quantity("thermometer"),
-                        default=0.5, help="of the temperature record [C]")
+                        default=THERMOMETER_NOISE, help="of the temperature record [C]")
     parser.add_argument("--budget", type=Path, help="budget.json of `sediment budget` for this test: its physical "
                         "total widens the band")
     parser.add_argument("--budget-sample", metavar="NAME", help="the sample of a budget.json that holds several")
@@ -159,11 +161,12 @@ def run(args: argparse.Namespace) -> int:
         raise ValueError(sphere)
     scale = SCALES[args.hydrometer_type]
     hydrometer_noise, zero_correction, meniscus = (
-        hydrometer_step(args, "hydrometer_noise", "hydrometer_noise", 0.25), hydrometer_step(args, "zero_correction"),
+        hydrometer_step(args, "hydrometer_noise", "hydrometer_noise", HYDROMETER_NOISE),
+        hydrometer_step(args, "zero_correction"),
         hydrometer_step(args, "meniscus"))
     noise = {"hydrometer": hydrometer_noise, "buoyancy": args.balance_noise,
              "pipette": args.pipette_noise / (args.pipette_volume * 1e3), "sieve": args.sieve_noise}
-    test = LabTest(0.060 if mass is None else mass, args.particle_density, args.cylinder_area, height,
+    test = LabTest(SPECIMEN_MASS if mass is None else mass, args.particle_density, args.cylinder_area, height,
                    hydrometer=hydrometer(args), zero_correction=zero_correction, meniscus=meniscus,
                    sphere_depth=args.sphere_depth, sphere_diameter=args.sphere_diameter, sphere_mass=args.sphere_mass,
                    noise=noise, thermometer=args.thermometer)
@@ -206,10 +209,10 @@ def hydrometer_step(args: argparse.Namespace, option: str, quantity: str = "", d
         return default
     scale = SCALES[args.hydrometer_type]
     grams = value * scale.per_unit
-    named = f"--{option.replace('_', '-')}" + ("" if scale.name == "152H" else f" {value:g} (151H) as a 152H's:")
+    named = f"--{option.replace('_', '-')}" + ("" if scale.in_grams else f" {value:g} ({scale.name}) as a 152H's:")
     quantity = quantity or option.replace("zero_", "")
     reason = refusal(grams, quantity)
-    if scale.name != "152H" and reason is not None and refusal(value, quantity) is None:
+    if not scale.in_grams and reason is not None and refusal(value, quantity) is None:
         raise ValueError(f"{named} {reason}; written in a 152H's g/L? with --hydrometer-type 151H "
                          f"give it in specific gravity: {value / scale.per_unit:.3g}")
     return check(grams, quantity, named)
@@ -283,7 +286,7 @@ def _invert(args: argparse.Namespace, test, sheets) -> int:
 
     band, budget, entry = 0.0, None, None
     if args.budget is not None:
-        from ..sim.run import file_digest
+        from ..sim.provenance import file_digest
         from ..studies.budget import budget_entry
 
         entry = budget_entry(args.budget, args.budget_sample)
@@ -395,15 +398,6 @@ def _design(args: argparse.Namespace, test) -> int:
     for name, mass, n, mean, worst in rows:
         table.add(name, f"{mass * 1e3:g}", n, f"{mean:.3g}" if n else "cannot read", f"{worst:.3g}" if n else "")
     print(table.text(), end="")
-    plt = figures.pyplot()
-    fig, ax = plt.subplots(figsize=(7, 4.5))
-    for name in dict.fromkeys(r[0] for r in rows):
-        mine = [r for r in rows if r[0] == name]
-        ax.plot([r[1] * 1e3 for r in mine], [r[4] for r in mine], "o-", label=name)
-    ax.set(xlabel="sample mass [g]", ylabel="worst error of the recovered PSD [pp]", yscale="log",
-           title=f"designs of a test of {args.design.stem}")
-    ax.grid(alpha=0.3)
-    ax.legend(fontsize=8)
     write_text(args.out / "design.csv", table.csv())
-    figures.save(fig, args.out / "design.png")
+    figures.design_errors(rows, args.out / "design.png", f"designs of a test of {args.design.stem}")
     return 0

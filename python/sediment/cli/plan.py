@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from ..constants import INSTRUMENTS
 from ..progress import bar as progress_bar
 from .sample import add_test_options, cylinder_of, suspension_of
 from .types import count, positive, positive_list, quantity, setting
@@ -50,8 +51,8 @@ def add_parser(commands) -> argparse.ArgumentParser:
                         "particles=20000, contacts=no)")
     test = parser.add_argument_group("sedimentation test")
     add_test_options(test)
-    test.add_argument("--instruments", nargs="+", default=["hydrometer", "buoyancy", "pipette"],
-                      choices=["hydrometer", "buoyancy", "pipette"], help="the readings that make the answer")
+    test.add_argument("--instruments", nargs="+", default=list(INSTRUMENTS), choices=INSTRUMENTS,
+                      help="the readings that make the answer")
     test.add_argument("--particles", type=_counts, default=[40000, 20000, 10000, 5000],
                       help="parcel ladder, comma-separated (default 40000,20000,10000,5000; the largest is the reference)")
     test.add_argument("--courant", type=positive_list, default=[1.0, 2.0, 4.0, 8.0],
@@ -148,7 +149,7 @@ def _measure_contacts(test, args: argparse.Namespace, tolerance: float) -> None:
     from ..planner.contacts import ReducedScene, measure_contacts
     from ..planner.scenes import prepare
     from ..results import write_text
-    from ..sim.run import Runs
+    from ..sim.process import Runs
 
     largest = test.psd.span()[1]
     cut = largest / 3 if args.contact_cut is None else args.contact_cut * 1e-6

@@ -8,7 +8,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ..constants import D422_CYLINDER_AREA, D422_CYLINDER_HEIGHT, SCHEDULES, SOIL_PARTICLE_DENSITY
+from ..constants import (D422_CYLINDER_AREA, D422_CYLINDER_HEIGHT, INSTRUMENTS, PIPETTE_DEPTH, PIPETTE_VOLUME,
+                         SCHEDULES, SOIL_PARTICLE_DENSITY)
 from .types import positive, quantity, temperature
 
 
@@ -23,7 +24,7 @@ def add_parser(commands) -> argparse.ArgumentParser:
     parser = commands.add_parser("readout", help="hydrometer, buoyancy-sphere and pipette readings from a layer "
                                  "file (fix layers/hdf5), with CSV tables, the granulometry figure and errors")
     parser.add_argument("layers", type=Path, nargs="?", help="layer file (HDF5)")
-    parser.add_argument("--instrument", default="all", choices=["hydrometer", "buoyancy", "pipette", "all"])
+    parser.add_argument("--instrument", default="all", choices=[*INSTRUMENTS, "all"])
     parser.add_argument("--schedule", default="d422", choices=sorted(SCHEDULES),
                         help="reading times (the buoyancy sphere uses Bravo et al.'s unless another is given)")
     parser.add_argument("--psd", type=Path, help="input PSD (diameter_um,percent_finer) to compare with "
@@ -41,8 +42,8 @@ def add_parser(commands) -> argparse.ArgumentParser:
                         help="free-surface coordinate [m] (default: top of the layers)")
     parser.add_argument("--sphere-depth", type=quantity("instrument_depth"),
                         help="buoyancy sphere centre depth [m] (default 0.3 H)")
-    parser.add_argument("--pipette-depth", type=quantity("instrument_depth"), default=0.10, help="[m]")
-    parser.add_argument("--pipette-volume", type=quantity("pipette_volume"), default=25e-6, help="[m3]")
+    parser.add_argument("--pipette-depth", type=quantity("instrument_depth"), default=PIPETTE_DEPTH, help="[m]")
+    parser.add_argument("--pipette-volume", type=quantity("pipette_volume"), default=PIPETTE_VOLUME, help="[m3]")
     parser.add_argument("--hydrometer", type=positive, nargs=6,
                         metavar=("L2", "VB", "STEM_D", "MASS", "L1_R0", "L1_R50"),
                         help="a measured hydrometer instead of the nominal 152H: bulb length [m], bulb volume "
@@ -82,6 +83,7 @@ def run(args: argparse.Namespace) -> int:
                 print(f"using {beside}")
     if args.layers is not None:    # the frames and what they are compared with checked before they are read
         from ..sim.layers import check_layer_file, read_layers_guarded
+        from ..sim.provenance import check_digest, check_inputs
         check_layer_file(args.layers)
         check_digest(args.layers)
         layers = read_layers_guarded(args.layers)
@@ -115,7 +117,7 @@ def run(args: argparse.Namespace) -> int:
         times = np.concatenate([[0.0], np.geomspace(10.0, 1440 * 60.0, 400)])
         column = settling_column(psd, args.height, times, args.concentration, suspension)
         title = f"{args.psd.name}: Stokes settling preview (no DEM)"
-    instruments = ["hydrometer", "buoyancy", "pipette"] if args.instrument == "all" else [args.instrument]
+    instruments = list(INSTRUMENTS) if args.instrument == "all" else [args.instrument]
     hydrometer = Hydrometer.measured(*_measured(args.hydrometer)) if args.hydrometer else None
     report = granulometry(column, instruments, psd, simulated, title, schedule=args.schedule,
                           sphere_depth=args.sphere_depth, pipette_depth=args.pipette_depth,
@@ -144,40 +146,3 @@ def _measured(values: list[float]) -> list[float]:
     quantities = ("bulb_length", "bulb_volume", "stem_diameter", "hydrometer_mass", "scale_mark", "scale_mark")
     names = ("L2", "VB", "STEM_D", "MASS", "L1_R0", "L1_R50")
     return [check(v, q, f"--hydrometer {n}") for v, q, n in zip(values, quantities, names)]
-
-
-def check_digest(path: Path) -> None:
-    """Refuses a layer file whose bytes are not those its run recorded when it completed it (in the
-    folder's run record): damaged, or replaced since."""
-    from ..sim.run import RECORD, file_digest, read_record
-
-    record = read_record(path.parent)
-    done = (record or {}).get("layers", {})
-    if done.get("file") == path.name and file_digest(path) != done.get("sha256"):
-        raise ValueError(f"{path} is damaged or was replaced: its bytes are not those its run {record['run_id']} "
-                         f"completed (SHA-256 in {path.parent / RECORD}); run the deck again (sediment run --force)")
-
-
-def check_inputs(path: Path, identity: str, compared: list[Path] = ()) -> None:
-    """Refuses a layer file beside a deck whose inputs are not those of the run that wrote it (the
-    folder sampled again since), or beside tables (`compared`) other than those its run started with:
-    its frames would be read against another test's. The run record names what differs."""
-    from ..sim.run import RECORD, file_digest, input_files, inputs_id, read_record
-
-    record = read_record(path.parent)
-    deck = path.parent / (record["deck"] if record else "in.sedimentation")
-    held = identity.split("-")
-    started = record.get("files", {}) if record and record["run_id"] == identity else {}
-    changed = [p.name for p in [deck, *(input_files(deck) if deck.is_file() else []), *compared]
-               if p.name in started and (not p.is_file() or file_digest(p) != started[p.name])]
-    if len(held) == 3 and deck.is_file() and inputs_id(deck) != held[0]:
-        reads = ", ".join([deck.name] + [p.name for p in input_files(deck)])
-        which = f"; {', '.join(changed)} changed since it started" if changed else ""
-        raise ValueError(f"{path} was written by a run of other inputs than those now in its folder ({reads}{which}): "
-                         "it was sampled again since, and its tables describe another test; run the deck again, or "
-                         "read the frames where their own tables are")
-    if changed:
-        raise ValueError(f"{', '.join(changed)} beside {path} changed since its run started (replaced, by another "
-                         f"sample's for one; {RECORD} holds the SHA-256 of what the run started with): the frames "
-                         "would be compared with another test's tables; put the run's own back, or give --psd and "
-                         "--simulated")

@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from ..constants import DRAGS, HINDRANCES, LAB_TEMPERATURE, SOIL_PARTICLE_DENSITY
+from ..constants import DRAGS, HINDRANCES, LAB_TEMPERATURE, SOIL_PARTICLE_DENSITY, SPECIMEN_MASS
 from .types import count, positive, quantity, temperature
 
 
@@ -59,7 +59,7 @@ def add_test_options(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--width", type=quantity("column_width"),
                         help="column side or slab width [m] (default: 2 largest "
                         "diameters; the slab spans the cylinder)")
-    parser.add_argument("--mass", type=quantity("specimen_mass"), default=0.060, help="dry sample mass [kg]")
+    parser.add_argument("--mass", type=quantity("specimen_mass"), default=SPECIMEN_MASS, help="dry sample mass [kg]")
     parser.add_argument("--particle-density", type=quantity("particle_density"),
                         default=SOIL_PARTICLE_DENSITY, help="[kg/m3]")
     parser.add_argument("--temperature", type=temperature, default=LAB_TEMPERATURE,
@@ -103,7 +103,8 @@ def cylinder_of(args: argparse.Namespace):
 def run(args: argparse.Namespace) -> int:
     """Plans the scene, prints it and writes its data file, deck and PSD tables."""
     from ..lab.psd import read_psd
-    from ..sim.scene import describe, plan, runs_replaced, write
+    from ..sim.scene import plan
+    from ..sim.scenefiles import describe, runs_replaced, write
 
     psd = read_psd(args.psd)
     record = ()

@@ -26,12 +26,13 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from .. import _core, figures
+from .. import figures
+from ..lab.instruments import instrument
 from ..lab.psd import PSD
-from ..lab.readout import Column, Suspension, gs_correction
+from ..lab.readout import Column, Suspension
+from ..lab.settling import terminal_speeds
 from ..lab.sheet import Reduction, Sheet
 from ..lab.synthetic import settling_column
-from ..planner.screening import terminal_speeds
 from ..results import Table
 from .fit import fit
 from .grid import SizeGrid
@@ -192,21 +193,10 @@ def point_readings(shares: np.ndarray, diameter: np.ndarray, sheets: list[Sheet]
     finer = finer_in_bins(grid, diameter)
     # reading = offset + slope x percent finer, as each instrument's standard reduction inverts it
     offset, slope = [], []
-    c0 = test.initial_concentration
-    gs = test.particle_density / 1000.0
     for sheet, r in zip(sheets, reduction):
-        n = len(sheet.time)
-        if sheet.instrument == "hydrometer":
-            offset.append(np.zeros(n))
-            slope.append(np.full(n, c0 / (100 * gs_correction(gs))))
-        elif sheet.instrument == "pipette":
-            offset.append(np.zeros(n))
-            slope.append(np.full(n, c0 / 100))
-        else:
-            sphere = test.sphere
-            fluid = np.array([_core.water_density(t) for t in r.temperature])
-            offset.append((sphere.mass - fluid * sphere.volume) * 1e3)
-            slope.append(np.full(n, -c0 / 100 * sphere.volume * (gs - 1) / gs * 1e3))
+        at, by = instrument(sheet.instrument).linear(test, r.temperature)
+        offset.append(at)
+        slope.append(by)
     offset, slope = np.concatenate(offset), np.concatenate(slope)
     jac = slope[:, None] * 100 * finer
     return offset + jac @ shares, jac

@@ -9,6 +9,8 @@ from pathlib import Path
 
 import numpy as np
 
+from ..constants import LAB_TEMPERATURE, PIPETTE_DEPTH, SCHEDULES, SPECIMEN_MASS
+from ..lab.instruments import instrument
 from ..lab.psd import PSD
 from ..lab.readout import Pipette, Suspension, gs_correction
 from ..lab.sheet import Sheet
@@ -18,18 +20,19 @@ from .model import LabTest, linearise, psd_of, run_forward
 
 CLAY_LIMIT = 2e-6    # [m]
 
-# The designs `design_test` compares: instruments and their reading times [min] (the pipette at 10 cm).
+# The designs `design_test` compares: instruments and their reading times [min] (the pipette at
+# PIPETTE_DEPTH, at its default times).
 DESIGNS = {
-    "152H, D422 times": [("hydrometer", (2, 5, 15, 30, 60, 250, 1440))],
-    "152H, D7928 times": [("hydrometer", (1, 2, 4, 15, 30, 60, 240, 1440))],
-    "pipette at 10 cm": [("pipette", None)],
-    "buoyancy sphere, Bravo et al.'s times": [("buoyancy", (0.5, 1, 2, 4, 15, 30, 60, 120, 240, 480))],
-    "152H (D7928) + pipette": [("hydrometer", (1, 2, 4, 15, 30, 60, 240, 1440)), ("pipette", None)],
+    "152H, D422 times": [("hydrometer", tuple(SCHEDULES["d422"]))],
+    "152H, D7928 times": [("hydrometer", tuple(SCHEDULES["d7928"]))],
+    f"pipette at {PIPETTE_DEPTH * 100:g} cm": [("pipette", None)],
+    "buoyancy sphere, Bravo et al.'s times": [("buoyancy", tuple(SCHEDULES["bravo"]))],
+    "152H (D7928) + pipette": [("hydrometer", tuple(SCHEDULES["d7928"])), ("pipette", None)],
 }
 
 
 def design_test(psd: PSD, folder: Path, masses=(0.030, 0.045, 0.060, 0.080), designs: dict = DESIGNS,
-                test: LabTest = LabTest(0.060), bins: int = 12, draws: int = 24, particles: int = 20000,
+                test: LabTest = LabTest(SPECIMEN_MASS), bins: int = 12, draws: int = 24, particles: int = 20000,
                 seed: int = 1) -> list[tuple[str, float, int, float, float]]:
     """Which instrument, reading times and sample mass recover `psd` best: for each mass a forward run of
     the test, each design's readings of it with their noise drawn `draws` times and fitted as `invert`
@@ -40,7 +43,7 @@ def design_test(psd: PSD, folder: Path, masses=(0.030, 0.045, 0.060, 0.080), des
     not in it (docs/error-budget.md: the exponent row)."""
     if bins < MIN_BINS:
         raise ValueError(f"--bins {bins}: give at least {MIN_BINS} size bins")
-    water = Suspension.at_temperature(20.0, test.particle_density)
+    water = Suspension.at_temperature(LAB_TEMPERATURE, test.particle_density)
     rng = np.random.default_rng(seed)
     results = []
     for mass in masses:
@@ -78,14 +81,15 @@ def design_test(psd: PSD, folder: Path, masses=(0.030, 0.045, 0.060, 0.080), des
 def _design_sheets(parts, test: LabTest, water: Suspension) -> list[Sheet]:
     """The sheets of a design (readings unset: the forward run reads them)."""
     sheets = []
-    for instrument, minutes in parts:
-        if instrument == "pipette":
-            time = np.sort(Pipette(0.10).default_times(water))
-            depth = np.full(len(time), 0.10)
+    for name, minutes in parts:
+        instrument(name)    # an unknown name is refused
+        if minutes is None:    # the pipette's default times at its depth
+            time = np.sort(Pipette(PIPETTE_DEPTH).default_times(water))
+            depth = np.full(len(time), PIPETTE_DEPTH)
         else:
             time = np.array(minutes, float) * 60
             depth = np.empty(0)
-        sheets.append(Sheet(instrument, Path(instrument), time, np.zeros(len(time)), np.full(len(time), 20.0), depth))
+        sheets.append(Sheet(name, Path(name), time, np.zeros(len(time)), np.full(len(time), LAB_TEMPERATURE), depth))
     return sheets
 
 
@@ -93,7 +97,7 @@ def _design_diameters(parts, test: LabTest, water: Suspension) -> list[float]:
     """The Stokes diameters a design's readings resolve, at the instruments' nominal depths."""
     out = []
     for sheet in _design_sheets(parts, test, water):
-        depth = {"hydrometer": 0.15, "pipette": 0.10, "buoyancy": test.sphere.depth}[sheet.instrument]
+        depth = instrument(sheet.instrument).nominal_depth(test)
         out += list(water.stokes_diameter(depth, sheet.time))
     return out
 
@@ -101,7 +105,7 @@ def _design_diameters(parts, test: LabTest, water: Suspension) -> list[float]:
 def clay_reading_time(psd: PSD, test: LabTest, temperatures=(18.0, 20.0, 23.0, 25.0)) -> list[tuple[float, float]]:
     """When the 152H's cut reaches the clay limit: the Stokes time of a 2 um grain to the bulb's depth at
     the reading the expected PSD gives there, for each water temperature; (temperature [C], time [s])."""
-    water = Suspension.at_temperature(20.0, test.particle_density)
+    water = Suspension.at_temperature(LAB_TEMPERATURE, test.particle_density)
     reading = psd.at([CLAY_LIMIT])[0] / 100 * test.initial_concentration / gs_correction(water.specific_gravity)
     hydrometer = test.hydrometer
     depth = hydrometer.effective_depth(reading, test.cylinder_area)

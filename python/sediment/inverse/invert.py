@@ -10,7 +10,9 @@ from pathlib import Path
 import numpy as np
 
 from .. import figures
+from ..constants import HYDROMETER_TYPES, LAB_TEMPERATURE
 from ..lab import texture
+from ..lab.instruments import HydrometerTest, instrument
 from ..lab.psd import NOT_FITTING
 from ..lab.readout import SCALES, Scale, Suspension, gs_correction
 from ..lab.sheet import Reduction, Sheet, SieveSheet, SheetError, check_sheet, standard_reduction
@@ -98,9 +100,9 @@ class Inversion:
                                  "graduation, from the calibration, less V_B / 2A); percent_finer is 100 a (reading - "
                                  "correction) / c0 in g/L"])
         for r in self.reduction:
-            hydrometer = r.instrument == "hydrometer"
-            reading = r.scale.as_read(r.reading) if hydrometer else r.reading
-            unit = r.scale.unit if hydrometer else NOISE_UNITS[r.instrument]
+            kind = instrument(r.instrument)
+            reading = r.scale.as_read(r.reading) if kind.on_hydrometer_scale else r.reading
+            unit = kind.sheet_unit(r.scale)
             for row in zip(r.time / 60, reading, r.correction / r.scale.per_unit, r.temperature, r.depth * 100,
                            r.diameter * 1e6, r.percent):
                 reduction.add(r.instrument, *map(float, row[:3]), r.meniscus / r.scale.per_unit, unit,
@@ -255,13 +257,14 @@ def invert(sheets: list[Sheet], test: LabTest, folder: Path, *, sieve: SieveShee
     if not sheets:
         raise ValueError("no sheet of readings to invert (a sieve sheet alone gives no sedimentation data)")
     recorded = np.concatenate([s.temperature[np.isfinite(s.temperature)] for s in sheets])
-    mean_temperature = float(recorded.mean()) if len(recorded) else 20.0
+    mean_temperature = float(recorded.mean()) if len(recorded) else LAB_TEMPERATURE
     water = Suspension.at_temperature(mean_temperature, test.particle_density)
     c0 = test.initial_concentration
     signals = [solids_signal(sheet, test, water) for sheet in sheets]
     corrected = [test.corrected(sheet) for sheet in sheets]
     for sheet, reading, signal in zip(sheets, corrected, signals):
-        below = np.flatnonzero(reading < -2 * test.noise[sheet.instrument]) if sheet.instrument == "hydrometer" else []
+        kind = instrument(sheet.instrument)
+        below = np.flatnonzero(reading < -2 * test.noise[sheet.instrument]) if kind.on_hydrometer_scale else []
         if len(below):
             k = below[0]
             raise SheetError(f"{sheet.where(k)}: the reading ({sheet.scale.quoted(sheet.reading[k])} on the sheet) is "
@@ -272,10 +275,9 @@ def invert(sheets: list[Sheet], test: LabTest, folder: Path, *, sieve: SieveShee
         # suspension (a pipette's first samples can draw a little more than the mean)
         noise = test.noise[sheet.instrument]
         tolerance = max(2 * noise, 0.02 * signal)
-        stated = "" if sheet.instrument == "pipette" else \
-            f" (now {noise_text(sheet.instrument, noise, sheet.scale)}; the tolerance is twice it, or 2 % of the solids' signal)"
-        check_sheet(sheet, whole_sample_reading(sheet, test, water), tolerance, reading,
-                    NOISE_OPTIONS[sheet.instrument] + stated)
+        stated = "" if not kind.noise_as_read else \
+            f" (now {kind.noise_text(noise, sheet.scale)}; the tolerance is twice it, or 2 % of the solids' signal)"
+        check_sheet(sheet, whole_sample_reading(sheet, test, water), tolerance, reading, kind.noise_option + stated)
     sieves = sieve_data(sieve, split, test.noise["sieve"])
     if split is None and sieves.top > test.height / COLUMN_DIAMETERS:
         d422 = [p for o, p in zip(sieve.opening, sieve.passing) if abs(o - 2e-3) < 1e-5]
@@ -344,11 +346,11 @@ def invert(sheets: list[Sheet], test: LabTest, folder: Path, *, sieve: SieveShee
     specimen_draws = []
     # the composite correction is one reading of the blank cylinder, subtracted from every reading of the
     # sheet: its error, a reading's, is common to them (as the thermometer's offset is)
-    blank_rows = [rows for sheet, rows in zip(sheets, rows_of) if sheet.instrument == "hydrometer"]
+    blank_rows = [rows for sheet, rows in zip(sheets, rows_of) if instrument(sheet.instrument).on_hydrometer_scale]
     for _ in range(draws):
         noisy = data + rng.normal(0.0, sigma) - rng.normal(0.0, test.thermometer) * per_degree
         for rows in blank_rows:
-            noisy[rows] += rng.normal(0.0, test.noise["hydrometer"])
+            noisy[rows] += rng.normal(0.0, test.noise[HydrometerTest.name])
         x, _, _ = fit(jac, base, shares, noisy, sigma, grid, weight * 10 ** -rng.uniform(0, ROUGHNESS_DECADES),
                       rng.normal(0.0, 1.0, penalty_rows),
                       draw_placement(grid, rng))
@@ -376,8 +378,9 @@ def invert(sheets: list[Sheet], test: LabTest, folder: Path, *, sieve: SieveShee
     inputs = test.record() | {
         "sheets": [str(s.path) for s in sheets] + ([str(sieve.path)] if sieve is not None else []),
         "composite_correction": {str(s.path): ("blank column" if len(s.blank) else test.zero_correction)
-                                 for s in sheets if s.instrument == "hydrometer"},
-        "hydrometer_type": next((s.scale.name for s in sheets if s.instrument == "hydrometer"), "152H"),
+                                 for s in sheets if instrument(s.instrument).on_hydrometer_scale},
+        "hydrometer_type": next((s.scale.name for s in sheets if instrument(s.instrument).on_hydrometer_scale),
+                                HYDROMETER_TYPES[0]),
         "temperatures_C": [float(recorded.min()), float(recorded.max())] if len(recorded) else None,
         "split_mm": None if split is None else split * 1e3, "specimen_share": sieves.share,
         "top_um": sieves.top * 1e6}
@@ -398,7 +401,8 @@ def invert(sheets: list[Sheet], test: LabTest, folder: Path, *, sieve: SieveShee
                              f"(more than {CONVERGED:g}), as the hindrance of each round's PSD moves the next; the answer "
                              "stands, but read differences smaller than that as the model's own spread, which the band "
                              "does not hold: more --particles steady the runs"))
-    unread = [s for s in sheets if s.instrument == "hydrometer" and not len(s.blank) and test.zero_correction == 0]
+    unread = [s for s in sheets
+              if instrument(s.instrument).on_hydrometer_scale and not len(s.blank) and test.zero_correction == 0]
     if unread:
         a = gs_correction(test.particle_density / 1000.0)
         out.notes.append(f"no composite correction for {', '.join(s.path.name for s in unread)}: its readings are "
@@ -425,7 +429,7 @@ def invert(sheets: list[Sheet], test: LabTest, folder: Path, *, sieve: SieveShee
         out.notes.append(f"{name} at {where} is {abs(modelled - measured) / s:.1f} noise units off the fit: check it")
     read = [r for r in rows if r[0] != "sieve"]
     if len(read) >= 5 and out.reduced_chi2 < TOO_GOOD:
-        units = {s.instrument: noise_text(s.instrument, test.noise[s.instrument], s.scale) for s in sheets}
+        units = {s.instrument: instrument(s.instrument).noise_text(test.noise[s.instrument], s.scale) for s in sheets}
         out.notes.append(f"note: the readings lie far closer to the fit than their stated errors say (chi-square per "
                          f"reading {out.reduced_chi2:.2g}, where about 1 is expected): the band, which those errors set "
                          f"({', '.join(f'{k} {v}' for k, v in units.items())}), is wider than the readings need; or the "
@@ -442,15 +446,6 @@ def _in_tail(diameter: np.ndarray, percent: np.ndarray, basis: np.ndarray, level
     """Whether the curve reaches `level` percent finer within a tail (or below the floor's edge)."""
     k = int(np.argmax(percent >= level))
     return percent[k] >= level and basis[k] in ("fine tail", "coarse tail", "floor")
-
-
-NOISE_UNITS = {"hydrometer": "g/L", "pipette": "g/L", "buoyancy": "g", "sieve": "points"}
-NOISE_OPTIONS = {"hydrometer": "--hydrometer-noise", "pipette": "--pipette-noise", "buoyancy": "--balance-noise"}
-
-
-def noise_text(instrument: str, noise: float, scale: Scale) -> str:
-    """An instrument's reading error as its noise option states it (a hydrometer's on its `scale`)."""
-    return scale.quoted_step(noise) if instrument == "hydrometer" else f"{noise:g} {NOISE_UNITS[instrument]}"
 
 
 STEP_WARNING = 15.0        # points between the coarsest cut and the next sieve that deserve a second look
@@ -495,15 +490,20 @@ def _sieves_tension(rows: list[tuple[str, float, float, float, float, float]]) -
         return None
     finest = min(sieves, key=lambda r: r[2])
     pull = (finest[4] - finest[3]) / finest[5]
-    for instrument in dict.fromkeys(r[0] for r in rows if r[0] != "sieve"):
-        first = min((r for r in rows if r[0] == instrument), key=lambda r: r[1])
+    for name in dict.fromkeys(r[0] for r in rows if r[0] != SieveSheet.instrument):
+        first = min((r for r in rows if r[0] == name), key=lambda r: r[1])
         against = (first[4] - first[3]) / first[5]
         if abs(pull) >= TENSION and abs(against) >= TENSION and pull * against < 0:
-            return (f"check: the {instrument}'s first reading ({first[1] / 60:g} min, {against:+.1f} noise units off the "
+            return (f"check: the {name}'s first reading ({first[1] / 60:g} min, {against:+.1f} noise units off the "
                     f"fit) and the {finest[2] * 1e3:g} mm sieve ({pull:+.1f}) pull the curve apart where they meet: a "
                     "sieve sheet of another sample, a wrong --mass, a first reading taken before the suspension stilled, "
                     "or a gap in the grading, which a step there absorbs")
     return None
+
+
+def _noise_text(name: str, noise: float, scale: Scale) -> str:
+    """A reading error as its option states it: an instrument's, or the sieves' in points."""
+    return f"{noise:g} points" if name == SieveSheet.instrument else instrument(name).noise_text(noise, scale)
 
 
 def _inputs_line(test: LabTest, inputs: dict) -> str:
@@ -511,7 +511,7 @@ def _inputs_line(test: LabTest, inputs: dict) -> str:
     scale = SCALES[inputs["hydrometer_type"]]
     correction = "; ".join(f"{Path(k).name}: {v if isinstance(v, str) else scale.quoted_step(v)}"
                            for k, v in inputs["composite_correction"].items()) or "none"
-    read = "" if scale.name == "152H" else " (its specific gravity R read as 1000 (R - 1) / 0.6226 g/L of a 152H)"
+    read = "" if scale.in_grams else " (its specific gravity R read as 1000 (R - 1) / 0.6226 g/L of a 152H)"
     temperatures = inputs["temperatures_C"]
     return (f"inputs: specimen {test.mass * 1e3:.5g} g (oven-dry), particle density {test.particle_density:g} kg/m3, "
             f"suspension {test.cylinder_area * test.height * 1e6:.4g} mL in a cylinder of {test.cylinder_area * 1e4:.4g} "
@@ -521,7 +521,7 @@ def _inputs_line(test: LabTest, inputs: dict) -> str:
             + f", the specimen's largest grain {inputs['top_um']:g} um"
             + (f" (the part passing {inputs['split_mm']:g} mm, {100 * inputs['specimen_share']:.4g} % of the sample)"
                if inputs["split_mm"] else "")
-            + "; noise: " + ", ".join(f"{k} {noise_text(k, v, scale)}" for k, v in test.noise.items())
+            + "; noise: " + ", ".join(f"{k} {_noise_text(k, v, scale)}" for k, v in test.noise.items())
             + f", thermometer {test.thermometer:g} C"
             + "; sheets: " + ", ".join(Path(s).name for s in inputs["sheets"]))
 

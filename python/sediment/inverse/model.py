@@ -11,8 +11,12 @@ from pathlib import Path
 import numpy as np
 
 from .. import _core
+from ..constants import (D422_CYLINDER_AREA, D422_CYLINDER_HEIGHT, SIEVE_NOISE, SOIL_PARTICLE_DENSITY,
+                         SPHERE_DEPTH_SHARE, SPHERE_DIAMETER, SPHERE_MASS, THERMOMETER_NOISE)
+from ..lab.instruments import INSTRUMENTS, instrument
 from ..lab.psd import PSD
-from ..lab.readout import BuoyancySphere, Column, Hydrometer, Pipette, Suspension, gs_correction
+from ..lab.readout import BuoyancySphere, Column, Hydrometer, Suspension
+from ..lab.settling import terminal_speeds
 from ..lab.sheet import Sheet, standard_reduction
 from .grid import SizeGrid
 
@@ -24,20 +28,19 @@ class LabTest:
     """What the sheets do not say: the sample, the cylinder and the instruments."""
 
     mass: float                          # dry specimen in the cylinder [kg]
-    particle_density: float = 2650.0     # [kg/m3]
-    cylinder_area: float = 27.8e-4       # [m2]
-    height: float = 0.36                 # suspension height [m]
+    particle_density: float = SOIL_PARTICLE_DENSITY    # [kg/m3]
+    cylinder_area: float = D422_CYLINDER_AREA          # [m2]
+    height: float = D422_CYLINDER_HEIGHT               # suspension height [m]
     hydrometer: Hydrometer = field(default_factory=Hydrometer.astm_152h)
     zero_correction: float = 0.0         # g/L subtracted from each hydrometer reading (composite correction)
     meniscus: float = 0.0                # g/L added for the depth only
-    sphere_depth: float | None = None    # centre [m], default 0.3 of the height
-    sphere_diameter: float = 0.025       # [m]
-    sphere_mass: float = 0.020           # [kg]
-    # reading noise: 152H read to 0.5 g/L; a balance to 1 mg; pipette sample masses to 0.1 mg (as g/L of 25 mL);
-    # a sieve's percent passing to 0.5 points
-    noise: dict = field(default_factory=lambda: {"hydrometer": 0.25, "buoyancy": 1e-3, "pipette": 0.1e-3 / 0.025,
-                                                 "sieve": 0.5})
-    thermometer: float = 0.5             # C, standard uncertainty of the temperature record
+    sphere_depth: float | None = None    # centre [m], default SPHERE_DEPTH_SHARE of the height
+    sphere_diameter: float = SPHERE_DIAMETER    # [m]
+    sphere_mass: float = SPHERE_MASS            # [kg]
+    # reading noise per instrument, in the unit the inverse takes its readings in (the instruments' defaults)
+    noise: dict = field(default_factory=lambda: {name: i.noise for name, i in INSTRUMENTS.items()}
+                                                | {"sieve": SIEVE_NOISE})
+    thermometer: float = THERMOMETER_NOISE    # C, standard uncertainty of the temperature record
 
     @property
     def initial_concentration(self) -> float:
@@ -46,14 +49,14 @@ class LabTest:
 
     @property
     def sphere(self) -> BuoyancySphere:
-        """The buoyancy sphere, its centre at `sphere_depth` (default 0.3 of the height)."""
-        depth = 0.3 * self.height if self.sphere_depth is None else self.sphere_depth
+        """The buoyancy sphere, its centre at `sphere_depth` (default SPHERE_DEPTH_SHARE of the height)."""
+        depth = SPHERE_DEPTH_SHARE * self.height if self.sphere_depth is None else self.sphere_depth
         return BuoyancySphere(depth, self.sphere_diameter, self.sphere_mass)
 
     def correction(self, sheet: Sheet) -> np.ndarray:
         """The 152H's composite correction at each reading [g/L]: the sheet's own `blank` column where
         it has one, else the test's zero correction (0 for other instruments)."""
-        if sheet.instrument != "hydrometer":
+        if not INSTRUMENTS[sheet.instrument].on_hydrometer_scale:
             return np.zeros(len(sheet.time))
         return np.array(sheet.blank, float) if len(sheet.blank) else np.full(len(sheet.time), self.zero_correction)
 
@@ -72,19 +75,12 @@ class LabTest:
 
 def whole_sample_reading(sheet: Sheet, test: LabTest, water: Suspension) -> float:
     """What the instrument reads with the whole sample in suspension (its unit)."""
-    c0 = test.initial_concentration
-    if sheet.instrument == "hydrometer":
-        return c0 / gs_correction(test.particle_density / 1000.0)
-    if sheet.instrument == "pipette":
-        return c0
-    rho = water.mixture_density(c0 / test.particle_density)
-    return (test.sphere_mass - rho * test.sphere.volume) * 1e3
+    return instrument(sheet.instrument).whole_sample(test, water)
 
 
 def solids_signal(sheet: Sheet, test: LabTest, water: Suspension) -> float:
     """How far the whole sample moves the instrument's reading from clear water's (its unit)."""
-    clear = (test.sphere_mass - water.fluid_density * test.sphere.volume) * 1e3 if sheet.instrument == "buoyancy" else 0.0
-    return abs(whole_sample_reading(sheet, test, water) - clear)
+    return abs(whole_sample_reading(sheet, test, water) - instrument(sheet.instrument).clear_water(test, water))
 
 
 def effective_times(sheet: Sheet, reference: Suspension, offset: float = 0.0) -> np.ndarray:
@@ -119,36 +115,12 @@ class ForwardRun:
         column = Column.from_layers(self.layers, fraction=fraction)
         return replace(column, suspension=self.water)
 
-    def hydrometer_readings(self, column: Column, sheet: Sheet, times: np.ndarray) -> np.ndarray:
-        """The 152H's readings of a column, composite-corrected as the sheet's are. The instrument floats
-        in the companion cylinder's liquid (water and dispersant at the reading's temperature: what the
-        composite correction and the meniscus read there) with the solids, so its bulb sits where the
-        sheet's reading puts it (D7928's H_m at the reading as read plus the meniscus)."""
-        liquid = self.test.correction(sheet) + self.test.meniscus    # the liquid's reading at its surface [g/L]
-        out = np.empty(len(times))
-        for value in np.unique(liquid):
-            at = liquid == value
-            density = float(self.test.hydrometer.liquid_density(value))
-            read = self.test.hydrometer.read(replace(column, suspension=replace(self.water, fluid_density=density)),
-                                             times[at], cylinder_area=self.test.cylinder_area).reading
-            out[at] = read - value
-        return out
-
     def readings(self, shares: np.ndarray, sheets: list[Sheet], times: list[np.ndarray]) -> np.ndarray:
         """Every sheet's modelled readings, in order, for a split of the mass."""
         column = self.column(shares)
         out = []
         for sheet, t in zip(sheets, times):
-            if sheet.instrument == "hydrometer":
-                out.append(self.hydrometer_readings(column, sheet, t))
-            elif sheet.instrument == "pipette":
-                out.append(np.array([Pipette(z).read(column, [ti]).reading[0] for z, ti in zip(sheet.depth, t)]))
-            else:
-                # the balance reads the sphere in the water at each reading's temperature
-                sphere = self.test.sphere
-                recorded = np.where(np.isfinite(sheet.temperature), sheet.temperature, self.water.temperature or 20.0)
-                water = np.array([_core.water_density(c) for c in recorded])
-                out.append(sphere.read(column, t).reading - (water - self.water.fluid_density) * sphere.volume * 1e3)
+            out.append(instrument(sheet.instrument).modelled(column, sheet, t, self.test, self.water))
         return np.concatenate(out) if out else np.empty(0)
 
 
@@ -171,7 +143,8 @@ def run_forward(psd: PSD, grid: SizeGrid, test: LabTest, water: Suspension, t_en
     """Writes and runs the test with `psd`, its layers split into the grid's bins."""
     from ..sim.layers import read_layers
     from ..sim.run import run_batch
-    from ..sim.scene import Cylinder, Effects, plan, write
+    from ..sim.scene import Cylinder, Effects, plan
+    from ..sim.scenefiles import write
 
     scene = plan(psd, cylinder=Cylinder(test.cylinder_area, test.height), mass=test.mass, suspension=water,
                  classes=class_bounds(grid), particles=particles, courant=courant, seed=seed, effects=Effects(),
@@ -223,8 +196,6 @@ def settling_diameter(water: Suspension, speed: float, stokes: float, voidage: f
                       hindrance: str = "none") -> float:
     """The diameter whose terminal speed on the standard drag curve (hindered at `voidage`) is `speed`,
     found within a factor of two of its Stokes diameter `stokes`."""
-    from ..planner.screening import terminal_speeds
-
     low, high = math.log(0.5 * stokes), math.log(2.0 * stokes)
     for _ in range(40):    # bisection in log d: the speed rises with the diameter
         middle = 0.5 * (low + high)

@@ -4,22 +4,22 @@ input PSD, and the error per size range (docs/sedimentation-tests.md section 6).
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from functools import partial
 from pathlib import Path
 
 import numpy as np
 
 from .. import figures
-from ..constants import D422_CYLINDER_AREA
+from ..constants import D422_CYLINDER_AREA, PIPETTE_DEPTH, PIPETTE_VOLUME
 from ..results import Table, write_atomic, write_text
+from .instruments import ReadoutSetup, instrument
 from .psd import PSD
-from .readout import SCHEDULES, BuoyancySphere, Column, Hydrometer, Pipette, Readings
+from .readout import Column, Hydrometer, Readings
 
 SIZE_RANGES_UM = [(0.0, 5.0), (5.0, 20.0), (20.0, 75.0)]
 
 
 def read_all(column: Column, instruments: list[str], schedule: str = "d422", sphere_depth: float | None = None,
-             pipette_depth: float = 0.10, pipette_volume: float = 25e-6,
+             pipette_depth: float = PIPETTE_DEPTH, pipette_volume: float = PIPETTE_VOLUME,
              cylinder_area: float = D422_CYLINDER_AREA, hydrometer: Hydrometer | None = None) -> tuple[list[Readings], list[str]]:
     """Readings of the chosen instruments at the schedule's times that the frames cover.
 
@@ -28,7 +28,7 @@ def read_all(column: Column, instruments: list[str], schedule: str = "d422", sph
     column : Column
         The simulated (or analytic) suspension at the frame times.
     instruments : list of str
-        Any of ``"hydrometer"``, ``"buoyancy"``, ``"pipette"``.
+        Names in ``sediment.lab.instruments.INSTRUMENTS`` (an unknown one is refused).
     schedule : str
         Reading times: ``"d422"``, ``"d7928"`` or ``"bravo"`` (the buoyancy sphere reads on Bravo et
         al.'s times with ``"d422"``).
@@ -55,17 +55,11 @@ def read_all(column: Column, instruments: list[str], schedule: str = "d422", sph
         notes.append(column.water_text())
     # a reading time at the last frame's to the digits a sum of time steps keeps is read at that frame
     last = column.time[-1]
+    setup = ReadoutSetup(schedule, sphere_depth, pipette_depth, pipette_volume, cylinder_area, hydrometer)
+    chosen = [instrument(name) for name in instruments]    # every name checked before any reads
     results = []
-    for name in instruments:
-        if name == "hydrometer":
-            read = partial((hydrometer or Hydrometer.astm_152h()).read, cylinder_area=cylinder_area)
-            times = np.array(SCHEDULES[schedule]) * 60.0
-        elif name == "buoyancy":
-            read = BuoyancySphere(0.3 * column.height if sphere_depth is None else sphere_depth).read
-            times = np.array(SCHEDULES["bravo" if schedule == "d422" else schedule]) * 60.0
-        else:
-            pipette = Pipette(pipette_depth, pipette_volume)
-            read, times = pipette.read, pipette.default_times(column.suspension)
+    for name, reader in zip(instruments, chosen):
+        read, times = reader.simulated(column, setup)
         times = np.where(np.abs(times - last) <= 1e-9 * last, last, times)
         early, late = int(np.sum(times <= column.time[0])), int(np.sum(times > column.time[-1]))
         covered = times[(times > column.time[0]) & (times <= column.time[-1])]
@@ -123,8 +117,8 @@ class Granulometry:
         table = Table(["reference", "instrument", "size_range", "readings", "mean_abs_error_points"],
                       notes=list(self.notes))
         for name, curve in self.references():
-            for instrument, size_range, count, error in error_summary(self.readings, curve):
-                table.add(name, instrument, size_range, count, f"{error:.4g}")
+            for reader, size_range, count, error in error_summary(self.readings, curve):
+                table.add(name, reader, size_range, count, f"{error:.4g}")
         return table
 
     def save(self, folder: Path) -> list[Path]:

@@ -18,7 +18,7 @@ import numpy as np
 from .. import _core
 from ..results import Table, write_text
 from ..constants import (D422_CYLINDER_AREA, GRAVITY, LAB_TEMPERATURE, NOMINAL_BULB_LENGTH, NOMINAL_BULB_VOLUME,
-                         SCHEDULES, SOIL_PARTICLE_DENSITY,
+                         PIPETTE_VOLUME, SCHEDULES, SOIL_PARTICLE_DENSITY, SPHERE_DIAMETER, SPHERE_MASS,
                          WATER_20C_DENSITY, WATER_20C_VISCOSITY)
 
 R_FACTOR = 1 - 1 / 2.65    # 152H: R = (rho_s - rho_w) / 0.6226 in g/L, calibrated for Gs = 2.65
@@ -35,6 +35,13 @@ class Scale:
     unit: str
     water: float       # what the scale reads in water at 20 C
     per_unit: float    # 152H g/L per unit of the scale
+    reading_range: str = "reading"       # sediment.plausible's ranges of its readings and blanks
+    blank_range: str = "correction"
+
+    @property
+    def in_grams(self) -> bool:
+        """Whether it reads the 152H's g/L itself (the unit everything after the sheet works in)."""
+        return self.water == 0.0 and self.per_unit == 1.0
 
     def grams(self, reading):
         """A reading of this scale as the 152H's g/L."""
@@ -46,19 +53,20 @@ class Scale:
 
     def quoted(self, grams: float) -> str:
         """A reading [152H g/L] as a message quotes it: on this scale, and in g/L where that differs."""
-        if self.name == "152H":
+        if self.in_grams:
             return f"{grams:g}"
         return f"{float(self.as_read(grams)):.5g} ({grams:.3g} g/L of a 152H)"
 
     def quoted_step(self, grams: float) -> str:
         """A difference of readings [152H g/L] (a noise, a correction) as a message quotes it."""
-        if self.name == "152H":
+        if self.in_grams:
             return f"{grams:g} g/L"
         return f"{grams / self.per_unit:.3g} in {self.unit} ({grams:.3g} g/L of a 152H)"
 
 
 SCALES = {"152H": Scale("152H", "g/L", 0.0, 1.0),
-          "151H": Scale("151H", "specific gravity", 1.0, 1000.0 / R_FACTOR)}
+          "151H": Scale("151H", "specific gravity", 1.0, 1000.0 / R_FACTOR, "reading_151h", "blank_151h")}
+GRAMS = SCALES["152H"]    # the scale of the 152H's g/L, which every sheet's readings become
 
 @dataclass(frozen=True)
 class Suspension:
@@ -249,7 +257,8 @@ class Column:
 
 @dataclass
 class Readings:
-    """What one instrument read at its reading times, and the PSD points it gives."""
+    """What one instrument read at its reading times, and the PSD points it gives (named, with its
+    table's heading, by the instrument's class in lab/instruments.py)."""
 
     instrument: str
     time: np.ndarray        # s
@@ -258,13 +267,13 @@ class Readings:
     diameter: np.ndarray    # m
     percent_finer: np.ndarray
     band: float = 0.0       # pp either side that the physics' uncertainty puts around each reading (error budget)
+    heading: str = "reading"    # the table's column of the readings, with their unit
 
     def table(self) -> Table:
         """Time [min], depth [cm], reading, diameter [um] and percent finer per reading (with a band: its
         low and high ends)."""
-        unit = {"hydrometer": "R [g/L]", "buoyancy": "m_app [g]", "pipette": "c [g/L]"}[self.instrument]
         banded = ["low", "high"] if self.band > 0 else []
-        table = Table(["time_min", "depth_cm", unit, "diameter_um", "percent_finer", *banded])
+        table = Table(["time_min", "depth_cm", self.heading, "diameter_um", "percent_finer", *banded])
         for row in zip(self.time / 60, self.depth * 100, self.reading, self.diameter * 1e6, self.percent_finer):
             ends = [row[-1] - self.band, row[-1] + self.band] if self.band > 0 else []
             table.add(*map(float, row), *ends)
@@ -381,10 +390,10 @@ class Hydrometer:
         meniscus), less the rise of the surface as the bulb enters, V_B / 2A."""
         return self.centre_distance(reading) - self.bulb_volume / (2 * cylinder_area)
 
-    def describe(self, scale: Scale = SCALES["152H"]) -> str:
+    def describe(self, scale: Scale = GRAMS) -> str:
         """The instrument as the console echoes it, its readings on `scale`."""
         def at(grams: float) -> str:
-            return f"{float(scale.as_read(grams)):.5g}{' g/L' if scale.name == '152H' else ''}"
+            return f"{float(scale.as_read(grams)):.5g}{' g/L' if scale.in_grams else ''}"
         points = self.calibration or ((0.0, float(self.centre_distance(0.0))),
                                       (50.0, float(self.centre_distance(50.0))))
         where = "calibrated" if self.calibration else f"nominal {scale.name} of D422"
@@ -444,7 +453,7 @@ class Hydrometer:
             # takes it less its companion cylinder's
             rows.append((t, depth, reading, water.stokes_diameter(depth, t),
                          _percent((reading - self.blank(water.fluid_density)) * a, c0)))
-        return _readings("hydrometer", rows)
+        return _readings(rows)
 
 
 @dataclass(frozen=True)
@@ -453,8 +462,8 @@ class BuoyancySphere:
     Teflon sphere of 25 mm and 20 g, so the apparent mass is what the balance shows (11.8 g in water)."""
 
     depth: float
-    diameter: float = 0.025
-    mass: float = 0.020     # its own mass [kg]; shifts the apparent mass, not the percent finer
+    diameter: float = SPHERE_DIAMETER
+    mass: float = SPHERE_MASS    # its own mass [kg]; shifts the apparent mass, not the percent finer
 
     @property
     def volume(self) -> float:
@@ -481,7 +490,7 @@ class BuoyancySphere:
             concentration = self.solids(apparent, suspension.fluid_density, suspension.specific_gravity)
             rows.append((t, self.depth, apparent * 1e3, suspension.stokes_diameter(self.depth, t),
                          _percent(concentration, c0)))
-        return _readings("buoyancy", rows)
+        return _readings(rows)
 
 
 @dataclass(frozen=True)
@@ -490,7 +499,7 @@ class Pipette:
     slab (the cylinder's axial section) its section through the axis, a circle of the same radius."""
 
     depth: float
-    volume: float = 25e-6
+    volume: float = PIPETTE_VOLUME
 
     def read(self, column: Column, times_s) -> Readings:
         """Solids concentration [g/L] drawn at each time, with the diameter and percent finer it gives."""
@@ -504,7 +513,7 @@ class Pipette:
             concentration = suspension.particle_density * column.weighted_mean(t, self.depth, radius, disc=disc)
             rows.append((t, self.depth, concentration, suspension.stokes_diameter(self.depth, t),
                          _percent(concentration, c0)))
-        return _readings("pipette", rows)
+        return _readings(rows)
 
     def default_times(self, suspension: Suspension) -> np.ndarray:
         """Stokes times of 50, 20, 10, 5 and 2 um at the pipette depth."""
@@ -520,9 +529,9 @@ def _percent(concentration: float, initial: float) -> float:
     return 100 * concentration / initial if initial > 0 else float("nan")    # no solids: undefined
 
 
-def _readings(name: str, rows: list[tuple]) -> Readings:
+def _readings(rows: list[tuple]) -> Readings:
     data = np.array(rows, float).reshape(-1, 5)
-    return Readings(name, *(data[:, k] for k in range(5)))
+    return Readings("", *(data[:, k] for k in range(5)))    # the registry names them (lab/instruments.py)
 
 
 def _fits(column: Column, depth: float, radius: float, what: str) -> None:

@@ -23,22 +23,15 @@ from pathlib import Path
 
 import numpy as np
 
-from ..constants import LAB_TEMPERATURE
+from ..constants import LAB_TEMPERATURE, PIPETTE_VOLUME
 from ..csvfile import CsvError, CsvFile, read_csv
-from ..plausible import RANGES, Range, pipette_mass
-from .readout import SCALES, BuoyancySphere, Hydrometer, Scale, Suspension, gs_correction
+from .instruments import INSTRUMENTS
+from .readout import GRAMS, BuoyancySphere, Hydrometer, Scale, Suspension
+from .sheetcheck import SheetError, plausible
 
-KINDS = {
-    "hydrometer": ("time_min", "reading", "temperature_C"),
-    "pipette": ("time_min", "depth_cm", "mass_g"),
-    "buoyancy": ("time_min", "apparent_mass_g"),
-    "sieve": ("opening_mm", "percent_passing"),
-}
-OPTIONAL = {"hydrometer": ("blank",), "pipette": ("temperature_C",), "buoyancy": ("temperature_C",), "sieve": ()}
-
-
-class SheetError(ValueError):
-    """A sheet that cannot be a record of a sedimentation test, with the reason and the row."""
+# The sheets' kinds by their columns: the instruments' and the sieves'
+KINDS = {name: i.columns for name, i in INSTRUMENTS.items()} | {"sieve": ("opening_mm", "percent_passing")}
+OPTIONAL = {name: i.optional for name, i in INSTRUMENTS.items()} | {"sieve": ()}
 
 
 @dataclass(frozen=True)
@@ -55,7 +48,7 @@ class Sheet:
     depth: np.ndarray = field(default_factory=lambda: np.empty(0))
     blank: np.ndarray = field(default_factory=lambda: np.empty(0))    # 152H composite correction per reading
     lines: tuple[int, ...] = ()    # each reading's line in the file, for messages
-    scale: Scale = SCALES["152H"]    # a hydrometer's scale as read (its readings and blank are the 152H's g/L)
+    scale: Scale = GRAMS    # a hydrometer's scale as read (its readings and blank are the 152H's g/L)
 
     def where(self, k: int) -> str:
         """Reading k as a message names it: its line in the file, and its time."""
@@ -84,8 +77,8 @@ class SieveSheet:
         return f"{self.path.name} (sieve)"
 
 
-def read_sheet(path: str | Path, pipette_volume: float = 25e-6, stirred: str | None = None,
-               scale: Scale = SCALES["152H"]) -> Sheet | SieveSheet:
+def read_sheet(path: str | Path, pipette_volume: float = PIPETTE_VOLUME, stirred: str | None = None,
+               scale: Scale = GRAMS) -> Sheet | SieveSheet:
     """Reads and checks one sheet (its kind from its header); a pipette's masses become g/L of the sample,
     a hydrometer's readings on `scale` the 152H's g/L. A `clock` column (HH:MM of each reading) stands for
     `time_min`, counted from `stirred` (HH:MM)."""
@@ -112,46 +105,21 @@ def read_sheet(path: str | Path, pipette_volume: float = 25e-6, stirred: str | N
     lines = [line for line, _ in table.rows]
     if kind == "sieve":
         return _sieve_sheet(path, values["opening_mm"], values["percent_passing"])
-    _plausible(path, lines, values, "time_min", "time_min")
+    plausible(path, lines, values, "time_min", "time_min")
     time = values["time_min"] * 60.0
     if time[0] <= 0 or np.any(np.diff(time) <= 0):
         raise SheetError(f"{path}: the times must be > 0 and increase from row to row")
     values.setdefault("temperature_C", np.full(len(time), math.nan))
     temperature = values["temperature_C"]
     recorded = np.isfinite(temperature)
-    if kind == "hydrometer" and not recorded.all():
+    if INSTRUMENTS[kind].on_hydrometer_scale and not recorded.all():
         missing = ", ".join(str(lines[k]) for k in np.flatnonzero(~recorded))
         raise SheetError(f"{path}: no temperature on line(s) {missing}: a hydrometer's reading needs the temperature "
                          "it was taken at")
-    _plausible(path, lines, values, "temperature_C", "temperature")
-    depth, blank = np.empty(0), np.empty(0)
-    if kind == "hydrometer":
-        reading = values["reading"]
-        gravities = bool(np.all((reading > 0.95) & (reading < 1.15)))
-        if gravities != (scale.name == "151H"):
-            raise SheetError(f"{path}: the readings ({reading.min():g}-{reading.max():g}) look like "
-                             + ("specific gravities: a 151H's sheet needs --hydrometer-type 151H" if gravities else
-                                "a 152H's g/L, not the specific gravities of a 151H (--hydrometer-type 151H)"))
-        _plausible(path, lines, values, "reading", "reading" if scale.name == "152H" else "reading_151h")
-        if "blank" in values:
-            blank = values["blank"]
-            if not np.isfinite(blank).all():
-                missing = ", ".join(str(lines[k]) for k in np.flatnonzero(~np.isfinite(blank)))
-                raise SheetError(f"{path}: no blank on line(s) {missing}: give the composite correction beside every "
-                                 "reading, or drop the column and give --zero-correction")
-            _plausible(path, lines, values, "blank", "correction" if scale.name == "152H" else "blank_151h")
-            blank = scale.grams(blank)
-        reading = scale.grams(reading)
-    elif kind == "pipette":
-        _plausible(path, lines, values, "depth_cm", "depth_cm")
-        _plausible(path, lines, values, "mass_g", pipette_mass(pipette_volume))
-        depth = values["depth_cm"] / 100.0
-        reading = values["mass_g"] / (pipette_volume * 1e3)      # g per litre of the sample
-    else:
-        _plausible(path, lines, values, "apparent_mass_g", "apparent_mass_g")
-        reading = values["apparent_mass_g"]
+    plausible(path, lines, values, "temperature_C", "temperature")
+    reading, depth, blank = INSTRUMENTS[kind].sheet_readings(path, lines, values, scale, pipette_volume)
     return Sheet(kind, path, time, reading, temperature, depth, blank, tuple(lines),
-                 scale if kind == "hydrometer" else SCALES["152H"])
+                 scale if INSTRUMENTS[kind].on_hydrometer_scale else GRAMS)
 
 
 def clock_minutes(text: str, where: str) -> float:
@@ -203,26 +171,6 @@ def _clock_to_minutes(table: CsvFile, stirred: str | None) -> CsvFile:
         previous = minutes
     header = table.header[:k] + ["time_min"] + table.header[k + 1:]
     return replace(table, header=header, rows=rows)
-
-
-def _plausible(path: Path, lines: list[int], values: dict[str, np.ndarray], column: str,
-               quantity: str | Range) -> None:
-    """Refuses the first value of a column outside its quantity's plausible range (blank cells aside),
-    naming the line and the likely unit slip; where the column's other values are plausible, the value
-    may be misread rather than in another unit, and the message gives theirs first."""
-    bounds = RANGES[quantity] if isinstance(quantity, str) else quantity
-    column_values = values[column]
-    fine = np.array([math.isfinite(v) and bounds.refusal(v) is None for v in column_values])
-    for line, value in zip(lines, column_values):
-        reason = bounds.refusal(value) if math.isfinite(value) else None
-        if reason is None:
-            continue
-        if fine.sum() >= 2:    # the others read as the column's unit: this one may be misread
-            others, slip = column_values[fine], bounds.slip(value)
-            reason = (f"{bounds.refusal(value, slips=False)}; the column's other rows read {others.min():g} to "
-                      f"{others.max():g}{' ' + bounds.unit if bounds.unit else ''}: check this one"
-                      + (f" (or{slip[1:]})" if slip else ""))
-        raise SheetError(f"{path}, line {line}: {column} {reason}")
 
 
 def _sieve_sheet(path: Path, opening_mm: np.ndarray, passing: np.ndarray) -> SieveSheet:
@@ -282,8 +230,8 @@ def read_temperature_record(path: str | Path, t_end: float | None = None) -> tup
     lines = [line for line, _ in table.rows]
     values = {"time_min": np.array(_numbers(table, "time_min")),
               "temperature_C": np.array(_numbers(table, "temperature_C", blank=True))}
-    _plausible(path, lines, values, "time_min", "record_time_min")
-    _plausible(path, lines, values, "temperature_C", "temperature")
+    plausible(path, lines, values, "time_min", "record_time_min")
+    plausible(path, lines, values, "temperature_C", "temperature")
     record = tuple((float(t) * 60.0, float(c)) for t, c in zip(values["time_min"], values["temperature_C"])
                    if math.isfinite(c))
     if not record:
@@ -308,21 +256,17 @@ def check_sheet(sheet: Sheet, whole: float, resolution: float, corrected: np.nda
 
     def named(k: int) -> str:
         after = "" if corrected is None or corrected[k] == sheet.reading[k] else \
-            f", {values[k]:g}{'' if sheet.scale.name == '152H' else ' g/L'} after its correction"
+            f", {values[k]:g}{'' if sheet.scale.in_grams else ' g/L'} after its correction"
         return f"{sheet.scale.quoted(sheet.reading[k])} on the sheet{after}"
     # the solids signal, falling with time: the sphere's apparent mass rises as the suspension thins
-    signal, top = (-values, -whole) if sheet.instrument == "buoyancy" else (values, whole)
+    kind = INSTRUMENTS[sheet.instrument]
+    signal, top = (-values, -whole) if kind.reading_falls_with_solids else (values, whole)
     over = np.flatnonzero(signal > top + resolution)
     if len(over):
         k = over[0]
-        sphere = (", the sphere's own mass and diameter (--sphere-mass, --sphere-diameter: what it reads in clear "
-                  "water follows from them)" if sheet.instrument == "buoyancy" else "")
         raise SheetError(f"{sheet.where(k)}: the reading ({named(k)}) is beyond what the whole sample in suspension "
-                         f"reads ({whole:.4g}): check the sample mass{sphere}, the units or the sheet")
-    if sheet.instrument == "pipette" and values.max() < 0.005 * whole:
-        raise SheetError(f"{sheet.label}: every sample weighs under 0.5 % of what the whole sample in suspension gives "
-                         f"({whole:.4g} g): mass_g is in grams (masses in kg?), or the sample mass is wrong")
-    same_depth = np.ones(len(signal), bool) if sheet.instrument != "pipette" else np.r_[True, np.diff(sheet.depth) == 0]
+                         f"reads ({whole:.4g}): check the sample mass{kind.beyond_whole_hint}, the units or the sheet")
+    same_depth = kind.check_sheet(sheet, values, whole)
     rises = np.flatnonzero((np.diff(signal) > resolution) & same_depth[1:])
     if len(rises):
         k = rises[0] + 1
@@ -351,7 +295,7 @@ class Reduction:
     depth: np.ndarray           # m
     diameter: np.ndarray        # m
     percent: np.ndarray         # of the specimen (the inverse scales it to the whole sample)
-    scale: Scale = SCALES["152H"]    # a hydrometer's scale as read (reading, correction and meniscus are in g/L)
+    scale: Scale = GRAMS    # a hydrometer's scale as read (reading, correction and meniscus are in g/L)
 
     def scaled(self, share: float) -> "Reduction":
         """The same reduction with its percent finer of a sample of which the specimen is `share`."""
@@ -369,25 +313,19 @@ def standard_reduction(sheet: Sheet, suspension: Suspension, initial_concentrati
                            suspension.temperature if suspension.temperature is not None else LAB_TEMPERATURE)
     waters = [Suspension.at_temperature(t, suspension.particle_density) for t in temperature]
     gs = suspension.specific_gravity
+    kind = INSTRUMENTS[sheet.instrument]
     applied = np.zeros(len(sheet.time))
-    if sheet.instrument == "hydrometer":
+    if kind.on_hydrometer_scale:
         applied = applied + correction
-        depth = hydrometer.effective_depth(sheet.reading + meniscus, cylinder_area)
-        percent = 100 * gs_correction(gs) * (sheet.reading - applied) / initial_concentration
-    elif sheet.instrument == "pipette":
-        depth = sheet.depth
-        percent = 100 * sheet.reading / initial_concentration
-    else:
-        water = np.array([w.fluid_density for w in waters])
-        depth = np.full(len(sheet.time), sphere.depth)
-        percent = 100 * sphere.solids(sheet.reading * 1e-3, water, gs) / initial_concentration
+    depth, percent = kind.reduce(sheet, waters, gs, initial_concentration, hydrometer, cylinder_area, sphere,
+                                 meniscus, applied)
     diameter = np.array([w.stokes_diameter(z, time) for w, z, time in zip(waters, depth, sheet.time)], float)
     return Reduction(sheet.instrument, sheet.time, sheet.reading, applied,
-                     meniscus if sheet.instrument == "hydrometer" else 0.0, temperature, np.asarray(depth, float),
+                     meniscus if kind.on_hydrometer_scale else 0.0, temperature, np.asarray(depth, float),
                      diameter, percent, sheet.scale)
 
 
-def read_hydrometer_calibration(path: str | Path, scale: Scale = SCALES["152H"]) -> tuple[np.ndarray, np.ndarray]:
+def read_hydrometer_calibration(path: str | Path, scale: Scale = GRAMS) -> tuple[np.ndarray, np.ndarray]:
     """A hydrometer's calibration (D7928's H_r): CSV ``reading,distance_cm``, the distance from the
     graduation of each reading (on `scale`) to the bulb's centre. Returns the readings [152H g/L] and the
     distances [m]."""
@@ -400,8 +338,8 @@ def read_hydrometer_calibration(path: str | Path, scale: Scale = SCALES["152H"])
     values = {name: np.array(_numbers(table, name)) for name in ("reading", "distance_cm")}
     if len(lines) < 2:
         raise SheetError(f"{path}: a calibration needs at least two readings with their distances")
-    _plausible(path, lines, values, "reading", "reading" if scale.name == "152H" else "reading_151h")
-    _plausible(path, lines, values, "distance_cm", "calibration_cm")
+    plausible(path, lines, values, "reading", scale.reading_range)
+    plausible(path, lines, values, "distance_cm", "calibration_cm")
     readings, distances = values["reading"], values["distance_cm"]
     order = np.argsort(readings, kind="stable")
     for a, b in zip(order[:-1], order[1:]):

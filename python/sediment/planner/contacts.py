@@ -30,10 +30,13 @@ from typing import Callable
 import numpy as np
 
 from ..lab.psd import PSD
+from ..lab.settling import terminal_speeds
 from ..results import Table, write_text
-from ..sim.run import Runs, run_batch
-from ..sim.scene import OVERLAP_TOLERANCE, Cylinder, Effects, pair_lines, plan, write_data
-from .screening import ReadingModel, SedimentationTest, encounters, terminal_speeds
+from ..sim.process import Runs
+from ..sim.run import run_batch
+from ..sim.scene import OVERLAP_TOLERANCE, Cylinder, Effects, plan
+from ..sim.scenefiles import pair_lines, write_data
+from .screening import ReadingModel, SedimentationTest, encounters
 
 
 @dataclass(frozen=True)

@@ -490,8 +490,10 @@ def _run_all(scene, trials: list[Trial], runs: Path, jobs: int, progress: bool, 
     if progress:
         bar = progress_bar(total=len(trials), desc=f"plan: {what}", unit="run")
     pool = ThreadPoolExecutor(max_workers=jobs)
+    futures: dict = {}    # filled one by one: a Ctrl-C while the trials are submitted finds those submitted
     try:
-        futures = {pool.submit(scene.run, t.settings, runs / t.name, t.seed): t for t in trials}
+        for t in trials:
+            futures[pool.submit(scene.run, t.settings, runs / t.name, t.seed)] = t
         for future in as_completed(futures):
             futures[future].outcome = future.result()
             if bar is not None:

@@ -21,7 +21,10 @@ import numpy as np
 
 from ..results import write_text
 from ..sim.deck import deck_text, index_variables
-from ..sim.run import Runs, run_batch
+from ..sim.observe import observe, relative_error
+from ..sim.printed import parse_printed
+from ..sim.process import Runs
+from ..sim.run import run_batch
 from ..constants import DRAGS, HINDRANCES
 from .screening import INCLUDE, MEASURE, OMIT, Screen, SedimentationTest, screen, verdict_of
 
@@ -151,7 +154,7 @@ class SampleScene:
 
     def write(self, settings: dict, folder: Path, seed: int) -> Path:
         """Writes the scene of a setting into `folder`; returns its deck."""
-        from ..sim.scene import write
+        from ..sim.scenefiles import write
         write(self._scene(settings, seed), Path(folder))
         return Path(folder) / "in.sedimentation"
 
@@ -315,8 +318,6 @@ class DeckScene:
 
     def run(self, settings: dict, folder: Path, seed: int) -> Outcome:
         """Runs the deck from its own folder with the setting as -var pairs."""
-        from ..studies.sweep import observe
-
         out = run_batch(self.deck, self._values(settings), ranks=self.ranks, check=False, running=self.running)
         outcome = Outcome(sum(s for s, _ in out.loops), out.wall_seconds)
         if out.error:
@@ -328,8 +329,7 @@ class DeckScene:
             outcome.failure = str(exc)
             return outcome
         outcome.observations = found
-        outcome.printed = {w[1]: float(w[2]) for w in (line.split() for line in out.text.splitlines())
-                           if len(w) == 3 and w[0] == "SCREEN"}
+        outcome.printed = parse_printed(out.text).screens
         return outcome
 
     @staticmethod
@@ -340,6 +340,4 @@ class DeckScene:
     @staticmethod
     def error(run: dict, reference: dict, uncertainty=None) -> dict[str, float]:
         """Relative error per observable (a series: largest difference over the reference's magnitude)."""
-        from ..studies.sweep import relative_error
-
         return {k: relative_error(run[k], ref) if k in run else math.inf for k, ref in reference.items()}

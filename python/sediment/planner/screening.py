@@ -17,15 +17,17 @@ from dataclasses import dataclass
 import numpy as np
 
 from .. import _core
+from ..constants import INSTRUMENTS, LAB_TEMPERATURE, PIPETTE_DEPTH, SPECIMEN_MASS
 from ..lab.granulometry import read_all
+from ..lab.instruments import instrument
 from ..lab.psd import PSD, log_classes
-from ..lab.readout import SCHEDULES, Hydrometer, Pipette, Suspension
+from ..lab.readout import SCHEDULES, Pipette, Suspension
+from ..lab.settling import terminal_speeds
 from ..lab.synthetic import settling_column
 from ..sim.scene import Cylinder
 
 BOLTZMANN = 1.380649e-23      # J/K
 BED_PACKING = 0.6             # solid fraction of a settled silt bed (random loose to close packing 0.55-0.64)
-PIPETTE_DEPTH = 0.10          # m, as in the readouts' default
 FILM_REBOUND_STOKES = 10.0    # approach Stokes number below which a squeeze film stops a rebound (Gondret et al. 2002)
 
 INCLUDE, OMIT, MEASURE, REPORT = "include", "omit", "measure", "report only"
@@ -44,8 +46,8 @@ class SedimentationTest:
     psd: PSD
     suspension: Suspension = Suspension()
     cylinder: Cylinder = Cylinder()
-    mass: float = 0.060
-    instruments: tuple[str, ...] = ("hydrometer", "buoyancy", "pipette")
+    mass: float = SPECIMEN_MASS
+    instruments: tuple[str, ...] = INSTRUMENTS
 
     @property
     def initial_concentration(self) -> float:
@@ -69,14 +71,6 @@ class Screen:
     change: float | None   # estimated largest change of a reading [percentage points], if estimable
     verdict: str           # include, omit, measure, report only
     reason: str
-
-
-def terminal_speeds(suspension: Suspension, diameter: np.ndarray, law: str = "standard",
-                    voidage: float = 1.0, hindrance: str = "none") -> np.ndarray:
-    """Terminal speed [m/s] of each diameter under a drag law (hindered, or law difelice: in a suspension
-    of fluid fraction `voidage`, with plain buoyancy)."""
-    model = _core.DragModel(law, suspension.fluid_density, suspension.viscosity, hindrance=hindrance)
-    return np.array([model.steady_speed(float(d), suspension.buoyant_weight(float(d)), voidage)[0] for d in diameter])
 
 
 class ReadingModel:
@@ -140,15 +134,7 @@ def encounters(test: SedimentationTest, classes: int = 120,
 def lowest_sensed_depth(test: SedimentationTest) -> float:
     """The deepest point any instrument senses [m below the surface]: the hydrometer's bulb bottom
     at a zero reading, the buoyancy sphere's bottom, the pipette sample's bottom."""
-    depths = []
-    if "hydrometer" in test.instruments:
-        h = Hydrometer.astm_152h()
-        depths.append(h.scale_zero + h.bulb_length)
-    if "buoyancy" in test.instruments:
-        depths.append(0.3 * test.cylinder.height + 0.0125)
-    if "pipette" in test.instruments:
-        depths.append(PIPETTE_DEPTH + (3 * 25e-6 / (4 * math.pi)) ** (1 / 3))
-    return max(depths)
+    return max(instrument(name).deepest(test.cylinder.height) for name in test.instruments)
 
 
 def verdict_of(change: float, tolerance: float) -> str:
@@ -213,7 +199,7 @@ def screen(test: SedimentationTest, tolerance: float = 0.5) -> list[Screen]:
                           "inertia at no extra cost"))
 
     drho = s.particle_density - s.fluid_density
-    kelvin = 273.15 + (s.temperature if s.temperature is not None else 20.0)
+    kelvin = 273.15 + (s.temperature if s.temperature is not None else LAB_TEMPERATURE)
     d_unit = (6 * BOLTZMANN * kelvin / (math.pi * drho * s.gravity)) ** 0.25    # Pe = 1
     peclet = (lo / d_unit) ** 4
     below = float(t.psd.at(np.array([d_unit]))[0])

@@ -26,17 +26,20 @@ from pathlib import Path
 import numpy as np
 
 from .. import figures
+from ..constants import (D422_CYLINDER_HEIGHT, INSTRUMENTS, LAB_TEMPERATURE, PIPETTE_DEPTH, SPECIMEN_MASS,
+                         SPHERE_DEPTH_SHARE)
 from ..lab.granulometry import read_all
 from ..lab.psd import PSD
 from ..lab.readout import SCHEDULES, Column, Suspension
+from ..lab.settling import terminal_speeds
 from ..planner.scenes import SampleScene
 from ..progress import bar as progress_bar
 from ..results import Table, write_text
 from ..sim.layers import read_layers
 from ..sim.run import run_batch
-from ..sim.scene import Cylinder, Effects, plan, write
+from ..sim.scene import Cylinder, Effects, plan
+from ..sim.scenefiles import write
 
-INSTRUMENTS = ("hydrometer", "buoyancy", "pipette")
 BOLTZMANN = 1.380649e-23    # J/K
 # 5 g/L of sodium hexametaphosphate (125 mL of a 40 g/L solution in 1000 mL, ASTM D422 and D7928): an
 # estimate, not a measurement: the solute's mass less the water it displaces at an apparent specific
@@ -135,13 +138,14 @@ def _readings(layer_file: Path, lab: Suspension, cylinder: Cylinder) -> dict[str
     return {r.instrument: (np.asarray(r.time), np.asarray(r.percent_finer)) for r in found}
 
 
-def brownian_change(psd: PSD, lab: Suspension, depths=(0.10, 0.30 * 0.36)) -> float:
+def brownian_change(psd: PSD, lab: Suspension,
+                    depths=(PIPETTE_DEPTH, SPHERE_DEPTH_SHARE * D422_CYLINDER_HEIGHT)) -> float:
     """Largest change of a reading from Brownian motion [pp], estimated: a grain's arrival at the
     sensing depth L is spread by sqrt(2 D L / v) about L / v (Stokes-Einstein D, Stokes v), which
     blurs the diameter a reading resolves by half that relative spread; the reading moves by the
     PSD's slope dP / d ln D times it, at every depth and reading time of the schedules."""
     times = np.array(sorted(set(SCHEDULES["d422"] + SCHEDULES["bravo"]))) * 60.0
-    kelvin = 273.15 + (lab.temperature if lab.temperature is not None else 20.0)
+    kelvin = 273.15 + (lab.temperature if lab.temperature is not None else LAB_TEMPERATURE)
     worst = 0.0
     for depth in depths:
         d = np.asarray(lab.stokes_diameter(depth, times), float)
@@ -156,7 +160,7 @@ def brownian_change(psd: PSD, lab: Suspension, depths=(0.10, 0.30 * 0.36)) -> fl
 def wall_change(psd: PSD, lab: Suspension, cylinder: Cylinder) -> float:
     """Largest change of a reading from the cylinder wall [pp], estimated: Ladenburg's slowing
     1 / (1 + 2.1 d / D) of each grain, read from analytic columns (as the planner's screening)."""
-    from ..planner.screening import ReadingModel, SedimentationTest, terminal_speeds
+    from ..planner.screening import ReadingModel, SedimentationTest
 
     test = SedimentationTest(psd, lab, cylinder)
     single = lambda d: terminal_speeds(lab, d)    # noqa: E731
@@ -165,7 +169,7 @@ def wall_change(psd: PSD, lab: Suspension, cylinder: Cylinder) -> float:
 
 
 def error_budget(psd: PSD, folder: Path, *, particles: int = 20000, courant: float = 2.0, replicas: int = 3,
-                 temperature: float = 20.0, mass: float = 0.060, cylinder: Cylinder = Cylinder(),
+                 temperature: float = LAB_TEMPERATURE, mass: float = SPECIMEN_MASS, cylinder: Cylinder = Cylinder(),
                  seed: int = 1, jobs: int = 2, progress: bool = True, choices=CHOICES, name: str = "",
                  **options) -> Budget:
     """Runs the reference and every choice of one test under `folder` and returns its budget.

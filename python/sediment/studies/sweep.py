@@ -29,18 +29,11 @@ import numpy as np
 from .. import figures
 from ..progress import bar as progress_bar
 from ..results import Table, write_text
+from ..sim.observe import READOUTS, Observation, observe, relative_error
 from ..sim.run import run_batch
 
 INTEGRATORS = {"implicit": "nve/sphere/fluid", "explicit": "nve/sphere"}
-READOUTS = ("hydrometer", "buoyancy", "pipette")
 SAFE_NAMES = {name: getattr(np, name) for name in ("exp", "log", "sqrt", "sin", "cos", "tanh", "pi", "abs")}
-
-
-@dataclass
-class Observation:
-    """One observable of one run: a scalar (x is None) or y over x."""
-    y: np.ndarray
-    x: np.ndarray | None = None
 
 
 @dataclass
@@ -156,66 +149,6 @@ def check_deck(deck: Path, parameter: str, integrators: list[str] | None) -> Non
     unknown = [i for i in integrators or [] if i not in INTEGRATORS]
     if unknown:
         raise ValueError(f"unknown integrator '{unknown[0]}' (expected {' or '.join(INTEGRATORS)})")
-
-
-def observe(text: str, names: list[str], layers_file: Path | None) -> dict[str, Observation]:
-    """The observables of one run, from what the deck printed and the layer file it wrote."""
-    results: dict[str, float] = {}
-    series: dict[str, list[tuple[float, float]]] = {}
-    for line in text.splitlines():
-        words = line.split()
-        if words[:1] == ["RESULT"]:
-            results.update({k: float(v) for k, v in zip(words[1::2], words[2::2])})
-        elif words[:1] == ["SERIES"] and len(words) == 4:
-            series.setdefault(words[1], []).append((float(words[2]), float(words[3])))
-    found: dict[str, Observation] = {}
-    readouts = [n for n in names if n in READOUTS]
-    if readouts:
-        found.update(_readout_curves(layers_file, readouts))
-    for name in names:
-        if name in readouts:
-            continue
-        if name in results:
-            found[name] = Observation(np.array([results[name]]))
-        elif name in series:
-            xy = np.array(series[name])
-            found[name] = Observation(xy[:, 1], xy[:, 0])
-        else:
-            printed = sorted(set(results) | set(series))
-            raise ValueError(f"the deck printed no RESULT or SERIES '{name}' (it printed: {', '.join(printed) or 'none'})")
-    return found
-
-
-def _readout_curves(layers_file: Path | None, instruments: list[str]) -> dict[str, Observation]:
-    from ..lab.granulometry import read_all
-    from ..sim.layers import read_layers
-    from ..lab.readout import Column
-
-    if layers_file is None or not layers_file.is_file():
-        raise ValueError(f"readout observables need the deck's layer file ({layers_file}): does it write one?")
-    readings, _ = read_all(Column.from_layers(read_layers(layers_file)), instruments)
-    return {r.instrument: Observation(r.percent_finer, r.diameter) for r in readings}
-
-
-def relative_error(run: Observation, ref: Observation, log_x: bool = False) -> float:
-    """Relative error of a run: |run / reference - 1| for a scalar; for a series, the largest
-    |run - reference| (the reference interpolated at the run's x, in log x for readouts) over the
-    reference's largest magnitude."""
-    if run.x is None:
-        return float(abs(run.y[0] - ref.y[0]) / abs(ref.y[0])) if ref.y[0] != 0 else float(abs(run.y[0]))
-    assert ref.x is not None
-    order = np.argsort(ref.x)
-    rx, ry = ref.x[order], ref.y[order]
-    x = run.x
-    inside = (x >= rx[0]) & (x <= rx[-1])
-    if not inside.any():
-        raise ValueError("a series does not overlap its reference (different x ranges)")
-    if log_x:
-        expected = np.interp(np.log(x[inside]), np.log(rx), ry)
-    else:
-        expected = np.interp(x[inside], rx, ry)
-    scale = np.max(np.abs(ry))
-    return float(np.max(np.abs(run.y[inside] - expected)) / (scale if scale > 0 else 1.0))
 
 
 def deck_number(value: float) -> str:
