@@ -17,7 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .. import _core
-from ..constants import INSTRUMENTS, LAB_TEMPERATURE, PIPETTE_DEPTH, SPECIMEN_MASS
+from ..constants import BOLTZMANN, INSTRUMENTS, LAB_TEMPERATURE, PIPETTE_DEPTH, SPECIMEN_MASS
 from ..lab.granulometry import read_all
 from ..lab.instruments import instrument
 from ..lab.psd import PSD, log_classes
@@ -26,7 +26,6 @@ from ..lab.settling import terminal_speeds
 from ..lab.synthetic import settling_column
 from ..sim.scene import Cylinder
 
-BOLTZMANN = 1.380649e-23      # J/K
 BED_PACKING = 0.6             # solid fraction of a settled silt bed (random loose to close packing 0.55-0.64)
 FILM_REBOUND_STOKES = 10.0    # approach Stokes number below which a squeeze film stops a rebound (Gondret et al. 2002)
 

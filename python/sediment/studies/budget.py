@@ -26,7 +26,7 @@ from pathlib import Path
 import numpy as np
 
 from .. import figures
-from ..constants import (D422_CYLINDER_HEIGHT, INSTRUMENTS, LAB_TEMPERATURE, PIPETTE_DEPTH, SPECIMEN_MASS,
+from ..constants import (BOLTZMANN, D422_CYLINDER_HEIGHT, INSTRUMENTS, LAB_TEMPERATURE, PIPETTE_DEPTH, SPECIMEN_MASS,
                          SPHERE_DEPTH_SHARE)
 from ..lab.granulometry import read_all
 from ..lab.psd import PSD
@@ -40,7 +40,6 @@ from ..sim.run import run_batch
 from ..sim.scene import Cylinder, Effects, plan
 from ..sim.scenefiles import write
 
-BOLTZMANN = 1.380649e-23    # J/K
 # 5 g/L of sodium hexametaphosphate (125 mL of a 40 g/L solution in 1000 mL, ASTM D422 and D7928): an
 # estimate, not a measurement: the solute's mass less the water it displaces at an apparent specific
 # volume of about 0.4 mL/g gives +3 kg/m3; a dilute electrolyte's viscosity rises by about 1 %.
