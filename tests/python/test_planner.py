@@ -337,3 +337,35 @@ def test_the_coarse_part_of_a_psd_keeps_its_shape():
     assert coarse.percent_finer[0] == 0 and coarse.percent_finer[-1] == pytest.approx(100)
     d = np.array([25e-6, 40e-6])
     assert coarse.at(d) == pytest.approx((psd.at(d) - psd.at([20e-6])[0]) / share)
+
+
+def test_the_swirls_of_a_narrow_sample_spread_its_fall_as_segre_et_al_say():
+    """For grains of one size the swirls' dispersion is D = 80 v a (1 - exp(-W / (60 a phi^-1/3))) while
+    they fall, and the spread of their arrival at depth H is sqrt(2 D H / v) / H; the fluctuation is
+    2.0 phi0^1/3 (Segre, Herbolzheimer & Chaikin 1997)."""
+    from sediment.lab.psd import PSD
+    from sediment.lab.settling import terminal_speeds
+    from sediment.planner.screening import swirl_spread
+
+    d = 30e-6
+    test = SedimentationTest(PSD(np.array([d, d * 1.0001]), np.array([0.0, 100.0])))
+    diameter, spread, fluctuation = swirl_spread(test, 0.1, classes=8)
+    phi = test.solid_fraction
+    assert fluctuation == pytest.approx(2.0 * phi ** (1 / 3))
+    v = float(terminal_speeds(test.suspension, np.array([d]))[0])
+    cut = 1 - math.exp(-test.cylinder.diameter / (60 * d / 2 * phi ** (-1 / 3)))
+    # its 8 classes leave within 0.02 % of one another's time: each is spread as the whole sample
+    whole = math.sqrt(2 * 80 * v * d / 2 * cut * 0.1 / v) / 0.1
+    assert spread == pytest.approx(np.full(8, whole), rel=1e-3)
+
+
+def test_two_way_coupling_is_screened_and_never_turned_on_by_the_screen():
+    """The flow the grains drive is screened with the others: omitted where the swirls' upper estimate
+    is below a quarter of the tolerance, else reported (the planner's sub-volume cannot hold them)."""
+    psd = read_psd(SAMPLE5)
+    screens = {s.effect: s for s in screen(SedimentationTest(psd))}
+    two_way = screens["two-way"]
+    assert two_way.value == pytest.approx(2.0 * SedimentationTest(psd).solid_fraction ** (1 / 3))
+    assert 0 < two_way.change < 0.125 and two_way.verdict == OMIT
+    strict = {s.effect: s for s in screen(SedimentationTest(psd), tolerance=0.05)}["two-way"]
+    assert strict.verdict == "report only" and "not simulated" in strict.reason

@@ -31,6 +31,12 @@ FILM_REBOUND_STOKES = 10.0    # approach Stokes number below which a squeeze fil
 
 INCLUDE, OMIT, MEASURE, REPORT = "include", "omit", "measure", "report only"
 
+# The swirls the grains drive (Segre, Herbolzheimer & Chaikin 1997, PRL 79 2574, dilute spheres,
+# phi <= 0.05): vertical velocity fluctuations of 2.0 phi^1/3 times the mean settling speed, correlated
+# over 2 xi = 40 a phi^-1/3. A grain crossing them diffuses vertically by about D = dV 2 xi.
+SWIRL_SPEED = 2.0      # times phi^1/3, of the mean settling speed
+SWIRL_LENGTH = 40.0    # times a phi^-1/3
+
 # Estimated changes at most OMIT_BELOW x tolerance are dropped without a run; at least INCLUDE_ABOVE x
 # tolerance are kept without one: a margin of four either way on estimates that came within 10 % of
 # the measured changes for the five samples of docs/effects.md.
@@ -95,10 +101,26 @@ class ReadingModel:
         return settling_column(t.psd, t.cylinder.height, self.times, t.initial_concentration, t.suspension,
                                layers=1200, classes=300, speed=speed)
 
+    def readings(self, speed) -> dict[str, np.ndarray]:
+        """Each instrument's readings [percent finer] when the classes settle at `speed(d)`."""
+        found, _ = read_all(self._column(speed), list(self.test.instruments), cylinder_area=self.test.cylinder.area)
+        return {r.instrument: r.percent_finer for r in found}
+
+    def largest_change(self, readings: dict[str, np.ndarray]) -> float:
+        """max |P - P_reference| over the instruments' `readings`."""
+        return max(float(np.max(np.abs(p - self.reference[name]))) for name, p in readings.items())
+
     def change(self, speed) -> float:
         """max |P - P_reference| over the instruments' readings when the classes settle at `speed(d)`."""
-        found, _ = read_all(self._column(speed), list(self.test.instruments), cylinder_area=self.test.cylinder.area)
-        return max(float(np.max(np.abs(r.percent_finer - self.reference[r.instrument]))) for r in found)
+        return self.largest_change(self.readings(speed))
+
+    def spread_change(self, speed, spread) -> float:
+        """The largest change of a reading when each class's speed is spread by the fraction `spread(d)`
+        (a Gaussian's standard deviation) about `speed(d)`: the mean of the readings at speed (1 +- spread),
+        which holds the spread's variance."""
+        faster = self.readings(lambda d: speed(d) * (1 + spread(d)))
+        slower = self.readings(lambda d: speed(d) * (1 - spread(d)))
+        return self.largest_change({name: 0.5 * (faster[name] + slower[name]) for name in faster})
 
 
 def encounters(test: SedimentationTest, classes: int = 120,
@@ -134,6 +156,35 @@ def lowest_sensed_depth(test: SedimentationTest) -> float:
     """The deepest point any instrument senses [m below the surface]: the hydrometer's bulb bottom
     at a zero reading, the buoyancy sphere's bottom, the pipette sample's bottom."""
     return max(instrument(name).deepest(test.cylinder.height) for name in test.instruments)
+
+
+def swirl_spread(test: SedimentationTest, depth: float, classes: int = 120) -> tuple[np.ndarray, np.ndarray, float]:
+    """How far the swirls of the suspension spread each class's arrival at `depth`, as a fraction of its
+    fall: sqrt(2 int D dt) / depth over the class's fall time depth / v. The swirls' dispersion is
+    D = dV 2 xi, with dV = SWIRL_SPEED phi^1/3 V (1 - exp(-W / (60 a phi^-1/3))), Segre et al.'s cut-off
+    by the cylinder's width W, and 2 xi = SWIRL_LENGTH a phi^-1/3 (at most W), for the fraction phi, mass-mean speed
+    V and radius a of the grains still above `depth` (a class has left when it has fallen `depth`).
+    Errs high: the swirls also weaken as the column stratifies (Tee et al. 2002, PRL 89 054501).
+
+    Returns (diameters, spreads, the fluctuation dV / V at the start)."""
+    lo, hi = test.psd.span()
+    diameter, share = log_classes(test.psd, lo, hi, classes)
+    share = share / share.sum()
+    speed = terminal_speeds(test.suspension, diameter)
+    order = np.argsort(-speed)    # the classes in the order they leave
+    d, w, v = diameter[order], share[order], speed[order]
+    left = depth / v
+    # while class m is the fastest still falling: the grains of classes m, m + 1, ... remain
+    remaining = np.cumsum(w[::-1])[::-1]
+    mean_speed = np.cumsum((w * v)[::-1])[::-1] / remaining
+    mean_radius = np.cumsum((w * d / 2)[::-1])[::-1] / remaining
+    phi = test.solid_fraction * remaining
+    fluctuation = SWIRL_SPEED * phi ** (1 / 3) * mean_speed \
+        * (1 - np.exp(-test.cylinder.diameter / (60 * mean_radius * phi ** (-1 / 3))))
+    dispersion = fluctuation * np.minimum(SWIRL_LENGTH * mean_radius * phi ** (-1 / 3), test.cylinder.diameter)
+    spread = np.sqrt(2 * np.cumsum(dispersion * np.diff(left, prepend=0.0))) / depth
+    back = np.argsort(order)
+    return diameter, spread[back], float(fluctuation[0] / mean_speed[0])
 
 
 def verdict_of(change: float, tolerance: float) -> str:
@@ -211,6 +262,21 @@ def screen(test: SedimentationTest, tolerance: float = 0.5) -> list[Screen]:
     screens.append(Screen("wall", "cylinder wall (Ladenburg)", "largest diameter / cylinder diameter", ratio, change,
                           REPORT, f"the wall slows grains by up to {100 * 2.1 * ratio:.2g} %, moving a reading by up "
                           f"to {change:.3g} pp; not simulated (the sub-volume is periodic)"))
+
+    diameter, spreads, fluctuation = swirl_spread(test, PIPETTE_DEPTH)
+    spread = lambda d: np.minimum(np.interp(np.log(d), np.log(diameter), spreads), 0.9)    # noqa: E731
+    change = model.spread_change(single, spread)
+    coupled = change > OMIT_BELOW * tolerance
+    screens.append(Screen("two-way", "two-way coupling (the flow the grains drive)",
+                          "velocity fluctuation / mean settling speed, 2.0 phi0^1/3", fluctuation, change,
+                          REPORT if coupled else OMIT,
+                          f"a homogeneous suspension settles as its hindrance says with or without the flow it "
+                          f"drives (deck check suspension_flow); what the flow adds is its swirls (Segre et al. "
+                          f"1997), which spread each class's arrival at {100 * PIPETTE_DEPTH:g} cm by up to "
+                          f"{100 * float(spreads.max()):.2g} % of its fall and move a reading by up to {change:.3g} pp "
+                          "(an upper estimate)"
+                          + ("; not simulated: the planner's sub-volume is two grains across, too narrow for the "
+                             "swirls (fix fluid/flow resolves them in a column of real grains)" if coupled else "")))
 
     screens.append(Screen("yield", "yield stress (Bingham)", "yield number tau_y / (drho g d)", 0.0, 0.0, OMIT,
                           "water is Newtonian: the yield machinery is never needed"))
