@@ -41,11 +41,6 @@ from cases import CASES, INVERT_SMALL, Ctx, add, build_fixtures  # noqa: E402, F
 # ==== runner ================================================================================================
 OUTCOME_NAMES = ("ok", "wrong", "crash", "vague")
 KNOWN_BAD: set[str] = {   # not ok in the round of docs/hostile.md; take a case off when it is fixed
-    "paste-balls/unit--viscosity=279",
-    "run/again-after-it-finished",
-    "spheres/spheres/binary-garbage",
-    
-    "sweep/value-25-a-negative-step",
 }
 
 

@@ -195,3 +195,16 @@ def test_a_signal_whose_interrupt_was_lost_still_stops_the_command(tmp_path, mon
     assert cli.main(["readout", "--psd", str(psd), "--stokes-preview", "--out", str(out)]) == 130
     assert "interrupted by SIGINT" in capsys.readouterr().err
     assert not out.exists() or not any(p for p in out.iterdir() if not p.name.startswith(".sediment"))
+
+
+@pytest.mark.parametrize("value", ["-1e-3", "-1e-3,1e-3", "-.5E+2", "-0.001,-2"])
+def test_a_negative_number_in_e_notation_reaches_its_option_s_check(value, capsys):
+    """argparse took '-1e-3' (and a list starting with it) for an option and said only that --dt had
+    no value; the option's own check now names the value."""
+    with pytest.raises(SystemExit) as stop:
+        cli.main(["sweep", "deck.lmp", "--dt", value, "--observe", "x"])
+    assert stop.value.code == 2
+    err = capsys.readouterr().err
+    assert "argument --dt: must be > 0" in err and "expected one argument" not in err
+    assert cli.NEGATIVE_NUMBER.match(value)
+    assert not any(cli.NEGATIVE_NUMBER.match(option) for option in ("--dt", "-h", "-1e", "-1e-3,x", "-e3"))

@@ -9,6 +9,7 @@ from __future__ import annotations
 import argparse
 import io
 import os
+import re
 import signal
 import sys
 import threading
@@ -34,6 +35,10 @@ class HelpFormatter(argparse.RawDescriptionHelpFormatter):
         return text + " (default: %(default)s)"
 
 
+_NUMBER = r"(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?"
+NEGATIVE_NUMBER = re.compile(rf"^-{_NUMBER}(,-?{_NUMBER})*$")    # -1e-3, or a list that starts with one
+
+
 def build_parser() -> argparse.ArgumentParser:
     """The parser of every command."""
     parser = argparse.ArgumentParser(prog="sediment", formatter_class=HelpFormatter,
@@ -46,6 +51,10 @@ def build_parser() -> argparse.ArgumentParser:
     commands = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
     for command in COMMANDS:
         sub = command.add_parser(commands)
+        # A negative number in E notation or a list starting with one (--dt -1e-3,1e-3) is a value, as
+        # -0.001 is, so that its option's check names it; argparse's own pattern knows only plain
+        # decimals and took it for an option.
+        sub._negative_number_matcher = NEGATIVE_NUMBER
         sub.formatter_class = HelpFormatter
         sub.epilog = "examples:\n" + "\n".join(f"  {line}" for line in command.EXAMPLES)
         sub.set_defaults(func=command.run)

@@ -150,6 +150,20 @@ def run_id(deck: Path, variables: dict[str, object]) -> str:
     return f"{inputs_id(deck)}-{digest.hexdigest()[:6]}-{secrets.token_hex(4)}"
 
 
+def already_finished(deck: Path, variables: dict[str, str]) -> Path | None:
+    """The complete layer file of the folder's finished run of this deck, as it reads now and with these
+    variables (a rerun would only write it again), or None."""
+    try:
+        record = read_record(deck.parent)
+    except ValueError:
+        return None
+    layers = layer_file_of(deck, variables)
+    if (record is None or layers is None or record.get("state") != "finished" or record.get("deck") != deck.name
+            or record.get("variables") != variables or inputs_of_run(record["run_id"]) != inputs_id(deck)):
+        return None
+    return layers if finished(layers, record["run_id"]) else None
+
+
 def inputs_of_run(identity: str) -> str | None:
     """The INPUTS part of a run id (`run_id`), or None for an id not of that form (a run of an older
     SEDIMENT, or none)."""

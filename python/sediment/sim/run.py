@@ -27,9 +27,9 @@ from ..progress import bar as progress_bar
 from ..results import write_atomic
 from .printed import parse_printed
 from .process import RunInterrupted, Runs, launch_command, release, signals_stop, start_process, stop_process
-from .provenance import (COMPARED, RECORD, check_partial, check_written, file_digest, finished, input_files,
-                         layer_file_of, read_record, restart_damage, resume_id, run_id, stamp, unresumable,
-                         write_record)
+from .provenance import (COMPARED, RECORD, already_finished, check_partial, check_written, file_digest, finished,
+                         input_files, layer_file_of, read_record, restart_damage, resume_id, run_id, stamp,
+                         unresumable, write_record)
 
 
 @dataclass
@@ -99,6 +99,10 @@ def run_deck(deck: Path, ranks: int = 1, variables: dict[str, str] | None = None
     with folder_lock(folder, "run"):
         if not resume:    # (a resumed run names what changed since it started)
             check_written(deck)
+            done = None if force else already_finished(deck, variables)
+            if done is not None:
+                raise ValueError(f"{deck.name} has already finished: {done.name} holds its complete frames (`sediment "
+                                 f"readout {folder}` reads them); --force runs it again and replaces them")
             launch = dict(variables, sediment_run_id=run_id(deck, variables))
             if force or unresumable(deck, variables):
                 launch["overwrite"] = "yes"

@@ -137,14 +137,19 @@ class BallDrop:
 def drop_ball(diameter: float, fall: float, submergence: bool = True, dt: float = 1e-5,
               trace: Path | None = None, law: str = LAW, plastic_viscosity: float | None = None) -> BallDrop:
     """Drops one ball into the paste (in.ball_in_paste) and reports where and when it stopped."""
+    calibrated = PLASTIC_VISCOSITY[law]
+    eta = calibrated if plastic_viscosity is None else plastic_viscosity
     variables = {"d": diameter, "fall": fall, "effect_submergence": "yes" if submergence else "no", "dt": dt,
-                 "law": law, "eta_B": PLASTIC_VISCOSITY[law] if plastic_viscosity is None else plastic_viscosity}
+                 "law": law, "eta_B": eta}
     if trace is not None:
         variables.update(trace="yes", trace_file=Path(trace).resolve())
     out = run_batch(EXAMPLES / "in.ball_in_paste", variables)
     r = out.results
     if r["stuck"] != 1:
-        raise RuntimeError(f"the {diameter * 1e3:g} mm ball dropped from {fall} m did not come to rest")
+        slip = (f" ({eta / calibrated:.3g} times the {calibrated:g} Pa s calibrated for law {law}: a value in mPa s "
+                "given as Pa s?)" if eta > 10 * calibrated else "")
+        raise RuntimeError(f"the {diameter * 1e3:g} mm ball dropped from {fall} m did not come to rest in the paste of "
+                           f"plastic viscosity {eta:g} Pa s{slip}")
     return BallDrop(diameter, fall, submergence, r["depth"], r["t_rest"], r["creep"], abs(r["vz"]),
                     out.wall_seconds)
 
