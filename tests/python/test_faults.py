@@ -118,10 +118,18 @@ def test_a_rerun_with_other_parameters_keeps_the_earlier_result(tmp_path):
 
 
 def test_a_run_starting_anew_over_a_result_is_refused(tmp_path):
+    """`sediment run` refuses a rerun of its finished deck before LAMMPS starts, naming --force; LAMMPS
+    run by hand refuses it in fix layers/hdf5. The result stays as it was either way."""
     deck = sample(tmp_path / "same", "--particles", 2000)
     assert sediment("run", deck, "--quiet").returncode == 0
+    before = digest(deck.parent / "layers.h5")
     again = sediment("run", deck, "--quiet")
-    assert again.returncode == 2 and "starts anew at step 0" in again.stderr
+    assert again.returncode == 2 and "in.sedimentation has already finished: layers.h5 holds its complete frames" \
+        in again.stderr and "--force" in again.stderr
+    by_hand = subprocess.run([os.environ["SEDIMENT_LMP"], "-in", deck.name, "-log", "none"], cwd=deck.parent,
+                             capture_output=True, text=True)
+    assert by_hand.returncode != 0 and "starts anew at step 0" in by_hand.stdout
+    assert digest(deck.parent / "layers.h5") == before
 
 
 def test_frames_of_another_fluid_are_not_spliced(tmp_path):
