@@ -14,9 +14,7 @@ in turn (a machine's load slows a run, never speeds it); each ratio is of runs o
 from __future__ import annotations
 
 import argparse
-import os
 import re
-import subprocess
 import sys
 import tempfile
 from pathlib import Path
@@ -24,10 +22,9 @@ from pathlib import Path
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE.parent / "python"))
 from sediment.cli.types import count  # noqa: E402
-from sediment.sim.paths import lmp_executable  # noqa: E402
+from sediment.sim.run import run_batch  # noqa: E402
 
 DECK = HERE / "in.flow_cost"
-LOOP = re.compile(r"^Loop time of ([0-9.eE+-]+) on \d+ procs for (\d+) steps", re.M)
 
 
 def section(text: str, name: str) -> float:
@@ -37,20 +34,10 @@ def section(text: str, name: str) -> float:
 
 
 def run(variables: dict[str, object], ranks: int, cwd: Path) -> dict[str, float]:
-    command = [str(lmp_executable()), "-in", str(DECK), "-log", "none"]
-    for key, value in variables.items():
-        command += ["-var", key, str(value)]
-    if ranks > 1:
-        command = ["mpirun", "-np", str(ranks), "--oversubscribe"] + command
-    done = subprocess.run(command, cwd=cwd, capture_output=True, text=True,
-                          env={**os.environ, "OMP_NUM_THREADS": "1", "OMPI_MCA_pml": "ob1",
-                               "OMPI_ALLOW_RUN_AS_ROOT": "1", "OMPI_ALLOW_RUN_AS_ROOT_CONFIRM": "1"})
-    if done.returncode != 0 or "ERROR" in done.stdout:
-        raise SystemExit(f"run {variables} on {ranks} ranks failed:\n{done.stdout[-2000:]}{done.stderr[-2000:]}")
-    loop, steps = LOOP.findall(done.stdout)[-1]
-    steps = int(steps)
-    return {"step": float(loop) / steps, "modify": section(done.stdout, "Modify") / steps,
-            "kspace": section(done.stdout, "Kspace") / steps}
+    out = run_batch(DECK, variables, ranks=ranks, cwd=cwd)
+    loop, steps = out.loops[-1]
+    return {"step": loop / steps, "modify": section(out.text, "Modify") / steps,
+            "kspace": section(out.text, "Kspace") / steps}
 
 
 def least(configs: list[tuple[dict, int]], repeat: int, cwd: Path) -> list[dict[str, float]]:

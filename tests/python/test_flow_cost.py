@@ -25,7 +25,6 @@ def test_the_breakdown_is_read_at_its_average(flow_cost):
     assert flow_cost.section(BREAKDOWN, "Kspace") == pytest.approx(0.2)
     assert flow_cost.section(BREAKDOWN, "Modify") == pytest.approx(0.26)
     assert flow_cost.section(BREAKDOWN, "Neigh") == 0.0
-    assert flow_cost.LOOP.findall(BREAKDOWN) == [("0.5", "100")]
 
 
 def test_a_small_run_prints_both_tables(flow_cost, capsys):
