@@ -14,7 +14,8 @@ import pytest
 from sediment.cli import main
 from sediment.inverse.model import LabTest
 from sediment.lab.instruments import INSTRUMENTS
-from sediment.lab.readout import SCALES, Column, Hydrometer, Suspension
+from sediment.lab.instruments import HYDROMETERS
+from sediment.lab.readout import Column, Hydrometer, Suspension
 from sediment.lab.sheet import SheetError, read_hydrometer_calibration, read_sheet, standard_reduction
 
 REPO = Path(__file__).resolve().parents[2]
@@ -114,8 +115,8 @@ def test_a_151h_sheet_reduces_as_d422_says_and_as_the_same_stems_152h(tmp_path):
     raw = np.genfromtxt(sheet151, delimiter=",", names=True)
     reductions = []
     for sheet, calibration in ((read_sheet(sample / "hydrometer.csv"), CALIBRATION),
-                               (read_sheet(sheet151, scale=SCALES["151H"]), calibration151)):
-        instrument = Hydrometer.calibrated(*read_hydrometer_calibration(calibration, sheet.scale), 55e-6, 0.137)
+                               (read_sheet(sheet151, hydrometer_type="151H"), calibration151)):
+        instrument = Hydrometer.calibrated(*read_hydrometer_calibration(calibration, sheet.scale.name), 55e-6, 0.137)
         reductions.append(standard_reduction(sheet, water, test.initial_concentration, instrument, test.cylinder_area,
                                              test.sphere, test.meniscus, test.correction(sheet)))
     gs = 2.7
@@ -124,7 +125,7 @@ def test_a_151h_sheet_reduces_as_d422_says_and_as_the_same_stems_152h(tmp_path):
     assert np.allclose(reductions[1].percent, reductions[0].percent, atol=1e-3)
     assert np.allclose(reductions[1].diameter, reductions[0].diameter, rtol=1e-5)
     nominal = Hydrometer.astm_152h()
-    depth = nominal.effective_depth(SCALES["151H"].grams([1.000, 1.020, 1.031])) * 100
+    depth = nominal.effective_depth(HYDROMETERS["151H"].scale.grams([1.000, 1.020, 1.031])) * 100
     assert depth == pytest.approx([16.3, 11.0, 8.1], abs=0.1)
 
 
@@ -135,15 +136,15 @@ def test_a_sheet_on_the_other_hydrometers_scale_is_refused_naming_the_option(tmp
     with pytest.raises(SheetError, match="look like specific gravities: a 151H's sheet needs --hydrometer-type 151H"):
         read_sheet(sheet151)
     with pytest.raises(SheetError, match="look like a 152H's g/L, not the specific gravities of a 151H"):
-        read_sheet(sample / "hydrometer.csv", scale=SCALES["151H"])
+        read_sheet(sample / "hydrometer.csv", hydrometer_type="151H")
     high = tmp_path / "high.csv"
     high.write_text("time_min,reading,temperature_C\n1,1.045,20\n")
     with pytest.raises(SheetError, match="line 2: reading 1.045 is not within 0.995-1.04: a 151H's scale"):
-        read_sheet(high, scale=SCALES["151H"])
+        read_sheet(high, hydrometer_type="151H")
     blank = tmp_path / "blank.csv"
     blank.write_text("time_min,reading,temperature_C,blank\n1,1.02,20,0.004\n")
     with pytest.raises(SheetError, match="blank 0.004 is not within 0.99-1.0125: a 151H in the control cylinder"):
-        read_sheet(blank, scale=SCALES["151H"])
+        read_sheet(blank, hydrometer_type="151H")
     out = ["--mass", "0.025", "--hydrometer-type", "151H", "--out", str(tmp_path / "out")]
     assert "--meniscus 0.05 (151H) as a 152H's: 80.303 g/L is not within -5 to 5 g/L" in _refusal(
         capsys, ["invert", str(sheet151), *out, "--meniscus", "0.05"])

@@ -130,7 +130,6 @@ def add_parser(commands) -> argparse.ArgumentParser:
 def run(args: argparse.Namespace) -> int:
     """Reads the sheets, inverts, prints the PSD and the verdict, writes the report."""
     from ..inverse import LabTest
-    from ..lab.readout import SCALES
     from ..lab.sheet import read_sheet
     from ..plausible import check, sphere_density
 
@@ -159,7 +158,6 @@ def run(args: argparse.Namespace) -> int:
     sphere = sphere_density(args.sphere_mass, args.sphere_diameter)
     if sphere is not None:
         raise ValueError(sphere)
-    scale = SCALES[args.hydrometer_type]
     hydrometer_noise, zero_correction, meniscus = (
         hydrometer_step(args, "hydrometer_noise", "hydrometer_noise", HYDROMETER_NOISE),
         hydrometer_step(args, "zero_correction"),
@@ -170,7 +168,7 @@ def run(args: argparse.Namespace) -> int:
                    hydrometer=hydrometer(args), zero_correction=zero_correction, meniscus=meniscus,
                    sphere_depth=args.sphere_depth, sphere_diameter=args.sphere_diameter, sphere_mass=args.sphere_mass,
                    noise=noise, thermometer=args.thermometer)
-    sheets = [read_sheet(p, args.pipette_volume, args.stirred, scale) for p in args.sheets]
+    sheets = [read_sheet(p, args.pipette_volume, args.stirred, args.hydrometer_type) for p in args.sheets]
     _refuse_repeats(sheets)
     sieves = [s for s in sheets if s.instrument == "sieve"]
     if len(sieves) > 1:
@@ -201,13 +199,13 @@ def specimen_mass(args: argparse.Namespace) -> float | None:
 def hydrometer_step(args: argparse.Namespace, option: str, quantity: str = "", default: float = 0.0) -> float:
     """An option given in the hydrometer's unit (a correction, the meniscus, the reading error) as the
     152H's g/L, checked against what a 152H's can plausibly be; `default` [g/L] where it is not given."""
-    from ..lab.readout import SCALES
+    from ..lab.instruments import hydrometer
     from ..plausible import check, refusal
 
     value = getattr(args, option)
     if value is None:
         return default
-    scale = SCALES[args.hydrometer_type]
+    scale = hydrometer(args.hydrometer_type).scale
     grams = value * scale.per_unit
     named = f"--{option.replace('_', '-')}" + ("" if scale.in_grams else f" {value:g} ({scale.name}) as a 152H's:")
     quantity = quantity or option.replace("zero_", "")
@@ -221,12 +219,12 @@ def hydrometer_step(args: argparse.Namespace, option: str, quantity: str = "", d
 def hydrometer(args: argparse.Namespace):
     """The hydrometer the options describe: the laboratory's calibration, or the nominal one of D422 (the
     151H's dimensions are the 152H's)."""
-    from ..lab.readout import SCALES, Hydrometer
+    from ..lab.readout import Hydrometer
     from ..lab.sheet import read_hydrometer_calibration
 
     if args.hydrometer_calibration is None:
         return Hydrometer.astm_152h(bulb_length=args.bulb_length, bulb_volume=args.bulb_volume)
-    readings, distances = read_hydrometer_calibration(args.hydrometer_calibration, SCALES[args.hydrometer_type])
+    readings, distances = read_hydrometer_calibration(args.hydrometer_calibration, args.hydrometer_type)
     try:
         return Hydrometer.calibrated(readings, distances, args.bulb_volume, args.bulb_length)
     except ValueError as exc:

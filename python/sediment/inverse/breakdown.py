@@ -27,7 +27,6 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from .. import figures
-from ..lab.instruments import instrument
 from ..lab.psd import PSD
 from ..lab.readout import Column, Suspension
 from ..lab.settling import terminal_speeds
@@ -194,7 +193,7 @@ def point_readings(shares: np.ndarray, diameter: np.ndarray, sheets: list[Sheet]
     # reading = offset + slope x percent finer, as each instrument's standard reduction inverts it
     offset, slope = [], []
     for sheet, r in zip(sheets, reduction):
-        at, by = instrument(sheet.instrument).linear(test, r.temperature)
+        at, by = sheet.kind.linear(test, r.temperature)
         offset.append(at)
         slope.append(by)
     offset, slope = np.concatenate(offset), np.concatenate(slope)

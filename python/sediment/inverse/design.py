@@ -97,7 +97,7 @@ def _design_diameters(parts, test: LabTest, water: Suspension) -> list[float]:
     """The Stokes diameters a design's readings resolve, at the instruments' nominal depths."""
     out = []
     for sheet in _design_sheets(parts, test, water):
-        depth = instrument(sheet.instrument).nominal_depth(test)
+        depth = sheet.kind.nominal_depth(test)
         out += list(water.stokes_diameter(depth, sheet.time))
     return out
 

@@ -12,9 +12,9 @@ import numpy as np
 from .. import figures
 from ..constants import HYDROMETER_TYPES, LAB_TEMPERATURE
 from ..lab import texture
-from ..lab.instruments import HydrometerTest, instrument
+from ..lab.instruments import HydrometerTest, hydrometer, instrument
 from ..lab.psd import NOT_FITTING
-from ..lab.readout import SCALES, Scale, Suspension, gs_correction
+from ..lab.readout import Suspension, gs_correction
 from ..lab.sheet import Reduction, Sheet, SieveSheet, SheetError, check_sheet, standard_reduction
 from ..results import Table, write_text
 from ..sim.scene import COLUMN_DIAMETERS
@@ -100,9 +100,9 @@ class Inversion:
                                  "graduation, from the calibration, less V_B / 2A); percent_finer is 100 a (reading - "
                                  "correction) / c0 in g/L"])
         for r in self.reduction:
-            kind = instrument(r.instrument)
+            kind = instrument(r.instrument, r.scale.name)
             reading = r.scale.as_read(r.reading) if kind.on_hydrometer_scale else r.reading
-            unit = kind.sheet_unit(r.scale)
+            unit = kind.sheet_unit()
             for row in zip(r.time / 60, reading, r.correction / r.scale.per_unit, r.temperature, r.depth * 100,
                            r.diameter * 1e6, r.percent):
                 reduction.add(r.instrument, *map(float, row[:3]), r.meniscus / r.scale.per_unit, unit,
@@ -263,7 +263,7 @@ def invert(sheets: list[Sheet], test: LabTest, folder: Path, *, sieve: SieveShee
     signals = [solids_signal(sheet, test, water) for sheet in sheets]
     corrected = [test.corrected(sheet) for sheet in sheets]
     for sheet, reading, signal in zip(sheets, corrected, signals):
-        kind = instrument(sheet.instrument)
+        kind = sheet.kind
         below = np.flatnonzero(reading < -2 * test.noise[sheet.instrument]) if kind.on_hydrometer_scale else []
         if len(below):
             k = below[0]
@@ -276,7 +276,7 @@ def invert(sheets: list[Sheet], test: LabTest, folder: Path, *, sieve: SieveShee
         noise = test.noise[sheet.instrument]
         tolerance = max(2 * noise, 0.02 * signal)
         stated = "" if not kind.noise_as_read else \
-            f" (now {kind.noise_text(noise, sheet.scale)}; the tolerance is twice it, or 2 % of the solids' signal)"
+            f" (now {kind.noise_text(noise)}; the tolerance is twice it, or 2 % of the solids' signal)"
         check_sheet(sheet, whole_sample_reading(sheet, test, water), tolerance, reading, kind.noise_option + stated)
     sieves = sieve_data(sieve, split, test.noise["sieve"])
     if split is None and sieves.top > test.height / COLUMN_DIAMETERS:
@@ -346,7 +346,7 @@ def invert(sheets: list[Sheet], test: LabTest, folder: Path, *, sieve: SieveShee
     specimen_draws = []
     # the composite correction is one reading of the blank cylinder, subtracted from every reading of the
     # sheet: its error, a reading's, is common to them (as the thermometer's offset is)
-    blank_rows = [rows for sheet, rows in zip(sheets, rows_of) if instrument(sheet.instrument).on_hydrometer_scale]
+    blank_rows = [rows for sheet, rows in zip(sheets, rows_of) if sheet.kind.on_hydrometer_scale]
     for _ in range(draws):
         noisy = data + rng.normal(0.0, sigma) - rng.normal(0.0, test.thermometer) * per_degree
         for rows in blank_rows:
@@ -378,8 +378,8 @@ def invert(sheets: list[Sheet], test: LabTest, folder: Path, *, sieve: SieveShee
     inputs = test.record() | {
         "sheets": [str(s.path) for s in sheets] + ([str(sieve.path)] if sieve is not None else []),
         "composite_correction": {str(s.path): ("blank column" if len(s.blank) else test.zero_correction)
-                                 for s in sheets if instrument(s.instrument).on_hydrometer_scale},
-        "hydrometer_type": next((s.scale.name for s in sheets if instrument(s.instrument).on_hydrometer_scale),
+                                 for s in sheets if s.kind.on_hydrometer_scale},
+        "hydrometer_type": next((s.scale.name for s in sheets if s.kind.on_hydrometer_scale),
                                 HYDROMETER_TYPES[0]),
         "temperatures_C": [float(recorded.min()), float(recorded.max())] if len(recorded) else None,
         "split_mm": None if split is None else split * 1e3, "specimen_share": sieves.share,
@@ -402,7 +402,7 @@ def invert(sheets: list[Sheet], test: LabTest, folder: Path, *, sieve: SieveShee
                              "stands, but read differences smaller than that as the model's own spread, which the band "
                              "does not hold: more --particles steady the runs"))
     unread = [s for s in sheets
-              if instrument(s.instrument).on_hydrometer_scale and not len(s.blank) and test.zero_correction == 0]
+              if s.kind.on_hydrometer_scale and not len(s.blank) and test.zero_correction == 0]
     if unread:
         a = gs_correction(test.particle_density / 1000.0)
         out.notes.append(f"no composite correction for {', '.join(s.path.name for s in unread)}: its readings are "
@@ -429,7 +429,7 @@ def invert(sheets: list[Sheet], test: LabTest, folder: Path, *, sieve: SieveShee
         out.notes.append(f"{name} at {where} is {abs(modelled - measured) / s:.1f} noise units off the fit: check it")
     read = [r for r in rows if r[0] != "sieve"]
     if len(read) >= 5 and out.reduced_chi2 < TOO_GOOD:
-        units = {s.instrument: instrument(s.instrument).noise_text(test.noise[s.instrument], s.scale) for s in sheets}
+        units = {s.instrument: instrument(s.instrument, s.scale.name).noise_text(test.noise[s.instrument]) for s in sheets}
         out.notes.append(f"note: the readings lie far closer to the fit than their stated errors say (chi-square per "
                          f"reading {out.reduced_chi2:.2g}, where about 1 is expected): the band, which those errors set "
                          f"({', '.join(f'{k} {v}' for k, v in units.items())}), is wider than the readings need; or the "
@@ -501,14 +501,14 @@ def _sieves_tension(rows: list[tuple[str, float, float, float, float, float]]) -
     return None
 
 
-def _noise_text(name: str, noise: float, scale: Scale) -> str:
+def _noise_text(name: str, noise: float, hydrometer_type: str) -> str:
     """A reading error as its option states it: an instrument's, or the sieves' in points."""
-    return f"{noise:g} points" if name == SieveSheet.instrument else instrument(name).noise_text(noise, scale)
+    return f"{noise:g} points" if name == SieveSheet.instrument else instrument(name, hydrometer_type).noise_text(noise)
 
 
 def _inputs_line(test: LabTest, inputs: dict) -> str:
     """The test's values as the inverse used them, for the console."""
-    scale = SCALES[inputs["hydrometer_type"]]
+    scale = hydrometer(inputs["hydrometer_type"]).scale
     correction = "; ".join(f"{Path(k).name}: {v if isinstance(v, str) else scale.quoted_step(v)}"
                            for k, v in inputs["composite_correction"].items()) or "none"
     read = "" if scale.in_grams else " (its specific gravity R read as 1000 (R - 1) / 0.6226 g/L of a 152H)"
@@ -521,7 +521,7 @@ def _inputs_line(test: LabTest, inputs: dict) -> str:
             + f", the specimen's largest grain {inputs['top_um']:g} um"
             + (f" (the part passing {inputs['split_mm']:g} mm, {100 * inputs['specimen_share']:.4g} % of the sample)"
                if inputs["split_mm"] else "")
-            + "; noise: " + ", ".join(f"{k} {_noise_text(k, v, scale)}" for k, v in test.noise.items())
+            + "; noise: " + ", ".join(f"{k} {_noise_text(k, v, scale.name)}" for k, v in test.noise.items())
             + f", thermometer {test.thermometer:g} C"
             + "; sheets: " + ", ".join(Path(s).name for s in inputs["sheets"]))
 

@@ -13,7 +13,7 @@ import numpy as np
 from .. import _core
 from ..constants import (D422_CYLINDER_AREA, D422_CYLINDER_HEIGHT, SIEVE_NOISE, SOIL_PARTICLE_DENSITY,
                          SPHERE_DEPTH_SHARE, SPHERE_DIAMETER, SPHERE_MASS, THERMOMETER_NOISE)
-from ..lab.instruments import INSTRUMENTS, instrument
+from ..lab.instruments import INSTRUMENTS
 from ..lab.psd import PSD
 from ..lab.readout import BuoyancySphere, Column, Hydrometer, Suspension
 from ..lab.settling import terminal_speeds
@@ -56,7 +56,7 @@ class LabTest:
     def correction(self, sheet: Sheet) -> np.ndarray:
         """The 152H's composite correction at each reading [g/L]: the sheet's own `blank` column where
         it has one, else the test's zero correction (0 for other instruments)."""
-        if not INSTRUMENTS[sheet.instrument].on_hydrometer_scale:
+        if not sheet.kind.on_hydrometer_scale:
             return np.zeros(len(sheet.time))
         return np.array(sheet.blank, float) if len(sheet.blank) else np.full(len(sheet.time), self.zero_correction)
 
@@ -75,12 +75,12 @@ class LabTest:
 
 def whole_sample_reading(sheet: Sheet, test: LabTest, water: Suspension) -> float:
     """What the instrument reads with the whole sample in suspension (its unit)."""
-    return instrument(sheet.instrument).whole_sample(test, water)
+    return sheet.kind.whole_sample(test, water)
 
 
 def solids_signal(sheet: Sheet, test: LabTest, water: Suspension) -> float:
     """How far the whole sample moves the instrument's reading from clear water's (its unit)."""
-    return abs(whole_sample_reading(sheet, test, water) - instrument(sheet.instrument).clear_water(test, water))
+    return abs(whole_sample_reading(sheet, test, water) - sheet.kind.clear_water(test, water))
 
 
 def effective_times(sheet: Sheet, reference: Suspension, offset: float = 0.0) -> np.ndarray:
@@ -120,7 +120,7 @@ class ForwardRun:
         column = self.column(shares)
         out = []
         for sheet, t in zip(sheets, times):
-            out.append(instrument(sheet.instrument).modelled(column, sheet, t, self.test, self.water))
+            out.append(sheet.kind.modelled(column, sheet, t, self.test, self.water))
         return np.concatenate(out) if out else np.empty(0)
 
 

@@ -7,8 +7,9 @@ reads in the column, how it reads a simulated column, how the standard reduction
 into diameters and percents finer, and what it reads of the inverse's forward model. Adding an
 instrument is writing one class, registering it below and adding its name to
 `constants.INSTRUMENTS` (the command line's list, checked against this table by a test).
-A hydrometer's two scales, 152H and 151H, are `readout.SCALES`; sieves are a kind of sheet, not
-an instrument (lab/sheet.py).
+The hydrometer's types, 152H and 151H, are a class each (`HYDROMETERS`, the names of
+`constants.HYDROMETER_TYPES`), differing in their stem's scale; sieves are a kind of sheet, not an
+instrument (lab/sheet.py).
 """
 from __future__ import annotations
 
@@ -24,8 +25,8 @@ from .. import _core
 from ..constants import (BALANCE_NOISE, D422_CYLINDER_AREA, HYDROMETER_NOISE, LAB_TEMPERATURE,
                          PIPETTE_DEPTH, PIPETTE_NOISE, PIPETTE_VOLUME, SCHEDULES, SPHERE_DEPTH_SHARE)
 from ..plausible import pipette_mass
-from .readout import (BuoyancySphere, Column, Hydrometer, Pipette, Readings, Scale, Suspension,
-                      gs_correction)
+from .readout import (GRAMS, SPECIFIC_GRAVITY, BuoyancySphere, Column, Hydrometer, Pipette, Readings, Scale,
+                      Suspension, gs_correction)
 from .sheetcheck import SheetError, plausible
 
 
@@ -96,7 +97,7 @@ class Instrument:
         """The depth Stokes' law takes for it, nominally [m]."""
         raise NotImplementedError
 
-    def sheet_readings(self, path: Path, lines: list[int], values: dict[str, np.ndarray], scale: Scale,
+    def sheet_readings(self, path: Path, lines: list[int], values: dict[str, np.ndarray],
                        pipette_volume: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Its sheet's (checked) readings in the inverse's unit, the depths (pipette) and blanks (hydrometer)."""
         raise NotImplementedError
@@ -123,11 +124,11 @@ class Instrument:
         """Reading = offset + slope x percent finer, as its standard reduction inverts it, per reading."""
         raise NotImplementedError
 
-    def sheet_unit(self, scale: Scale) -> str:
+    def sheet_unit(self) -> str:
         """The unit of its readings as the sheet gives them."""
         return self.noise_unit
 
-    def noise_text(self, noise: float, scale: Scale) -> str:
+    def noise_text(self, noise: float) -> str:
         """A reading error as its noise option states it."""
         return f"{noise:g} {self.noise_unit}"
 
@@ -138,7 +139,8 @@ class Instrument:
 
 
 class HydrometerTest(Instrument):
-    """A hydrometer (ASTM 152H, or a 151H read as the 152H's g/L: `readout.SCALES`), D422/D7928."""
+    """A hydrometer, D422/D7928; each type a subclass with its stem's scale. The 151H and the 152H have the
+    same dimensions (D422 3.2), so they float alike; everything after the sheet works on the 152H's g/L."""
 
     name = "hydrometer"
     heading = "R [g/L]"
@@ -148,6 +150,9 @@ class HydrometerTest(Instrument):
     noise_unit = "g/L"
     noise_option = "--hydrometer-noise"
     on_hydrometer_scale = True
+    type_name: ClassVar[str]
+    scale: ClassVar[Scale]               # what its stem reads, and how that becomes the 152H's g/L
+    other_scale_hint: ClassVar[str]      # what a sheet on the other type's scale should have given
 
     def physical(self, column, setup):
         """The hydrometer (default the nominal 152H) on the schedule's times."""
@@ -163,14 +168,12 @@ class HydrometerTest(Instrument):
         """The 152H's bulb centre, nominally."""
         return 0.15
 
-    def sheet_readings(self, path, lines, values, scale, pipette_volume):
-        """Readings and blanks on the sheet's scale (152H or 151H) as the 152H's g/L."""
-        reading = values["reading"]
+    def sheet_readings(self, path, lines, values, pipette_volume):
+        """Readings and blanks on its scale as the 152H's g/L."""
+        reading, scale = values["reading"], self.scale
         gravities = bool(np.all((reading > 0.95) & (reading < 1.15)))
         if gravities == scale.in_grams:
-            raise SheetError(f"{path}: the readings ({reading.min():g}-{reading.max():g}) look like "
-                             + ("specific gravities: a 151H's sheet needs --hydrometer-type 151H" if gravities else
-                                "a 152H's g/L, not the specific gravities of a 151H (--hydrometer-type 151H)"))
+            raise SheetError(f"{path}: the readings ({reading.min():g}-{reading.max():g}) look like {self.other_scale_hint}")
         plausible(path, lines, values, "reading", scale.reading_range)
         blank = np.empty(0)
         if "blank" in values:
@@ -212,13 +215,30 @@ class HydrometerTest(Instrument):
         per_percent = test.initial_concentration / (100 * gs_correction(test.particle_density / 1000.0))
         return np.zeros(len(temperature)), np.full(len(temperature), per_percent)
 
-    def sheet_unit(self, scale):
-        """The scale's unit (g/L or specific gravity)."""
-        return scale.unit
+    def sheet_unit(self):
+        """Its scale's unit (g/L or specific gravity)."""
+        return self.scale.unit
 
-    def noise_text(self, noise, scale):
-        """The noise on the sheet's scale."""
-        return scale.quoted_step(noise)
+    def noise_text(self, noise):
+        """The noise on its scale."""
+        return self.scale.quoted_step(noise)
+
+
+class Hydrometer152H(HydrometerTest):
+    """ASTM 152H: grams of soil of Gs 2.65 per litre of suspension, 0 in water at 20 C."""
+
+    type_name = "152H"
+    scale = GRAMS
+    other_scale_hint = "specific gravities: a 151H's sheet needs --hydrometer-type 151H"
+
+
+class Hydrometer151H(HydrometerTest):
+    """ASTM 151H: the suspension's specific gravity, 1 in water at 20 C; its R is the 152H's
+    1000 (R - 1) / 0.6226 g/L, which makes D422's two percent-finer formulas agree."""
+
+    type_name = "151H"
+    scale = SPECIFIC_GRAVITY
+    other_scale_hint = "a 152H's g/L, not the specific gravities of a 151H (--hydrometer-type 151H)"
 
 
 class BuoyancyTest(Instrument):
@@ -250,7 +270,7 @@ class BuoyancyTest(Instrument):
         """The sphere's centre."""
         return test.sphere.depth
 
-    def sheet_readings(self, path, lines, values, scale, pipette_volume):
+    def sheet_readings(self, path, lines, values, pipette_volume):
         """The balance's apparent masses [g]."""
         plausible(path, lines, values, "apparent_mass_g", "apparent_mass_g")
         return values["apparent_mass_g"], np.empty(0), np.empty(0)
@@ -310,7 +330,7 @@ class PipetteTest(Instrument):
         """The default tip depth."""
         return PIPETTE_DEPTH
 
-    def sheet_readings(self, path, lines, values, scale, pipette_volume):
+    def sheet_readings(self, path, lines, values, pipette_volume):
         """The samples' dry masses as g/L of the sample, and their depths."""
         plausible(path, lines, values, "depth_cm", "depth_cm")
         plausible(path, lines, values, "mass_g", pipette_mass(pipette_volume))
@@ -341,12 +361,25 @@ class PipetteTest(Instrument):
         return np.r_[True, np.diff(sheet.depth) == 0]    # a sample deeper down holds more than the one above it
 
 
-# The table of them, in constants.INSTRUMENTS' order (the readouts' and the reports' order)
-INSTRUMENTS: dict[str, Instrument] = {i.name: i for i in (HydrometerTest(), BuoyancyTest(), PipetteTest())}
+# The tables of them: the hydrometer's types in constants.HYDROMETER_TYPES' order (the first the default),
+# the instruments in constants.INSTRUMENTS' (the readouts' and the reports' order)
+HYDROMETERS: dict[str, HydrometerTest] = {h.type_name: h for h in (Hydrometer152H(), Hydrometer151H())}
+INSTRUMENTS: dict[str, Instrument] = {i.name: i for i in (HYDROMETERS["152H"], BuoyancyTest(), PipetteTest())}
 
 
-def instrument(name: str) -> Instrument:
-    """The instrument of a name; an unknown name is refused with the valid ones."""
+def hydrometer(type_name: str) -> HydrometerTest:
+    """The hydrometer of a type; an unknown type is refused with the valid ones."""
+    try:
+        return HYDROMETERS[type_name]
+    except KeyError:
+        raise ValueError(f"unknown hydrometer type '{type_name}': the types are {', '.join(HYDROMETERS)}") from None
+
+
+def instrument(name: str, hydrometer_type: str = "152H") -> Instrument:
+    """The instrument of a name (a hydrometer of `hydrometer_type`); an unknown name is refused with the
+    valid ones."""
+    if name == HydrometerTest.name:
+        return hydrometer(hydrometer_type)
     try:
         return INSTRUMENTS[name]
     except KeyError:

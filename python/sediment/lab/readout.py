@@ -64,9 +64,8 @@ class Scale:
         return f"{grams / self.per_unit:.3g} in {self.unit} ({grams:.3g} g/L of a 152H)"
 
 
-SCALES = {"152H": Scale("152H", "g/L", 0.0, 1.0),
-          "151H": Scale("151H", "specific gravity", 1.0, 1000.0 / R_FACTOR, "reading_151h", "blank_151h")}
-GRAMS = SCALES["152H"]    # the scale of the 152H's g/L, which every sheet's readings become
+GRAMS = Scale("152H", "g/L", 0.0, 1.0)    # the 152H's scale, whose g/L every sheet's readings become
+SPECIFIC_GRAVITY = Scale("151H", "specific gravity", 1.0, 1000.0 / R_FACTOR, "reading_151h", "blank_151h")
 
 @dataclass(frozen=True)
 class Suspension:

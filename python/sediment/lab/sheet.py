@@ -25,7 +25,7 @@ import numpy as np
 
 from ..constants import LAB_TEMPERATURE, PIPETTE_VOLUME
 from ..csvfile import CsvError, CsvFile, read_csv
-from .instruments import INSTRUMENTS
+from .instruments import INSTRUMENTS, Instrument, hydrometer, instrument
 from .readout import GRAMS, BuoyancySphere, Hydrometer, Scale, Suspension
 from .sheetcheck import SheetError, plausible
 
@@ -60,6 +60,11 @@ class Sheet:
         """The sheet's file and instrument, as messages name it."""
         return f"{self.path.name} ({self.instrument})"
 
+    @property
+    def kind(self) -> Instrument:
+        """The instrument that read it (a hydrometer of its scale's type)."""
+        return instrument(self.instrument, self.scale.name)
+
 
 @dataclass(frozen=True)
 class SieveSheet:
@@ -78,9 +83,9 @@ class SieveSheet:
 
 
 def read_sheet(path: str | Path, pipette_volume: float = PIPETTE_VOLUME, stirred: str | None = None,
-               scale: Scale = GRAMS) -> Sheet | SieveSheet:
+               hydrometer_type: str = "152H") -> Sheet | SieveSheet:
     """Reads and checks one sheet (its kind from its header); a pipette's masses become g/L of the sample,
-    a hydrometer's readings on `scale` the 152H's g/L. A `clock` column (HH:MM of each reading) stands for
+    a hydrometer's readings (of a 152H or 151H: `hydrometer_type`) the 152H's g/L. A `clock` column (HH:MM of each reading) stands for
     `time_min`, counted from `stirred` (HH:MM)."""
     table = _table(path)
     if "clock" in table.header:
@@ -105,6 +110,7 @@ def read_sheet(path: str | Path, pipette_volume: float = PIPETTE_VOLUME, stirred
     lines = [line for line, _ in table.rows]
     if kind == "sieve":
         return _sieve_sheet(path, values["opening_mm"], values["percent_passing"])
+    reader = instrument(kind, hydrometer_type)
     plausible(path, lines, values, "time_min", "time_min")
     time = values["time_min"] * 60.0
     if time[0] <= 0 or np.any(np.diff(time) <= 0):
@@ -112,14 +118,14 @@ def read_sheet(path: str | Path, pipette_volume: float = PIPETTE_VOLUME, stirred
     values.setdefault("temperature_C", np.full(len(time), math.nan))
     temperature = values["temperature_C"]
     recorded = np.isfinite(temperature)
-    if INSTRUMENTS[kind].on_hydrometer_scale and not recorded.all():
+    if reader.on_hydrometer_scale and not recorded.all():
         missing = ", ".join(str(lines[k]) for k in np.flatnonzero(~recorded))
         raise SheetError(f"{path}: no temperature on line(s) {missing}: a hydrometer's reading needs the temperature "
                          "it was taken at")
     plausible(path, lines, values, "temperature_C", "temperature")
-    reading, depth, blank = INSTRUMENTS[kind].sheet_readings(path, lines, values, scale, pipette_volume)
+    reading, depth, blank = reader.sheet_readings(path, lines, values, pipette_volume)
     return Sheet(kind, path, time, reading, temperature, depth, blank, tuple(lines),
-                 scale if INSTRUMENTS[kind].on_hydrometer_scale else GRAMS)
+                 reader.scale if reader.on_hydrometer_scale else GRAMS)
 
 
 def clock_minutes(text: str, where: str) -> float:
@@ -259,7 +265,7 @@ def check_sheet(sheet: Sheet, whole: float, resolution: float, corrected: np.nda
             f", {values[k]:g}{'' if sheet.scale.in_grams else ' g/L'} after its correction"
         return f"{sheet.scale.quoted(sheet.reading[k])} on the sheet{after}"
     # the solids signal, falling with time: the sphere's apparent mass rises as the suspension thins
-    kind = INSTRUMENTS[sheet.instrument]
+    kind = sheet.kind
     signal, top = (-values, -whole) if kind.reading_falls_with_solids else (values, whole)
     over = np.flatnonzero(signal > top + resolution)
     if len(over):
@@ -313,7 +319,7 @@ def standard_reduction(sheet: Sheet, suspension: Suspension, initial_concentrati
                            suspension.temperature if suspension.temperature is not None else LAB_TEMPERATURE)
     waters = [Suspension.at_temperature(t, suspension.particle_density) for t in temperature]
     gs = suspension.specific_gravity
-    kind = INSTRUMENTS[sheet.instrument]
+    kind = sheet.kind
     applied = np.zeros(len(sheet.time))
     if kind.on_hydrometer_scale:
         applied = applied + correction
@@ -325,10 +331,11 @@ def standard_reduction(sheet: Sheet, suspension: Suspension, initial_concentrati
                      diameter, percent, sheet.scale)
 
 
-def read_hydrometer_calibration(path: str | Path, scale: Scale = GRAMS) -> tuple[np.ndarray, np.ndarray]:
+def read_hydrometer_calibration(path: str | Path, hydrometer_type: str = "152H") -> tuple[np.ndarray, np.ndarray]:
     """A hydrometer's calibration (D7928's H_r): CSV ``reading,distance_cm``, the distance from the
-    graduation of each reading (on `scale`) to the bulb's centre. Returns the readings [152H g/L] and the
+    graduation of each reading (on the scale of `hydrometer_type`) to the bulb's centre. Returns the readings [152H g/L] and the
     distances [m]."""
+    scale = hydrometer(hydrometer_type).scale
     table = _table(path)
     path = table.path
     if not {"reading", "distance_cm"} <= set(table.header):
