@@ -3,7 +3,9 @@
 
 setuptools works in build-pip/, not in build/: build/ is CMake's (make build), and pip install .
 must not write into it."""
+import re
 from glob import glob
+from pathlib import Path
 
 from pybind11.setup_helpers import ParallelCompile, Pybind11Extension
 from setuptools import setup
@@ -18,4 +20,6 @@ core = Pybind11Extension(
     cxx_std=17,
 )
 
-setup(ext_modules=[core], options={"build": {"build_base": "build-pip"}})
+# The release, from the one place that states it (pyproject.toml lists the version as dynamic)
+release = re.search(r'version = "([0-9.]+)"', Path("core/include/sediment/version.hpp").read_text()).group(1)
+setup(version=release, ext_modules=[core], options={"build": {"build_base": "build-pip"}})

@@ -10,7 +10,9 @@ sys.path.insert(0, os.environ["SEDIMENT_PYTHON"])    # the checkout's python/, b
 project = "SEDIMENT"
 author = "the SEDIMENT developers"
 copyright = "the SEDIMENT developers, GPL-2.0-or-later"
-release = version = "0.1.0"
+from sediment import _core    # noqa: E402  (the release, from the core: core/include/sediment/version.hpp)
+
+release = version = _core.VERSION
 extensions = ["myst_parser", "sphinx.ext.autodoc", "numpydoc", "sphinx.ext.mathjax"]
 source_suffix = {".rst": "restructuredtext", ".md": "markdown"}
 master_doc = "index"

@@ -6,6 +6,7 @@
 #include "fix_layers_hdf5.h"
 #include "sediment_args.h"
 #include "sediment_hdf5.h"
+#include "sediment/version.hpp"
 
 #include "compute_concentration_grid.h"
 #include "fix_fluid.h"
@@ -39,7 +40,6 @@ namespace {
 
 constexpr const char *SCHEMA = "sediment-layers";
 constexpr int SCHEMA_VERSION = 1;
-constexpr const char *SEDIMENT_VERSION = "0.1.0";
 
 // The frame datasets, in the order of FixLayersHDF5::frame_sets; the last, the fluid's density and
 // viscosity per frame, only in the files of a fix with a fluid.
@@ -308,7 +308,7 @@ void FixLayersHDF5::open_file()
     write_attribute(file, "dimension", domain->dimension);
     for (const auto &[name, value] : identity) write_attribute(file, name, value);
     write_attribute(file, "run_id", run_id ? run_id : "");
-    write_attribute(file, "code_version", std::string("SEDIMENT ") + SEDIMENT_VERSION + ", LAMMPS " + lmp->version);
+    write_attribute(file, "code_version", std::string("SEDIMENT ") + sediment::version + ", LAMMPS " + lmp->version);
     write_attribute(file, "run_start", utils::current_date());
     std::string columns;
     for (const std::string &name : names) columns += (columns.empty() ? "" : ",") + name;
@@ -563,7 +563,7 @@ void FixLayersHDF5::restart(char *buf)
 {
   double numbers[RESTART_NUMBERS];
   memcpy(numbers, buf, 2 * sizeof(double));
-  if (numbers[0] != RESTART_MARKER) {    // a file of SEDIMENT 0.1.0: time and step only
+  if (numbers[0] != RESTART_MARKER) {    // a restart of an earlier build: time and step only
     update->atime = numbers[0];
     update->atimestep = static_cast<bigint>(numbers[1]);
     return;

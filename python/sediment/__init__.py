@@ -10,8 +10,6 @@ LAMMPS, scenes, layer files), `sediment.studies` (validation and accuracy studie
 The names below are loaded when first used, so that the parts that need no compiled code (running
 decks, reading layer files) import before the extension is built.
 """
-from .constants import VERSION as __version__    # noqa: F401  (sediment.__version__)
-
 _CORE = ("DragModel", "critical_yield_number", "drag_coefficient", "drag_law_names", "explicit_step_limit",
          "mixture_density", "rayleigh_time", "relaxation_time", "rotation_drag_rate", "sphere_inertia",
          "stokes_velocity", "submergence", "terminal_velocity", "time_to_fraction", "water_density",
@@ -22,14 +20,15 @@ __all__ = sorted(_CORE + _STYLES)
 
 
 def __getattr__(name: str):
-    """The core's functions and the style registration, imported on first use."""
-    if name in _CORE:
+    """The core's functions, the release (__version__: the core's VERSION) and the style registration,
+    imported on first use."""
+    if name in _CORE or name == "__version__":
         try:
             from . import _core
         except ImportError as exc:
             raise ImportError("sediment._core is not built: run `make build` (or `make test`) in the repository, "
                               "or `pip install .`") from exc
-        return getattr(_core, name)
+        return getattr(_core, "VERSION" if name == "__version__" else name)
     if name in _STYLES:
         from .sim import styles
 

@@ -18,6 +18,8 @@ class DragModel:
     def steady_speed(self: DragModel, d: float, driving_force: float, voidage: float = ...) -> tuple: ...
     def tangent(self: DragModel, d: float, speed: float, voidage: float = ...) -> float: ...
 
+VERSION: str
+
 def critical_yield_number(law: str = ...) -> float:
     """Y = tau_y / ((rho_p - rho_f) g d) at which a sphere stops."""
 

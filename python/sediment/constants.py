@@ -2,10 +2,6 @@
 """Physical constants and laboratory defaults, in SI units, defined once for the whole package."""
 from __future__ import annotations
 
-# The release (the one source: tests/python/test_repository.py checks pyproject.toml, CITATION.cff,
-# CMakeLists.txt and the layer files' writer against it)
-VERSION = "0.1.0"
-
 GRAVITY = 9.81                    # m/s2
 WATER_20C_DENSITY = 998.2067      # kg/m3 (Tanaka et al. 2001; sediment._core.water_density(20))
 WATER_20C_VISCOSITY = 1.0016e-3   # Pa s (IAPWS 2008; sediment._core.water_viscosity(20))
@@ -60,9 +56,10 @@ SCHEDULES = {              # hydrometer reading times [min]
 
 
 def __getattr__(name: str):
-    """BOLTZMANN [J/K], the core's (core/include/sediment/water.hpp), loaded when first asked for, so
-    that the names above work before a build."""
-    if name == "BOLTZMANN":
+    """BOLTZMANN [J/K] (core/include/sediment/water.hpp) and VERSION, the release
+    (core/include/sediment/version.hpp): the core's, loaded when first asked for, so that the names above
+    work before a build."""
+    if name in ("BOLTZMANN", "VERSION"):
         from . import _core
-        return _core.BOLTZMANN
+        return getattr(_core, name)
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

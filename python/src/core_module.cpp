@@ -6,6 +6,7 @@
 #include "sediment/geometry.hpp"
 #include "sediment/integrator.hpp"
 #include "sediment/terminal.hpp"
+#include "sediment/version.hpp"
 #include "sediment/water.hpp"
 
 #include <pybind11/numpy.h>
@@ -126,6 +127,7 @@ PYBIND11_MODULE(_core, m)
   }, "Names of the hindrances ('none' included).");
 
   m.attr("BOLTZMANN") = boltzmann;
+  m.attr("VERSION") = version;
   m.def("water_density", [](double celsius) { return water_density(checked_temperature(celsius)); },
         py::arg("celsius"), "Density of water [kg/m3] at 0-40 C (Tanaka et al. 2001).");
   m.def("water_viscosity", [](double celsius) { return water_viscosity(checked_temperature(celsius)); },

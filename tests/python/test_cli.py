@@ -9,6 +9,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+import sediment
 from sediment import cli
 from sediment.cli import types
 from sediment.plausible import RANGES
@@ -135,6 +136,8 @@ def test_every_help_works_before_the_core_is_built_and_a_command_says_what_to_bu
         assert done.returncode == 0 and "Traceback" not in done.stderr, (command, done.stderr)
     done = bare("terminal", "--diameter", "1e-4", "--particle-density", "2650")
     assert done.returncode == 2 and done.stderr.count("\n") == 1 and "not built: run `make build`" in done.stderr
+    done = bare("--version")    # the release is the core's
+    assert done.returncode == 2 and done.stderr.count("\n") == 1 and "not built: run `make build`" in done.stderr
 
 
 def test_the_commands_come_in_the_order_of_the_work_with_examples_that_parse(capsys):
@@ -143,7 +146,7 @@ def test_the_commands_come_in_the_order_of_the_work_with_examples_that_parse(cap
     assert names[:6] == ["plan", "sample", "run", "readout", "budget", "invert"]
     with pytest.raises(SystemExit) as done:
         parser.parse_args(["--version"])
-    assert done.value.code == 0 and capsys.readouterr().out.strip() == "sediment 0.1.0"
+    assert done.value.code == 0 and capsys.readouterr().out.strip() == f"sediment {sediment.__version__}"
     for command in cli.COMMANDS:
         assert command.EXAMPLES
         for line in command.EXAMPLES:

@@ -338,7 +338,10 @@ def test_8_the_layer_file_a_deck_writes_and_whether_a_run_finished(tmp_path):
     assert sediment("run", deck, "--quiet").returncode == 0
     record = json.loads((deck.parent / ".sediment-run.json").read_text())
     assert record["state"] == "finished" and record["deck"] == "in.sedimentation"
-    assert read_layers(deck.parent / "layers.h5").identity["run_id"] == record["run_id"]
+    identity = read_layers(deck.parent / "layers.h5").identity
+    assert identity["run_id"] == record["run_id"]
+    from sediment import _core    # the writer states the release the package does (core/include/sediment/version.hpp)
+    assert identity["code_version"].startswith(f"SEDIMENT {_core.VERSION}, LAMMPS ")
     # a stop that came as LAMMPS finished: the file is this run's and complete
     assert finished(deck.parent / "layers.h5", record["run_id"])
     assert not finished(deck.parent / "layers.h5", record["run_id"][:-1] + "x")

@@ -3,6 +3,7 @@
 links no LAMMPS (Debian's build backend; no network, so no build isolation). The notebooks run with
 the installed package too (test_notebooks.py)."""
 import os
+import re
 import shutil
 import subprocess
 from pathlib import Path
@@ -21,6 +22,14 @@ def test_pip_install_gives_the_package_and_the_command(installed, tmp_path):
     assert where.startswith(str(venv))
     linked = subprocess.run(["ldd", where], capture_output=True, text=True, check=True).stdout
     assert "lammps" not in linked and "sediment_lammps" not in linked
+    # the release the metadata, the command and the module state: the header's (setup.py reads it)
+    release = re.search(r'version = "([0-9.]+)"',
+                        (REPO / "core" / "include" / "sediment" / "version.hpp").read_text()).group(1)
+    stated = subprocess.run([venv / "bin" / "python", "-c", "from importlib.metadata import version; import sediment; "
+                             "print(version('sediment'), sediment.__version__)"], capture_output=True, text=True,
+                            check=True, cwd=tmp_path).stdout.split()
+    command = subprocess.run([venv / "bin" / "sediment", "--version"], capture_output=True, text=True, check=True)
+    assert stated == [release, release] and command.stdout == f"sediment {release}\n"
     # the main job with the installed package, LAMMPS from the build
     env = dict(os.environ, SEDIMENT_LMP=str(REPO / "build" / "lmp_sediment"), PYTHONPATH="")
     sediment = venv / "bin" / "sediment"

@@ -32,16 +32,20 @@ def test_the_notes_the_code_cites_are_in_the_repository():
     assert [f for f in _tracked() if any(word in (REPO / f).read_text() for word in outside)] == []
 
 
-def test_the_version_is_one():
-    """sediment.constants.VERSION is the release; every other file that states it agrees."""
-    from sediment.constants import VERSION
+def test_the_version_is_stated_once():
+    """core/include/sediment/version.hpp states the release; the build, the package, the layer files' writer
+    and the documentation read it from there, and no other file types it in (CITATION.cff, which GitHub
+    reads as written, is checked against it)."""
+    from sediment import _core
+    import sediment
 
-    stated = {"pyproject.toml": r'^version = "([^"]+)"', "CITATION.cff": r"^version: (\S+)",
-              "CMakeLists.txt": r"project\(sediment VERSION (\S+)"}
-    for name, pattern in stated.items():
-        found = re.search(pattern, (REPO / name).read_text(), re.MULTILINE)
-        assert found and found.group(1) == VERSION, f"{name} states {found and found.group(1)}, not {VERSION}"
-    # the version the layer files record (fix layers/hdf5), wherever the package defines it
-    written = [m.group(1) for f in sorted((REPO / "lammps-pkg" / "SEDIMENT").glob("*.[ch]*"))
-               for m in re.finditer(r'SEDIMENT_VERSION\s*=\s*"([^"]+)"', f.read_text())]
-    assert written and set(written) == {VERSION}, f"the layer files' writer states {written}, not {VERSION}"
+    header = (REPO / "core" / "include" / "sediment" / "version.hpp").read_text()
+    release = re.search(r'version = "([0-9.]+)"', header).group(1)
+    assert _core.VERSION == sediment.__version__ == release
+    assert re.search(r"^version: (\S+)$", (REPO / "CITATION.cff").read_text(), re.MULTILINE).group(1) == release
+    assert 'dynamic = ["version"]' in (REPO / "pyproject.toml").read_text()
+    typed = re.compile(r'(?<![\w.])' + re.escape(release) + r'(?![\w.])')
+    readers = ("CMakeLists.txt", "setup.py", "pyproject.toml", "docs/site/conf.py", "python/sediment/constants.py",
+               "python/sediment/cli/__init__.py", "lammps-pkg/SEDIMENT/fix_layers_hdf5.cpp")
+    assert [f for f in readers if typed.search((REPO / f).read_text())] == []
+    assert "sediment::version" in (REPO / "lammps-pkg" / "SEDIMENT" / "fix_layers_hdf5.cpp").read_text()

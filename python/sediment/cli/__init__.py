@@ -15,7 +15,6 @@ import sys
 import threading
 from pathlib import Path
 
-from ..constants import VERSION
 from . import budget, calibrate, case_a, invert, paste, plan, readout, run, sample, spheres, sweep, terminal
 
 # In the order of the work: plan a test, sample it, run it, read it; the physics' uncertainty; a
@@ -35,6 +34,20 @@ class HelpFormatter(argparse.RawDescriptionHelpFormatter):
         return text + " (default: %(default)s)"
 
 
+class _Version(argparse.Action):
+    """--version: the release the built core states (core/include/sediment/version.hpp), read only when
+    asked for, so that --help works before a build."""
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        try:
+            from .. import _core
+        except ImportError:
+            parser.exit(2, "sediment --version: the C++ core (sediment._core), which states the release, is not "
+                           "built: run `make build` in the repository, or install the package (README, Python route)\n")
+        print(f"sediment {_core.VERSION}")
+        parser.exit(0)
+
+
 _NUMBER = r"(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?"
 NEGATIVE_NUMBER = re.compile(rf"^-{_NUMBER}(,-?{_NUMBER})*$")    # -1e-3, or a list that starts with one
 
@@ -47,7 +60,7 @@ def build_parser() -> argparse.ArgumentParser:
                                      epilog="a test end to end:\n" + "\n".join(f"  {line}" for line in (
                                          plan.EXAMPLES[0], sample.EXAMPLES[1], run.EXAMPLES[0], readout.EXAMPLES[0])) +
                                      "\n\n`sediment COMMAND --help` for a command's options and examples")
-    parser.add_argument("--version", action="version", version=f"sediment {VERSION}")
+    parser.add_argument("--version", action=_Version, nargs=0, help="show the release of the core and exit")
     commands = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
     for command in COMMANDS:
         sub = command.add_parser(commands)
