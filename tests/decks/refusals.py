@@ -302,7 +302,11 @@ def fuzz_input(np_ranks: int):
             return case, "refused" if not case.valid else "valid input refused: " + out.error
         if ran:
             return case, "ran" if case.valid else "silently accepted"
-        return case, f"crash (exit {out.returncode})"
+        # what a recurrence needs to show its cause: whether LAMMPS had ended its run (a fault at exit, in
+        # MPI_Finalize or a destructor) and the last lines, where Open MPI prints the faulting stack
+        stage = "after LAMMPS ended (Total wall time printed)" if "Total wall time" in out.text else "during the run"
+        tail = "\n      ".join(out.text.strip().splitlines()[-15:])
+        return case, f"crash (exit {out.returncode}) {stage}; the deck's last lines:\n      {tail}"
 
     cases = fuzz.cases()
     with tempfile.TemporaryDirectory() as tmp:
