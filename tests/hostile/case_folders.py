@@ -334,7 +334,9 @@ def concurrent(first: str, second: str, same_out: bool = True, delay: float = 0.
         winner = refs[0] if b.rc != 0 else refs[1]
         if got != winner:
             return "wrong", f"exit {codes}: the folder is not the other's whole result: {diff(winner, got)}"
-        if has(refused.message, [("another sediment command", "in use", "busy", "lock")]):
+        # refused while the other runs (the lock), or, started as the other published, for its files,
+        # which the message says the other command wrote
+        if has(refused.message, [("another sediment command", "in use", "busy", "lock", "(written by sediment ")]):
             return "ok", refused.last
         return "vague", f"'{refused.last[:150]}' (wants the other command named)"
     return fn
