@@ -369,3 +369,16 @@ def test_two_way_coupling_is_screened_and_never_turned_on_by_the_screen():
     assert 0 < two_way.change < 0.125 and two_way.verdict == OMIT
     strict = {s.effect: s for s in screen(SedimentationTest(psd), tolerance=0.05)}["two-way"]
     assert strict.verdict == "report only" and "not simulated" in strict.reason
+
+
+def test_the_two_way_figure_draws_the_screens_own_readings(tmp_path):
+    """benchmarks/two_way_swirls.py (docs/effects.md's figure) reads the screen's readings: its panel's
+    largest difference is the screen's change, which it checks before it draws."""
+    import subprocess
+
+    out = tmp_path / "two_way.png"
+    done = subprocess.run(["/usr/bin/python3", REPO / "benchmarks" / "two_way_swirls.py", "--samples", "5", "--out", out],
+                          capture_output=True, text=True, env=dict(os.environ, PYTHONPATH=str(REPO / "python")))
+    assert done.returncode == 0, done.stderr
+    change = {s.effect: s for s in screen(SedimentationTest(read_psd(SAMPLE5)))}["two-way"].change
+    assert f"sample 5: the screen's largest change of a reading {change:.3g} pp" in done.stdout and out.is_file()

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Callable
 
 import numpy as np
 
@@ -89,12 +90,14 @@ class ReadingModel:
                                                pipette]))
         column = self._column(reference_speed)
         self.reference: dict[str, np.ndarray] = {}
+        self.reading_times: dict[str, np.ndarray] = {}    # s, each instrument's
         for name in test.instruments:    # one at a time: an instrument that cannot read this test is named
             try:
                 found, _ = read_all(column, [name], cylinder_area=test.cylinder.area)
             except ValueError as exc:
                 raise ValueError(f"the {name} cannot read this test ({exc}): plan without it (--instruments)") from None
             self.reference.update({r.instrument: r.percent_finer for r in found})
+            self.reading_times.update({r.instrument: r.time for r in found})
 
     def _column(self, speed):
         t = self.test
@@ -114,13 +117,17 @@ class ReadingModel:
         """max |P - P_reference| over the instruments' readings when the classes settle at `speed(d)`."""
         return self.largest_change(self.readings(speed))
 
-    def spread_change(self, speed, spread) -> float:
-        """The largest change of a reading when each class's speed is spread by the fraction `spread(d)`
-        (a Gaussian's standard deviation) about `speed(d)`: the mean of the readings at speed (1 +- spread),
+    def spread_readings(self, speed, spread) -> dict[str, np.ndarray]:
+        """Each instrument's readings when each class's speed is spread by the fraction `spread(d)` (a
+        Gaussian's standard deviation) about `speed(d)`: the mean of the readings at speed (1 +- spread),
         which holds the spread's variance."""
         faster = self.readings(lambda d: speed(d) * (1 + spread(d)))
         slower = self.readings(lambda d: speed(d) * (1 - spread(d)))
-        return self.largest_change({name: 0.5 * (faster[name] + slower[name]) for name in faster})
+        return {name: 0.5 * (faster[name] + slower[name]) for name in faster}
+
+    def spread_change(self, speed, spread) -> float:
+        """The largest change of a reading when each class's speed is spread by the fraction `spread(d)`."""
+        return self.largest_change(self.spread_readings(speed, spread))
 
 
 def encounters(test: SedimentationTest, classes: int = 120,
@@ -185,6 +192,15 @@ def swirl_spread(test: SedimentationTest, depth: float, classes: int = 120) -> t
     spread = np.sqrt(2 * np.cumsum(dispersion * np.diff(left, prepend=0.0))) / depth
     back = np.argsort(order)
     return diameter, spread[back], float(fluctuation[0] / mean_speed[0])
+
+
+def swirl_spread_of(test: SedimentationTest, depth: float = PIPETTE_DEPTH) -> tuple[Callable, float, float]:
+    """`swirl_spread` as a function of the diameter (capped at 0.9, where a class would stop), its largest
+    value, and the fluctuation dV / V at the start."""
+    diameter, spreads, fluctuation = swirl_spread(test, depth)
+    def spread(d):
+        return np.minimum(np.interp(np.log(d), np.log(diameter), spreads), 0.9)
+    return spread, float(spreads.max()), fluctuation
 
 
 def verdict_of(change: float, tolerance: float) -> str:
@@ -263,8 +279,7 @@ def screen(test: SedimentationTest, tolerance: float = 0.5) -> list[Screen]:
                           REPORT, f"the wall slows grains by up to {100 * 2.1 * ratio:.2g} %, moving a reading by up "
                           f"to {change:.3g} pp; not simulated (the sub-volume is periodic)"))
 
-    diameter, spreads, fluctuation = swirl_spread(test, PIPETTE_DEPTH)
-    spread = lambda d: np.minimum(np.interp(np.log(d), np.log(diameter), spreads), 0.9)    # noqa: E731
+    spread, widest, fluctuation = swirl_spread_of(test)
     change = model.spread_change(single, spread)
     coupled = change > OMIT_BELOW * tolerance
     screens.append(Screen("two-way", "two-way coupling (the flow the grains drive)",
@@ -273,7 +288,7 @@ def screen(test: SedimentationTest, tolerance: float = 0.5) -> list[Screen]:
                           f"a homogeneous suspension settles as its hindrance says with or without the flow it "
                           f"drives (deck check suspension_flow); what the flow adds is its swirls (Segre et al. "
                           f"1997), which spread each class's arrival at {100 * PIPETTE_DEPTH:g} cm by up to "
-                          f"{100 * float(spreads.max()):.2g} % of its fall and move a reading by up to {change:.3g} pp "
+                          f"{100 * widest:.2g} % of its fall and move a reading by up to {change:.3g} pp "
                           "(an upper estimate)"
                           + ("; not simulated: the planner's sub-volume is two grains across, too narrow for the "
                              "swirls (fix fluid/flow resolves them in a column of real grains)" if coupled else "")))
