@@ -83,6 +83,8 @@ def main(argv: list[str] | None = None) -> int:
     _RECEIVED.clear()
     if threading.current_thread() is threading.main_thread():    # where Python lets a handler be set
         previous = {sig: signal.signal(sig, _interrupt) for sig in (signal.SIGINT, signal.SIGTERM)}
+    unraisable = sys.unraisablehook
+    sys.unraisablehook = _quiet_lost_interrupt(unraisable)
     try:
         return _command(argv)
     except KeyboardInterrupt as exc:    # while the command's parts loaded
@@ -90,6 +92,7 @@ def main(argv: list[str] | None = None) -> int:
               "again", file=sys.stderr)
         return 130
     finally:
+        sys.unraisablehook = unraisable
         for sig, handler in previous.items():
             signal.signal(sig, handler)
 
@@ -188,6 +191,16 @@ _RECEIVED: list[str] = []    # the signals this command took, whether or not the
 def _interrupt(signum: int, _frame: object) -> None:
     _RECEIVED.append(signal.Signals(signum).name)
     raise KeyboardInterrupt(_RECEIVED[-1])
+
+
+def _quiet_lost_interrupt(report):
+    """`report` (Python's report of an exception it cannot raise, one in a finaliser) less our own
+    interrupt: a signal that lands in a finaliser is lost there, and `_still_interrupted` stops the
+    command for it with its one-line message, so its traceback would only alarm."""
+    def hook(unraisable) -> None:
+        if not (isinstance(unraisable.exc_value, KeyboardInterrupt) and _RECEIVED):
+            report(unraisable)
+    return hook
 
 
 def _still_interrupted() -> None:
