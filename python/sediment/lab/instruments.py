@@ -173,7 +173,8 @@ class HydrometerTest(Instrument):
         reading, scale = values["reading"], self.scale
         gravities = bool(np.all((reading > 0.95) & (reading < 1.15)))
         if gravities == scale.in_grams:
-            raise SheetError(f"{path}: the readings ({reading.min():g}-{reading.max():g}) look like {self.other_scale_hint}")
+            raise SheetError(f"{path}: the readings ({reading.min():g}-{reading.max():g}) look like "
+                             + self.other_scale_hint)
         plausible(path, lines, values, "reading", scale.reading_range)
         blank = np.empty(0)
         if "blank" in values:

@@ -85,8 +85,8 @@ class SieveSheet:
 def read_sheet(path: str | Path, pipette_volume: float = PIPETTE_VOLUME, stirred: str | None = None,
                hydrometer_type: str = "152H") -> Sheet | SieveSheet:
     """Reads and checks one sheet (its kind from its header); a pipette's masses become g/L of the sample,
-    a hydrometer's readings (of a 152H or 151H: `hydrometer_type`) the 152H's g/L. A `clock` column (HH:MM of each reading) stands for
-    `time_min`, counted from `stirred` (HH:MM)."""
+    a hydrometer's readings (of a 152H or 151H: `hydrometer_type`) the 152H's g/L. A `clock` column
+    (HH:MM of each reading) stands for `time_min`, counted from `stirred` (HH:MM)."""
     table = _table(path)
     if "clock" in table.header:
         table = _clock_to_minutes(table, stirred)
@@ -333,8 +333,8 @@ def standard_reduction(sheet: Sheet, suspension: Suspension, initial_concentrati
 
 def read_hydrometer_calibration(path: str | Path, hydrometer_type: str = "152H") -> tuple[np.ndarray, np.ndarray]:
     """A hydrometer's calibration (D7928's H_r): CSV ``reading,distance_cm``, the distance from the
-    graduation of each reading (on the scale of `hydrometer_type`) to the bulb's centre. Returns the readings [152H g/L] and the
-    distances [m]."""
+    graduation of each reading (on the scale of `hydrometer_type`) to the bulb's centre. Returns the
+    readings [152H g/L] and the distances [m]."""
     scale = hydrometer(hydrometer_type).scale
     table = _table(path)
     path = table.path
