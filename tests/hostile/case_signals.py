@@ -7,6 +7,7 @@ import shutil
 import signal
 import subprocess
 import time
+from dataclasses import replace
 from typing import Callable
 
 from case_folders import RERUNS, SLOW, prepare, quick_command
@@ -53,7 +54,7 @@ def signalled(writer: str, sig: int, phase: str, at) -> Callable:
         finished = proc.poll() is not None
         if not finished:
             proc.send_signal(sig)
-        done = finish(proc, 60, t0)
+        done = as_the_shell_sees(finish(proc, 60, t0), sig)
         time.sleep(0.3 if sig != signal.SIGKILL else 6.0)
         got = csvs(out)
         clean = ctx.tmp / "clean"
@@ -61,13 +62,13 @@ def signalled(writer: str, sig: int, phase: str, at) -> Callable:
         new = csvs(clean)
         leftovers = [p.name for p in out.parent.iterdir() if p.name not in ("out", "clean", "_run", "_one.csv")
                      and not p.name.endswith(".lock")]   # plan's lock files stay beside --out, as a run's do
+        early = sig != signal.SIGKILL and before_our_code(done, sig)
         if sig == signal.SIGKILL:
             if done.rc not in (-9, 0):
                 bad = crashed(done)
                 if bad:
                     return "crash", bad
         else:
-            early = before_our_code(done, sig)
             bad = crashed(done)
             if bad and not (done.rc == -sig and finished) and not early:
                 return "crash", bad
@@ -93,6 +94,15 @@ def signalled(writer: str, sig: int, phase: str, at) -> Callable:
             if early else "")
         return "ok", f"{state}; the folder {'the earlier set' if got == old and old != new else 'whole'}"
     return fn
+
+
+def as_the_shell_sees(done, sig: int):
+    """A command that said it was interrupted and then died of that signal ends, for the shell, as exit 130
+    does (128 + 2): Python kills itself with SIGINT at exit where the interrupt once went through C code
+    run by PyRun_* (an extension's import), though the command caught it and said what it left."""
+    if sig == signal.SIGINT and done.rc == -sig and "interrupted by SIGINT" in done.err:
+        return replace(done, rc=130)
+    return done
 
 
 def before_our_code(done, sig: int) -> bool:

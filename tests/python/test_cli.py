@@ -218,3 +218,24 @@ def test_a_negative_number_in_e_notation_reaches_its_option_s_check(value, capsy
     assert "argument --dt: must be > 0" in err and "expected one argument" not in err
     assert cli.NEGATIVE_NUMBER.match(value)
     assert not any(cli.NEGATIVE_NUMBER.match(option) for option in ("--dt", "-h", "-1e", "-1e-3,x", "-e3"))
+
+
+def test_an_interrupt_a_library_turned_into_its_own_error_still_stops_the_command(tmp_path, monkeypatch, capsys):
+    """numpy's import turns a KeyboardInterrupt into "ImportError: numpy.core.multiarray failed to import"
+    (hostile round, SIGINT as `sample` loaded): the command ends with 130 and says it was interrupted, not
+    a traceback or an error about the input."""
+    import signal
+
+    from sediment.cli import readout
+
+    def broken(args):
+        try:
+            signal.raise_signal(signal.SIGINT)
+        except KeyboardInterrupt:
+            raise ImportError("numpy.core.multiarray failed to import") from None
+    monkeypatch.setattr(readout, "run", broken)
+    psd = Path(__file__).resolve().parents[2] / "examples" / "granulometry" / "psd" / "sample5.csv"
+    out = tmp_path / "preview"
+    assert cli.main(["readout", "--psd", str(psd), "--stokes-preview", "--out", str(out)]) == 130
+    err = capsys.readouterr().err
+    assert "interrupted by SIGINT" in err and "Traceback" not in err and "ImportError" not in err

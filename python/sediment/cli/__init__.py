@@ -106,6 +106,7 @@ def _command(argv: list[str] | None) -> int:
     try:
         from .. import _core    # noqa: F401  (every command but --help needs it)
     except ImportError:
+        _still_interrupted()    # a signal during the import is not a missing build
         print(f"sediment {args.command}: the C++ core (sediment._core) is not built: run `make build` in the "
               "repository, or install the package (README, Python route)", file=sys.stderr)
         return 2
@@ -130,21 +131,30 @@ def _command(argv: list[str] | None) -> int:
         print(f"sediment {args.command}: {exc}", file=sys.stderr)
         return 130
     except KeyboardInterrupt as exc:
-        if outputs is None:
-            left = "files being written were left as *.partial or not written"
-            if args.command == "run":
-                left += "; sediment run --resume continues a run from its last restart file, --force starts it anew"
-        elif outputs.published:
-            left = f"after its results were written into {args.final_out}"
-        else:
-            left = f"{args.final_out} is as it was: nothing of this {outputs.name} was written"
-        print(f"sediment {args.command}: interrupted by {exc or 'SIGINT'}; {left}", file=sys.stderr)
-        return 130
-    except (ValueError, OSError, RuntimeError) as exc:    # SheetError is a ValueError; OSError: missing, read-only or full files
-        print(f"sediment {args.command}: error: {exc}", file=sys.stderr)
-        return 2
+        return _interrupted(args, outputs, str(exc) or "SIGINT")
+    except Exception as exc:
+        if _RECEIVED:    # an interrupt a library turned into an error of its own (numpy's import: ImportError)
+            return _interrupted(args, outputs, _RECEIVED[0])
+        if not isinstance(exc, (ValueError, OSError, RuntimeError)):
+            raise
+        print(f"sediment {args.command}: error: {exc}", file=sys.stderr)    # SheetError is a ValueError;
+        return 2                                                            # OSError: missing, read-only or full files
     finally:
         sys.stdout = stdout
+
+
+def _interrupted(args: argparse.Namespace, outputs, name: str) -> int:
+    """Says what an interrupted command left; exit status 130."""
+    if outputs is None:
+        left = "files being written were left as *.partial or not written"
+        if args.command == "run":
+            left += "; sediment run --resume continues a run from its last restart file, --force starts it anew"
+    elif outputs.published:
+        left = f"after its results were written into {args.final_out}"
+    else:
+        left = f"{args.final_out} is as it was: nothing of this {outputs.name} was written"
+    print(f"sediment {args.command}: interrupted by {name}; {left}", file=sys.stderr)
+    return 130
 
 
 def _publish(outputs) -> None:
