@@ -30,6 +30,11 @@ int main(int argc, char **argv)
     fprintf(stderr, "ERROR: %s\n", e.what());
     MPI_Abort(MPI_COMM_WORLD, 1);
   }
+  // What LAMMPS printed (its results, its ERROR line) is out before MPI's shutdown: a pipe's buffer
+  // would go with the process if it died there (a run in a suite died of SIGSEGV at exit with no line
+  // of its output, once in thousands, under load).
+  fflush(stdout);
+  fflush(stderr);
   MPI_Barrier(MPI_COMM_WORLD);
   MPI_Finalize();
   return status;

@@ -22,6 +22,14 @@ sys.path.insert(0, str(HERE.parents[1] / "python"))
 from sediment.sim.run import DeckOutput, run_batch  # noqa: E402
 
 
+def died(out: DeckOutput) -> str:
+    """A run that died of a signal, as a report says it: whether LAMMPS had ended (a fault at exit, in
+    MPI_Finalize or a destructor) or not, and the last lines, where Open MPI prints the faulting stack."""
+    stage = "after LAMMPS ended (Total wall time printed)" if "Total wall time" in out.text else "during the run"
+    tail = "\n      ".join(out.text.strip().splitlines()[-15:])
+    return f"crash (exit {out.returncode}) {stage}; the deck's last lines:\n      {tail}"
+
+
 def run_deck(deck: str | Path, variables: dict[str, object] | None = None, np_ranks: int = 1,
              expect_failure: bool = False, cwd: Path | None = None, timeout: float = 600) -> DeckOutput:
     deck = Path(deck)

@@ -7,7 +7,7 @@ from __future__ import annotations
 import tempfile
 from pathlib import Path
 
-from harness import G, check, report, run_batch, run_deck
+from harness import G, check, died, report, run_batch, run_deck
 
 
 # ---- numerical guards and lost atoms ---------------------------------------------------------
@@ -258,6 +258,8 @@ def bad_input(np_ranks: int):
         messages = (messages,) if isinstance(messages, str) else messages
         if "ERROR" not in out.text or not any(m in out.text for m in messages):
             return f"{lines!r}: expected {' or '.join(messages)}; got {out.error}"
+        if out.returncode < 0:    # refused, then died of a signal on the way out
+            return f"{lines!r}: {died(out)}"
         return None
 
     with tempfile.TemporaryDirectory() as tmp:
@@ -302,11 +304,7 @@ def fuzz_input(np_ranks: int):
             return case, "refused" if not case.valid else "valid input refused: " + out.error
         if ran:
             return case, "ran" if case.valid else "silently accepted"
-        # what a recurrence needs to show its cause: whether LAMMPS had ended its run (a fault at exit, in
-        # MPI_Finalize or a destructor) and the last lines, where Open MPI prints the faulting stack
-        stage = "after LAMMPS ended (Total wall time printed)" if "Total wall time" in out.text else "during the run"
-        tail = "\n      ".join(out.text.strip().splitlines()[-15:])
-        return case, f"crash (exit {out.returncode}) {stage}; the deck's last lines:\n      {tail}"
+        return case, died(out)
 
     cases = fuzz.cases()
     with tempfile.TemporaryDirectory() as tmp:
