@@ -439,3 +439,25 @@ def test_a_run_that_starts_after_the_stop_is_stopped_at_once(tmp_path):
     deck.write_text("print hello\n")
     with pytest.raises(RunInterrupted, match="stopped before this one began"):
         run_batch(deck, running=runs)
+
+
+def test_a_stopped_run_leaves_no_process_holding_its_output(tmp_path):
+    """A one-rank run is an Open MPI singleton whose daemon (orted) sets up a session of its own and holds
+    the run's stdout; stopping only the run's session left it there, and the reader of the run's output
+    (an interrupted plan) waiting until the daemon chose to exit. Here the run starts a child in another
+    session that holds the output as the daemon does: after the stop the output ends at once."""
+    import threading
+
+    from sediment.sim.process import start_process, stop_process
+
+    proc = start_process(["sh", "-c", "echo started; setsid sleep 600"], dict(os.environ), tmp_path,
+                         stdout=subprocess.PIPE)
+    assert proc.stdout.readline() == "started\n"
+    time.sleep(0.2)    # setsid has made its session and become sleep
+    stop_process(proc, grace=5.0)
+    rest: list[str] = []
+    reader = threading.Thread(target=lambda: rest.append(proc.stdout.read()), daemon=True)
+    reader.start()
+    reader.join(timeout=15)
+    assert not reader.is_alive(), "a process the run started still holds its output"
+    assert rest == [""]

@@ -48,8 +48,10 @@ def start_process(cmd: list[str], env: dict[str, str], cwd: Path, **kwargs) -> s
 
 def _guard(session: int) -> subprocess.Popen:
     """A process outside the run that waits on a pipe only this process holds: when this process ends
-    in any way, the pipe closes and the guard stops the run's session (SIGTERM, then SIGKILL)."""
-    script = f"read _; pkill -TERM -s {session}; sleep 5; pkill -KILL -s {session}"
+    in any way, the pipe closes and the guard stops the run's session and the children its processes
+    started in other sessions (SIGTERM, then SIGKILL)."""
+    script = (f"read _; for p in $(pgrep -s {session}); do pkill -TERM -P $p; done; "
+              f"pkill -TERM -s {session}; sleep 5; pkill -KILL -s {session}")
     return subprocess.Popen(["sh", "-c", script], stdin=subprocess.PIPE, stdout=subprocess.DEVNULL,
                             stderr=subprocess.DEVNULL, start_new_session=True)
 
@@ -63,9 +65,12 @@ def release(proc: subprocess.Popen) -> None:
         guard.stdin.close()
 
 
-def _session(session: int) -> list[int]:
-    """The live processes of a session (zombies excluded)."""
-    pids = []
+def _family(session: int) -> list[int]:
+    """The live processes of the run: those of its session and their descendants in any session
+    (zombies excluded). A one-rank run is an Open MPI singleton, whose daemon (orted) starts a session
+    of its own yet holds the run's stdout and stderr: left running, it keeps the pipes open and the
+    reader of the run's output waiting after the run was stopped."""
+    parent, in_session = {}, set()
     for entry in os.scandir("/proc"):
         if not entry.name.isdigit():
             continue
@@ -74,16 +79,26 @@ def _session(session: int) -> list[int]:
         except OSError:
             continue
         fields = stat[stat.rindex(")") + 2:].split()    # state, ppid, pgrp, session, ...
-        if int(fields[3]) == session and fields[0] != "Z":
-            pids.append(int(entry.name))
-    return pids
+        if fields[0] == "Z":
+            continue
+        pid = int(entry.name)
+        parent[pid] = int(fields[1])
+        if int(fields[3]) == session:
+            in_session.add(pid)
+    family = set(in_session)
+    grew = True
+    while grew:
+        children = {pid for pid, ppid in parent.items() if ppid in family} - family
+        family |= children
+        grew = bool(children)
+    return sorted(family)
 
 
 def stop_process(proc: subprocess.Popen, grace: float = 10.0) -> None:
-    """SIGTERM to every process of the run's session (mpirun and every rank), SIGKILL to those left
-    after `grace` seconds."""
+    """SIGTERM to every process of the run (`_family`: mpirun, every rank and the daemons they forked),
+    SIGKILL to those left after `grace` seconds."""
     for sig in (signal.SIGTERM, signal.SIGKILL):
-        for pid in _session(proc.pid):
+        for pid in _family(proc.pid):
             try:
                 os.kill(pid, sig)
             except ProcessLookupError:
@@ -93,9 +108,9 @@ def stop_process(proc: subprocess.Popen, grace: float = 10.0) -> None:
             proc.wait(timeout=grace)
         except subprocess.TimeoutExpired:
             continue
-        while _session(proc.pid) and time.monotonic() < end:
+        while _family(proc.pid) and time.monotonic() < end:
             time.sleep(0.05)
-        if not _session(proc.pid):
+        if not _family(proc.pid):
             break
     release(proc)
 
