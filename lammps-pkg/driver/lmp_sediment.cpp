@@ -15,6 +15,10 @@
 
 int main(int argc, char **argv)
 {
+  // LAMMPS's screen is stdout: a line it prints leaves at once, even into a pipe. Debian's 2021 build
+  // ends an error inside error->all with MPI_Finalize() and exit(1), so a fault in MPI's shutdown
+  // would otherwise take the ERROR line, still in the pipe's buffer, with the process.
+  setvbuf(stdout, nullptr, _IOLBF, BUFSIZ);
   MPI_Init(&argc, &argv);
   int status = 0;
   try {
@@ -30,11 +34,7 @@ int main(int argc, char **argv)
     fprintf(stderr, "ERROR: %s\n", e.what());
     MPI_Abort(MPI_COMM_WORLD, 1);
   }
-  // What LAMMPS printed (its results, its ERROR line) is out before MPI's shutdown: a pipe's buffer
-  // would go with the process if it died there (a run in a suite died of SIGSEGV at exit with no line
-  // of its output, once in thousands, under load).
-  fflush(stdout);
-  fflush(stderr);
+  fflush(stdout);    // a last line without its newline, before MPI's shutdown
   MPI_Barrier(MPI_COMM_WORLD);
   MPI_Finalize();
   return status;

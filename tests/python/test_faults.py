@@ -9,6 +9,7 @@ import os
 import shutil
 import signal
 import subprocess
+import threading
 import time
 from pathlib import Path
 
@@ -446,8 +447,6 @@ def test_a_stopped_run_leaves_no_process_holding_its_output(tmp_path):
     the run's stdout; stopping only the run's session left it there, and the reader of the run's output
     (an interrupted plan) waiting until the daemon chose to exit. Here the run starts a child in another
     session that holds the output as the daemon does: after the stop the output ends at once."""
-    import threading
-
     from sediment.sim.process import start_process, stop_process
 
     proc = start_process(["sh", "-c", "echo started; setsid sleep 600"], dict(os.environ), tmp_path,
@@ -461,3 +460,24 @@ def test_a_stopped_run_leaves_no_process_holding_its_output(tmp_path):
     reader.join(timeout=15)
     assert not reader.is_alive(), "a process the run started still holds its output"
     assert rest == [""]
+
+
+def test_lammps_lines_reach_a_pipe_as_they_are_printed(tmp_path):
+    """Debian's 2021 LAMMPS ends a refused deck inside error->all with MPI_Finalize() and exit(1): a fault in
+    MPI's shutdown (seen once in thousands of runs, under load) took the ERROR line, still in stdout's
+    block buffer, with it. lmp_sediment's stdout is line-buffered: a line is in the pipe when printed."""
+    from sediment.sim.paths import lmp_executable
+    from sediment.sim.process import run_environment, start_process, stop_process
+
+    deck = tmp_path / "in.wait"
+    deck.write_text("units si\nregion b block 0 1 0 1 0 1\ncreate_box 1 b\nshell sleep 60\n")
+    proc = start_process([lmp_executable(), "-in", str(deck), "-log", "none"], run_environment(), tmp_path,
+                         stdout=subprocess.PIPE)
+    try:
+        first: list[str] = []
+        reader = threading.Thread(target=lambda: first.append(proc.stdout.readline()), daemon=True)
+        reader.start()
+        reader.join(timeout=30)
+        assert first and first[0].startswith("LAMMPS ("), "LAMMPS's first line was still in its buffer"
+    finally:
+        stop_process(proc, grace=5.0)
