@@ -481,3 +481,31 @@ def test_lammps_lines_reach_a_pipe_as_they_are_printed(tmp_path):
         assert first and first[0].startswith("LAMMPS ("), "LAMMPS's first line was still in its buffer"
     finally:
         stop_process(proc, grace=5.0)
+
+
+@pytest.mark.parametrize("deck", ["refused", "finished"])
+def test_mpi_components_stay_mapped_through_mpi_finalize(tmp_path, deck):
+    """Open MPI 4.1's singleton unloads its PMIx component in MPI_Finalize before it stops the progress thread
+    that may still call into it: about once in 2000 runs under load, the thread jumped into unmapped code
+    (SIGSEGV; a core showed it). lmp_sediment pins the components of Open MPI and PMIx first, on both ways
+    out: LAMMPS's own MPI_Finalize inside error->all (Debian's 2021 build) and the driver's."""
+    from sediment.sim.paths import lmp_executable
+    from sediment.sim.process import run_environment
+
+    text = "units si\nregion b block 0 1 0 1 0 1\ncreate_box 1 b\n"
+    if deck == "refused":
+        text += "fix f all fluid density -1 viscosity 1e-3\n"
+    (tmp_path / "in.deck").write_text(text)
+    proc = subprocess.Popen([lmp_executable(), "-in", "in.deck", "-log", "none"], cwd=tmp_path, text=True,
+                            env=dict(run_environment(), LD_DEBUG="files"), stdout=subprocess.PIPE,
+                            stderr=subprocess.STDOUT)
+    out, _ = proc.communicate(timeout=120)
+    assert proc.returncode == (1 if deck == "refused" else 0), out[-2000:]
+    lines = out.splitlines()
+    last = "ERROR: Fix fluid: density" if deck == "refused" else "Total wall time"
+    end = max(k for k, line in enumerate(lines) if line.startswith(last))
+    unloaded = [line.split("file=")[1].split()[0] for line in lines[end:]
+                if line.strip().startswith(f"{proc.pid}:") and "destroying link map" in line]
+    components = [path for path in unloaded if Path(path).name.startswith(("mca_", "pmix_mca_"))]
+    assert unloaded, "LD_DEBUG's record of unloaded libraries is missing"
+    assert not components, f"unloaded by MPI_Finalize: {components}"
