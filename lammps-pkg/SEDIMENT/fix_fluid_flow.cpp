@@ -42,7 +42,7 @@ static inline int wrap(int i, int n)
 
 FixFluidFlow::FixFluidFlow(LAMMPS *lmp, int narg, char **arg) :
     Fix(lmp, narg, arg), fluid_id(nullptr), fluid(nullptr), nzt(0), column(false), column_lo(0.0), column_hi(0.0),
-    relax(1.0), velocity(nullptr), solved(false), fft(nullptr), plane_lo(0), plane_hi(-1), reversals(0),
+    relax(1.0), drift_limit(0.0), drift(0.0), solved_speed(0.0), velocity(nullptr), solved(false), fft(nullptr), plane_lo(0), plane_hi(-1), reversals(0),
     reversal_growth(1.0)
 {
   if (narg < 8 || strcmp(arg[4], "grid") != 0)
@@ -84,11 +84,16 @@ FixFluidFlow::FixFluidFlow(LAMMPS *lmp, int narg, char **arg) :
     } else if (args.is("every")) {
       args.need(1, "a step count");
       nevery = args.count(1, 1000000);
+    } else if (args.is("drift")) {
+      args.need(1, "a distance in cells");
+      drift_limit = args.positive(1, "drift");
     } else {
-      args.unknown("grid, column, brinkman, width, relax or every");
+      args.unknown("grid, column, brinkman, width, relax, every or drift");
     }
     args.next(nvalues);
   }
+  if (drift_limit > 0.0 && nevery > 1)
+    error->all(FLERR, "Fix fluid/flow: give 'every N' or 'drift D', not both (drift chooses the steps between solves)");
   if (domain->dimension != 3) error->all(FLERR, "Fix fluid/flow requires a 3d simulation");
   if (!domain->xperiodic || !domain->yperiodic)
     error->all(FLERR, "Fix fluid/flow requires a box periodic in x and y (boundary p p ...)");
@@ -209,12 +214,35 @@ void FixFluidFlow::setup(int /*vflag*/)
     relax = 1.0;
     solve();
     relax = keep;
+    if (drift_limit > 0.0) solved_speed = largest_speed();
   }
 }
 
 void FixFluidFlow::end_of_step()
 {
+  if (drift_limit > 0.0) {
+    // The flow follows the spheres' positions and their forces: it is stale once they may have moved
+    // drift cells, or once their speeds (their drag) have changed by that fraction, as when they start
+    // from rest or reach a floor.
+    const double speed = largest_speed();
+    drift += speed * update->dt / spacing[0];
+    if (drift < drift_limit && std::abs(speed - solved_speed) <= drift_limit * solved_speed) return;
+    solved_speed = speed;
+  }
   solve();
+}
+
+// The largest speed of a sphere of the group (all ranks): how far the spheres may have moved in a step.
+double FixFluidFlow::largest_speed() const
+{
+  double **v = atom->v;
+  const int *mask = atom->mask;
+  double local = 0.0;
+  for (int i = 0; i < atom->nlocal; ++i)
+    if (mask[i] & groupbit) local = std::max(local, v[i][0] * v[i][0] + v[i][1] * v[i][1] + v[i][2] * v[i][2]);
+  double largest;
+  MPI_Allreduce(&local, &largest, 1, MPI_DOUBLE, MPI_MAX, world);
+  return sqrt(largest);
 }
 
 // The force sphere i puts on the fluid: minus its drag, against the fluid velocity it saw this step.
@@ -424,6 +452,8 @@ void FixFluidFlow::solve()
   }
   if (solved) check_stable(change);
   solved = true;
+  drift = 0.0;
+  diag[SOLVES] += 1.0;
 }
 
 // The lagged solve's instability (doc page, Stability): the spheres' fluid velocities reverse from
@@ -450,7 +480,7 @@ void FixFluidFlow::check_stable(const double *local)
 double FixFluidFlow::compute_vector(int n)
 {
   // force on the fluid (x, y, z), largest |mean u_z| over a plane of nodes, largest |u| component on
-  // the grid, spheres of the group outside the column (all of the last solve)
+  // the grid, spheres of the group outside the column (all of the last solve); solves so far
   return diag[n];
 }
 
@@ -480,17 +510,20 @@ int FixFluidFlow::unpack_exchange(int nlocal, double *buf)
 void FixFluidFlow::write_restart(FILE *fp)
 {
   if (comm->me != 0) return;
-  const double state[1] = {solved ? 1.0 : 0.0};
+  const double state[4] = {solved ? 1.0 : 0.0, drift, solved_speed, diag[SOLVES]};
   const int size = sizeof(state);
   fwrite(&size, sizeof(int), 1, fp);
-  fwrite(state, sizeof(double), 1, fp);
+  fwrite(state, sizeof(double), 4, fp);
 }
 
 void FixFluidFlow::restart(char *buf)
 {
-  double state;
-  memcpy(&state, buf, sizeof(double));
-  solved = state != 0.0;
+  double state[4];
+  memcpy(state, buf, sizeof(state));
+  solved = state[0] != 0.0;
+  drift = state[1];
+  solved_speed = state[2];
+  diag[SOLVES] = state[3];
 }
 
 int FixFluidFlow::pack_restart(int i, double *buf)

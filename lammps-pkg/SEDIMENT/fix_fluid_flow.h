@@ -62,6 +62,10 @@ class FixFluidFlow : public Fix {
   bool column;           // closed in z: free slip at column_lo and column_hi
   double column_lo, column_hi;
   double relax;          // u <- (1 - relax) u + relax u_solved
+  double drift_limit;    // > 0: solve once the spheres may have moved this many cells since the last solve,
+                         // or their largest speed has changed by this fraction
+  double drift;          // cells the fastest sphere of each step has moved since the last solve, summed
+  double solved_speed;   // the largest speed at the last solve
   sediment::StokesOperator stokes;
   sediment::FlowKernel kernel;
   double **velocity;     // per atom: the fluid velocity its drag is taken against
@@ -77,12 +81,13 @@ class FixFluidFlow : public Fix {
   double origin[3], spacing[3], length[3];
   double self_flow[3];    // per axis: the flow a unit force gives back where it is spread (images too)
   // Diagnostics of the last solve (compute_vector)
-  enum { FX, FY, FZ, FLUX, PEAK, OUTSIDE, NDIAG };
+  enum { FX, FY, FZ, FLUX, PEAK, OUTSIDE, SOLVES, NDIAG };
   double diag[NDIAG];
 
   int reversals;             // solves in a row whose fluid velocities reversed and grew (check_stable)
   double reversal_growth;    // and how much the squared velocities grew over them
   void solve();
+  double largest_speed() const;
   void check_stable(const double *change);
   void transform_solve();
   void measure_self_flow();

@@ -122,6 +122,9 @@ SCENES = [
     Scene("fluid_flow", "fix buoy all fluid/buoyancy water\nfix drag all fluid/drag water law stokes\n"
           "fix flow all fluid/flow water grid 8 8 16 column 0 0.008 every 2 relax 0.1\n",
           {"fz": "f_flow[3]", "peak": "f_flow[5]"}),
+    Scene("fluid_flow_drift", "fix buoy all fluid/buoyancy water\nfix drag all fluid/drag water law stokes\n"
+          "fix flow all fluid/flow water grid 8 8 16 column 0 0.008 drift 0.02 relax 0.1\n",
+          {"fz": "f_flow[3]", "solves": "f_flow[7]"}),
     Scene("layers_hdf5", CONTACTS + "compute conc all concentration/grid layers z 16 bounds 0 0.008\n"
           "fix buoy all fluid/buoyancy water\nfix drag all fluid/drag water law stokes\n"
           "fix layers all layers/hdf5 50 ${layers} c_conc fluid water particle_density 2500\n",
