@@ -42,8 +42,8 @@ static inline int wrap(int i, int n)
 
 FixFluidFlow::FixFluidFlow(LAMMPS *lmp, int narg, char **arg) :
     Fix(lmp, narg, arg), fluid_id(nullptr), fluid(nullptr), nzt(0), column(false), column_lo(0.0), column_hi(0.0),
-    relax(1.0), drift_limit(0.0), drift(0.0), solved_speed(0.0), velocity(nullptr), solved(false), fft(nullptr), plane_lo(0), plane_hi(-1), reversals(0),
-    reversal_growth(1.0)
+    relax(1.0), drift_limit(0.0), drift(0.0), solved_speed(0.0), velocity(nullptr), solved(false), fft(nullptr),
+    plane_lo(0), plane_hi(-1), reversals(0), reversal_growth(1.0)
 {
   if (narg < 8 || strcmp(arg[4], "grid") != 0)
     error->all(FLERR, "Fix fluid/flow: expected 'fix ID group fluid/flow FLUID-ID grid NX NY NZ keyword value ...'");

@@ -31,7 +31,7 @@ int pin_mpi_component(dl_phdr_info *info, size_t, void *)
 // Every MPI_Finalize of the process comes here (MPI's profiling interface), Debian's 2021 LAMMPS's
 // inside error->all included. Open MPI 4.1's singleton (a run without mpirun) unloads its PMIx
 // component and only then stops the progress thread, which may still run one of that component's
-// callbacks: the thread jumps into unmapped code (SIGSEGV, about once in 2000 runs under load; a core
+// callbacks: the thread jumps into unmapped code (SIGSEGV, once in thousands of runs under load; a core
 // showed the thread in libevent calling into where mca_pmix_ext3x.so had been). With the components
 // pinned, their code stays where the callbacks expect it.
 extern "C" int MPI_Finalize()
