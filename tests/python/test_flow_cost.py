@@ -29,10 +29,12 @@ def test_the_breakdown_is_read_at_its_average(flow_cost):
 
 def test_a_small_run_prints_both_tables(flow_cost, capsys):
     assert flow_cost.main(["--particles", "600", "--steps", "4", "--repeat", "1", "--grid", "8", "--every", "1,0",
-                           "--grids", "8", "--ranks", "1"]) == 0
+                           "--drift", "0.5", "--grids", "8", "--ranks", "1"]) == 0
     lines = capsys.readouterr().out.splitlines()
     assert lines[0].startswith("600 grains, 8^3 cells, 1 ranks: one-way step")
-    rows = [line.split() for line in lines[2:4]]
-    assert [row[0] for row in rows] == ["1", "once"] and all(float(row[1]) > 0 for row in rows)
+    rows = [line.split() for line in lines[2:5]]
+    assert [row[0] for row in rows] == ["1", "once", "drift"] and all(float(row[-3]) > 0 for row in rows)
+    # every step: the setup's solve and one per step of both runs (5 + 4); once: the setup's alone
+    assert [float(row[-1]) for row in rows[:2]] == [10.0, 1.0] and 1 <= float(rows[2][-1]) <= 10
     last = lines[-1].split()
     assert last[:2] == ["8", "1"] and len(last) == 5 and float(last[3]) > 0    # PPPM's Kspace time
