@@ -10,6 +10,8 @@ import time
 from dataclasses import replace
 from typing import Callable
 
+from sediment.folders import JOURNAL, settle
+
 from case_folders import RERUNS, SLOW, prepare, quick_command
 from cases import Ctx, add
 from harness import LONG, PSD, FullDisk, can_mount, crashed, csvs, diff, finish, has, must, refusal, sed, start, tree
@@ -56,6 +58,9 @@ def signalled(writer: str, sig: int, phase: str, at) -> Callable:
             proc.send_signal(sig)
         done = as_the_shell_sees(finish(proc, 60, t0), sig)
         time.sleep(0.3 if sig != signal.SIGKILL else 6.0)
+        journaled = sig == signal.SIGKILL and (out / JOURNAL).exists()
+        if journaled:    # killed while moving its files: the next command to lock the folder completes it first
+            settle(out)
         got = csvs(out)
         clean = ctx.tmp / "clean"
         sed(*[clean if x == out else x for x in args + change], timeout=300)
@@ -90,6 +95,7 @@ def signalled(writer: str, sig: int, phase: str, at) -> Callable:
         if csvs(out) != new:
             return "wrong", "the command again after the signal gives another result: " + diff(new, csvs(out))
         state = "finished first" if finished else f"exit {done.rc}" + (
+            " (killed while it moved its files: the journal completed the new set)" if journaled else "") + (
             " (the signal came in the interpreter's start-up, before sediment's first line: Python's default)"
             if early else "")
         return "ok", f"{state}; the folder {'the earlier set' if got == old and old != new else 'whole'}"
@@ -138,7 +144,7 @@ def budget_signal(sig: int, at: float) -> Callable:
             time.sleep(0.01)
         finished = proc.poll() is not None
         proc.send_signal(sig)
-        done = finish(proc, 60, t0)
+        done = as_the_shell_sees(finish(proc, 60, t0), sig)
         time.sleep(0.5 if sig != signal.SIGKILL else 6.5)
         if finished:
             return "crash" if crashed(done) else "wrong", f"ended by itself before the signal: exit {done.rc} {done.last}"
@@ -190,7 +196,7 @@ def run_signal(sig: int, phase: str) -> Callable:
         finished = proc.poll() is not None
         if not finished:
             proc.send_signal(sig)
-        done = finish(proc, 60, t0)
+        done = as_the_shell_sees(finish(proc, 60, t0), sig)
         time.sleep(0.3 if sig != signal.SIGKILL else 6.0)
         if sig != signal.SIGKILL:
             bad = crashed(done)
