@@ -486,7 +486,7 @@ def test_lammps_lines_reach_a_pipe_as_they_are_printed(tmp_path):
 @pytest.mark.parametrize("deck", ["refused", "finished"])
 def test_mpi_components_stay_mapped_through_mpi_finalize(tmp_path, deck):
     """Open MPI 4.1's singleton unloads its PMIx component in MPI_Finalize before it stops the progress thread
-    that may still call into it: about once in 2000 runs under load, the thread jumped into unmapped code
+    that may still call into it: once in thousands of runs under load, the thread jumped into unmapped code
     (SIGSEGV; a core showed it). lmp_sediment pins the components of Open MPI and PMIx first, on both ways
     out: LAMMPS's own MPI_Finalize inside error->all (Debian's 2021 build) and the driver's."""
     from sediment.sim.paths import lmp_executable
