@@ -454,6 +454,7 @@ void DragBlock::step(double dt, BatchMath kind)
 template <class Atom>
 [[gnu::always_inline]] inline void DragBlock::add_spheres(Atom atom, int count, double ftm2v,
                                                            const double (*__restrict v)[3],
+                                                           const double (*__restrict flow)[3],
                                                            const double (*__restrict force)[3],
                                                            const double *__restrict radius,
                                                            const double *__restrict mass,
@@ -465,7 +466,12 @@ template <class Atom>
     const double a[3] = {force[i][0] * inverse_mass, force[i][1] * inverse_mass, force[i][2] * inverse_mass};
     DragScale scale;
     if (fraction) scale.voidage = voidage_of(fraction[i], max_fraction);
-    set_for_one_piece(n, {model_, 2.0 * radius[i], scale}, inverse_mass, a, v[i]);
+    if (flow) {
+      const double slip[3] = {v[i][0] - flow[i][0], v[i][1] - flow[i][1], v[i][2] - flow[i][2]};
+      set_for_one_piece(n, {model_, 2.0 * radius[i], scale}, inverse_mass, a, slip);
+    } else {
+      set_for_one_piece(n, {model_, 2.0 * radius[i], scale}, inverse_mass, a, v[i]);
+    }
     inverse_mass_[n] = inverse_mass;
   }
   size_ = count;
@@ -474,8 +480,9 @@ template <class Atom>
 // step_spheres' stores: velocity(), displacement() and pack_weights(correction(), 1 / m) of each
 // sphere, and its rotation's kick.
 template <class Atom>
-[[gnu::always_inline]] inline double DragBlock::finish_spheres(Atom atom, HalfKick kick,
+[[gnu::always_inline]] inline double DragBlock::finish_spheres(Atom atom, HalfKick kick, double dt,
                                                                 double (*__restrict x)[3], double (*__restrict v)[3],
+                                                                const double (*__restrict flow)[3],
                                                                 double (*__restrict omega)[3],
                                                                 const double (*__restrict torque)[3],
                                                                 const double *__restrict radius,
@@ -488,6 +495,11 @@ template <class Atom>
     double new_x[3], new_v[3];
     displacement(n, new_x);
     velocity(n, new_v);
+    if (flow)    // back from the sphere's fluid's frame
+      for (int k = 0; k < 3; ++k) {
+        new_v[k] += flow[i][k];
+        new_x[k] += flow[i][k] * dt;
+      }
     for (int k = 0; k < 3; ++k) {
       new_x[k] += x[i][k];
       x[i][k] = new_x[k];
@@ -513,10 +525,11 @@ template <class Atom>
 [[gnu::always_inline]] inline double DragBlock::step_spheres_of(const SphereRows &rows, Atom atom, int count,
                                                                  const HalfKick &kick, double dt, BatchMath kind)
 {
-  add_spheres(atom, count, kick.ftm2v, rows.v, rows.force, rows.radius, rows.mass, rows.fraction, rows.max_fraction);
+  add_spheres(atom, count, kick.ftm2v, rows.v, rows.flow, rows.force, rows.radius, rows.mass, rows.fraction,
+              rows.max_fraction);
   step(dt, kind);
-  const double state =
-      finish_spheres(atom, kick, rows.x, rows.v, rows.omega, rows.torque, rows.radius, rows.mass, rows.weights);
+  const double state = finish_spheres(atom, kick, dt, rows.x, rows.v, rows.flow, rows.omega, rows.torque, rows.radius,
+                                      rows.mass, rows.weights);
   clear();
   return state;
 }
@@ -545,6 +558,7 @@ double DragBlock::step_spheres(const SphereRows &rows, const int *atoms, int cou
                                BatchMath kind)
 {
   assert(size_ == 0 && count > 0 && count <= capacity && model_->smooth());
+  assert(!rows.flow || (u_[0] == 0.0 && u_[1] == 0.0 && u_[2] == 0.0));
   if (kind == BatchMath::AVX512 && batch_math_available(kind))
     return step_spheres_avx512(rows, atoms, count, kick, dt);
   if (kind == BatchMath::AVX2 && batch_math_available(kind)) return step_spheres_avx2(rows, atoms, count, kick, dt);

@@ -43,9 +43,12 @@ class FixFluid : public Fix {
   const double *velocity() const { return flow; }
   // The fluid velocity at local atom i: the uniform one, or where a fix fluid/flow gives the fluid its
   // own velocity, the one it solved for atom i (the styles' general per-atom paths read this; their
-  // uniform paths, taken only without a fix fluid/flow, read velocity()).
+  // uniform paths read velocity(), and atom_velocities() where there is a fix fluid/flow).
   const double *velocity_at(int i) const { return atom_flow ? (*atom_flow)[i] : flow; }
   bool has_atom_flow() const { return atom_flow != nullptr; }
+  // The fix fluid/flow's per-atom velocity rows, or nullptr: read once for a loop over the atoms (the
+  // rows move when the atom arrays grow).
+  double **atom_velocities() const { return atom_flow ? *atom_flow : nullptr; }
   // Whether every sphere is wholly immersed (no free surface, no region).
   bool fills_space() const { return !has_surface && !region_id; }
 

@@ -179,9 +179,14 @@ double FixFluidDrag::rotation_rate(int i, const sediment::SphereDrag &drag) cons
                                       drag.scale.wetted);
 }
 
+bool FixFluidDrag::immersed_everywhere() const
+{
+  return fluid->fills_space() && !rotation;
+}
+
 bool FixFluidDrag::uniform() const
 {
-  return fluid->fills_space() && !rotation && !fluid->has_atom_flow();
+  return immersed_everywhere() && !fluid->has_atom_flow();
 }
 
 template <class Visit> void FixFluidDrag::for_each_explicit(Visit visit)

@@ -43,9 +43,12 @@ class FixFluidDrag : public Fix {
   bool fraction_capped(int i) const { return immersed().capped(i); }
   // Linear rate of the rotational drag torque, torque = -rate * I * omega (0 if off).
   double rotation_rate(int i, const sediment::SphereDrag &drag) const;
-  // True when every atom of the group is wholly immersed (a fluid without surface or region), has
-  // no rotational drag and the fluid's velocity is uniform (no fix fluid/flow): then immersed_drag(i) is sphere_drag(i) for the atoms of the group, and
-  // an integrator may skip the per-atom region, surface and rotation look-ups.
+  // True when every atom of the group is wholly immersed (a fluid without surface or region) and has
+  // no rotational drag: then immersed_drag(i) is sphere_drag(i) for the atoms of the group, and an
+  // integrator may skip the per-atom region, surface and rotation look-ups (the fluid's velocity
+  // may still be per atom: fix fluid/flow).
+  bool immersed_everywhere() const;
+  // immersed_everywhere(), with the fluid's velocity uniform (no fix fluid/flow).
   bool uniform() const;
   // True when the drag of a wholly immersed sphere is not linear in the slip (any law but Stokes in a
   // Newtonian fluid).

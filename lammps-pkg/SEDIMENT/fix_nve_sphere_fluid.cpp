@@ -151,13 +151,7 @@ void FixNVESphereFluid::setup(int /*vflag*/)
 {
   if (floor_axis >= 0) check_floor();
   // After every fix's init(): the drag fixes know their fluid only then.
-  uniform = drags.size() == 1 && drags.front()->uniform() ? drags.front() : nullptr;
-  // Linear only with a uniform drag: its spheres are wholly immersed, so F = c d w.
-  linear_per_diameter = uniform ? uniform->linear_per_diameter() : 0.0;
-  if (linear_per_diameter > 0.0)
-    half_step = floor_axis < 0 ? HalfStep::Linear : HalfStep::LinearOnFloor;
-  else
-    half_step = HalfStep::General;
+  uniform = drags.size() == 1 && drags.front()->immersed_everywhere() ? drags.front() : nullptr;
   bool nonlinear = false, set_valued = false;
   atom_flow = false;
   for (FixFluidDrag *drag : drags) {
@@ -165,6 +159,13 @@ void FixNVESphereFluid::setup(int /*vflag*/)
     set_valued |= !drag->drag_model()->smooth();
     atom_flow |= drag->fluid_fix()->has_atom_flow();
   }
+  // Linear only with a uniform drag in a fluid of one velocity: its spheres are wholly immersed, so
+  // F = c d w, and the second half may take the weights anew from the diameter.
+  linear_per_diameter = uniform && !atom_flow ? uniform->linear_per_diameter() : 0.0;
+  if (linear_per_diameter > 0.0)
+    half_step = floor_axis < 0 ? HalfStep::Linear : HalfStep::LinearOnFloor;
+  else
+    half_step = HalfStep::General;
   // A block steps its spheres in one flow; with a fix fluid/flow each sphere has its own, and joins
   // the block in its fluid's frame (the drag sees only the slip: first_half).
   if (nonlinear) half_step = set_valued ? HalfStep::Blocked : HalfStep::Smooth;
@@ -414,10 +415,13 @@ template <bool on_floor> void FixNVESphereFluid::first_half_immersed()
 {
   const auto [x, v, f, omega, torque, radius, rmass, mask, nlocal] = sphere_arrays(atom);
   const FixFluidDrag::Immersed immersed = uniform->immersed();
+  // A fix fluid/flow's velocity per sphere, or the fluid's own for all (the block's).
+  double **flow_rows = uniform->fluid_fix()->atom_velocities();
   const sediment::SphereRows rows{x, v, omega, f, torque, radius, rmass, immersed.fraction,
-                                  immersed.max_fraction, flat_rows<NWEIGHTS>(weights)};
+                                  immersed.max_fraction, flat_rows<NWEIGHTS>(weights), flat_rows<3>(flow_rows)};
   const int drag_bit = uniform->groupbit;
-  const double *flow = uniform->fluid_fix()->velocity();
+  static const double no_flow[3] = {0.0, 0.0, 0.0};
+  const double *flow = flow_rows ? no_flow : uniform->fluid_fix()->velocity();
   const int floor_dim = floor_axis;
   const double floor_at = floor_level;
   const double dt = update->dt;
@@ -447,7 +451,7 @@ template <bool on_floor> void FixNVESphereFluid::first_half_immersed()
       continue;
     }
     if (immersed.capped(i)) ++capped;
-    if (on_floor && rests_on_floor(x[i], v[i], f[i], radius[i], flow, floor_dim, floor_at)) {
+    if (on_floor && rests_on_floor(x[i], v[i], f[i], radius[i], flow_rows ? flow_rows[i] : flow, floor_dim, floor_at)) {
       state += hold_on_floor(weights[i], x[i], v[i], omega[i], radius[i], floor_dim, floor_at);
       continue;
     }
@@ -526,10 +530,11 @@ void FixNVESphereFluid::initial_integrate(int /*vflag*/)
       return;
     }
     const FixFluidDrag::Immersed immersed = drag->immersed();
+    double **flow_rows = drag->fluid_fix()->atom_velocities();
     step_first_half<true>([=](int i, sediment::SphereDrag &sphere, const double *&u, double &) {
       if (!(mask[i] & drag_bit)) return;
       sphere = immersed.drag(i);
-      u = flow;
+      u = flow_rows ? flow_rows[i] : flow;
       if (immersed.capped(i)) counts[CAPPED] += 1.0;
     });
     return;

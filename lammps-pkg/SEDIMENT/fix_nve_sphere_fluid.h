@@ -71,16 +71,17 @@ class FixNVESphereFluid : public Fix {
   static const std::array<PerAtomArray, 4> per_atom_arrays;
   static int doubles_per_atom();
   std::vector<class FixFluidDrag *> drags;
-  // Set in setup() when there is one fluid/drag and it is uniform() (every atom of its group wholly
-  // immersed, no rotational drag): the step then skips the per-atom region and surface look-ups, and
-  // the atoms in a fluid are those of the drag fix's group.
+  // Set in setup() when there is one fluid/drag and it is immersed_everywhere() (every atom of its
+  // group wholly immersed, no rotational drag): the step then skips the per-atom region and surface
+  // look-ups, and the atoms in a fluid are those of the drag fix's group. Its fluid's velocity is
+  // uniform, or per atom with a fix fluid/flow (atom_flow).
   class FixFluidDrag *uniform;
   // How the first half steps the spheres in a fluid, decided in setup(): General (linear laws, one
   // sphere at a time), Blocked (some fluid/drag has a nonlinear law: its spheres are stepped in
   // blocks, sediment::DragBlock), Smooth (Blocked, with every law smooth: no block prepares a step in
-  // pieces, and no sphere is asked whether it needs one), LinearOnFloor (the uniform drag is linear in
-  // the slip, F = c d w: c is taken once per run, and the step is sediment::linear_step_initial with
-  // no per-sphere choice of law) or Linear (LinearOnFloor without a floor: the weights then depend on
+  // pieces, and no sphere is asked whether it needs one), LinearOnFloor (the uniform drag, in a fluid
+  // of one velocity, is linear in the slip, F = c d w: c is taken once per run, and the step is
+  // sediment::linear_step_initial with no per-sphere choice of law) or Linear (LinearOnFloor without a floor: the weights then depend on
   // the sphere's diameter and mass only, and the second half takes them anew, with fix nve/sphere's
   // two divisions, instead of from the weights row, which is neither written nor read).
   enum class HalfStep { General, Blocked, Smooth, LinearOnFloor, Linear };

@@ -277,7 +277,8 @@ struct Atoms {
   std::vector<std::array<double, 3>> x, v, omega, force, torque;
   std::vector<double> radius, mass, fraction;
   std::vector<std::array<double, PACKED_WEIGHTS_SIZE>> weights;
-  SphereRows rows(bool hindered)
+  std::vector<std::array<double, 3>> flow;    // each sphere's fluid velocity (a fix fluid/flow's)
+  SphereRows rows(bool hindered, bool with_flow = false)
   {
     return {reinterpret_cast<double(*)[3]>(x.data()),
             reinterpret_cast<double(*)[3]>(v.data()),
@@ -288,7 +289,8 @@ struct Atoms {
             mass.data(),
             hindered ? fraction.data() : nullptr,
             0.55,
-            reinterpret_cast<double(*)[PACKED_WEIGHTS_SIZE]>(weights.data())};
+            reinterpret_cast<double(*)[PACKED_WEIGHTS_SIZE]>(weights.data()),
+            with_flow ? reinterpret_cast<const double(*)[3]>(flow.data()) : nullptr};
   }
 };
 
@@ -310,6 +312,7 @@ Atoms some_atoms(int n)
     atoms.torque.push_back({1e-3 * weight * d, -2e-3 * weight * d * std::cos(t), 0.0});
     atoms.fraction.push_back(std::array<double, 4>{0.0, 0.1, 0.3, 0.7}[i % 4]);
     atoms.weights.push_back({0.0, 0.0, 0.0, 0.0});
+    atoms.flow.push_back({2e-4 * std::cos(2 * t), 0.0, (i % 3 == 1) ? -1e-3 : 5e-4 * std::sin(t)});
   }
   return atoms;
 }
@@ -332,7 +335,9 @@ TEST(DragBlock, StepSpheresIsTheBlockStepThenTheRotationKick)
   // step_spheres takes LAMMPS's rows itself: bit for bit the step that add_smooth and step give each
   // sphere (1 / m, a_n and the voidage as fix nve/sphere/fluid takes them), then fix nve/sphere's kick of
   // its rotation and the weights packed per unit mass. For atoms one after the other (the vector
-  // loads and stores) and atoms with gaps between them, under three laws, on every kind.
+  // loads and stores) and atoms with gaps between them, under three laws, on every kind; and with a
+  // fluid velocity per sphere (rows.flow), each stepped in its fluid's frame as fix nve/sphere/fluid's
+  // general step does: its slip added, its velocity and displacement taken back with the flow's.
   const Fluid fluid{998.2, 1.002e-3, 0.0};
   const double dt = 1e-4, ftm2v = 1.0;
   const HalfKick kick = half_kick(dt, ftm2v);
@@ -342,8 +347,10 @@ TEST(DragBlock, StepSpheresIsTheBlockStepThenTheRotationKick)
     const bool hindered = law == DragLaw::DiFelice;
     for (const BatchMath kind : batch_math_kinds) {
       if (!batch_math_available(kind)) continue;
-      for (const int gap : {1, 3}) {    // every atom, or every third
-        SCOPED_TRACE(testing::Message() << drag_law_name(law) << " " << batch_math_name(kind) << " gap " << gap);
+      for (const auto [gap, with_flow] : {std::pair{1, false}, {3, false}, {1, true}, {3, true}}) {
+        // every atom, or every third
+        SCOPED_TRACE(testing::Message() << drag_law_name(law) << " " << batch_math_name(kind) << " gap " << gap
+                                        << (with_flow ? " with flow" : ""));
         Atoms expected = some_atoms(n), stepped = some_atoms(n);
         std::vector<int> chosen;
         for (int i = 1; i < n; i += gap) chosen.push_back(i);
@@ -359,7 +366,10 @@ TEST(DragBlock, StepSpheresIsTheBlockStepThenTheRotationKick)
                                  expected.force[i][2] * per_mass};
             DragScale scale;
             if (hindered) scale.voidage = voidage_of(expected.fraction[i], 0.55);
-            block.add_smooth({&model, 2.0 * expected.radius[i], scale}, per_mass, a, expected.v[i].data());
+            double slip[3];
+            for (int k = 0; k < 3; ++k) slip[k] = expected.v[i][k] - (with_flow ? expected.flow[i][k] : 0.0);
+            block.add_smooth({&model, 2.0 * expected.radius[i], scale}, per_mass, a,
+                             with_flow ? slip : expected.v[i].data());
           }
           block.step(dt, kind);
           for (int m = 0; m < count; ++m) {
@@ -367,6 +377,11 @@ TEST(DragBlock, StepSpheresIsTheBlockStepThenTheRotationKick)
             double dx[3];
             block.velocity(m, expected.v[i].data());
             block.displacement(m, dx);
+            if (with_flow)
+              for (int k = 0; k < 3; ++k) {
+                expected.v[i][k] += expected.flow[i][k];
+                dx[k] += expected.flow[i][k] * dt;
+              }
             for (int k = 0; k < 3; ++k) expected.x[i][k] += dx[k];
             expected_state += state_sum(expected.x[i].data(), expected.v[i].data());
             const double spin = spin_weight(kick, expected.radius[i], expected.mass[i]);
@@ -374,7 +389,8 @@ TEST(DragBlock, StepSpheresIsTheBlockStepThenTheRotationKick)
             pack_weights(block.correction(m), ftm2v / expected.mass[i], expected.weights[i].data());
           }
           block.clear();
-          state += block.step_spheres(stepped.rows(hindered), chosen.data() + start, count, kick, dt, kind);
+          state += block.step_spheres(stepped.rows(hindered, with_flow), chosen.data() + start, count, kick, dt,
+                                      kind);
           EXPECT_EQ(block.size(), 0);
         }
         expect_same_atoms(stepped, expected);

@@ -115,6 +115,9 @@ struct SphereRows {
   const double *fraction;    // the local solid fraction of a hindrance, or nullptr (clear fluid)
   double max_fraction;       // where the fraction is capped (voidage_of)
   double (*weights)[PACKED_WEIGHTS_SIZE];    // written: each sphere's packed weights per unit mass
+  // Each sphere's own fluid velocity (a fix fluid/flow's), held over the step, or nullptr: the block's
+  // (set_law). With it, a sphere is stepped in its fluid's frame, where the block's velocity is zero.
+  const double (*flow)[3] = nullptr;
 };
 
 // The slip's exact advance over t under ds/dt = c - k s from s0, given p = phis(k t).
@@ -201,7 +204,8 @@ class DragBlock {
   // with the block empty and its law smooth: each wholly immersed, of diameter 2 radius, its
   // acceleration force ftm2v / mass. Its drag step as add_smooth, step and velocity, displacement
   // and correction give it, then fix nve/sphere's kick of its rotation (spin_weight), bit for bit:
-  // x and v advanced, omega kicked, its weights packed per unit mass into rows.weights. Leaves the
+  // x and v advanced, omega kicked, its weights packed per unit mass into rows.weights; with rows.flow
+  // (the block's velocity then zero), in the frame of each sphere's fluid, as above. Leaves the
   // block empty; returns the sum of the spheres' new state_sums (a check of a finite state).
   // Loops over the block's spheres in vectors of the kind's width, as the stages: consecutive atoms
   // (the common case) as rows one after the other.
@@ -243,11 +247,12 @@ class DragBlock {
   }
   // step_spheres in parts: its loads and stores over atoms atom(n), and the whole for an instruction set.
   template <class Atom>
-  void add_spheres(Atom atom, int count, double ftm2v, const double (*v)[3], const double (*force)[3],
-                   const double *radius, const double *mass, const double *fraction, double max_fraction);
+  void add_spheres(Atom atom, int count, double ftm2v, const double (*v)[3], const double (*flow)[3],
+                   const double (*force)[3], const double *radius, const double *mass, const double *fraction,
+                   double max_fraction);
   template <class Atom>
-  double finish_spheres(Atom atom, HalfKick kick, double (*x)[3], double (*v)[3], double (*omega)[3],
-                        const double (*torque)[3], const double *radius, const double *mass,
+  double finish_spheres(Atom atom, HalfKick kick, double dt, double (*x)[3], double (*v)[3], const double (*flow)[3],
+                        double (*omega)[3], const double (*torque)[3], const double *radius, const double *mass,
                         double (*weights)[PACKED_WEIGHTS_SIZE]) const;
   template <class Atom>
   double step_spheres_of(const SphereRows &rows, Atom atom, int count, const HalfKick &kick, double dt, BatchMath kind);
