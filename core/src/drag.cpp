@@ -4,6 +4,7 @@
 #include "sediment/geometry.hpp"
 
 #include <algorithm>
+#include <cassert>
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -201,6 +202,21 @@ double DragModel::force(double d, double speed, DragScale scale) const
   const double re = reynolds(d, speed);
   const DragCurve g = curve(re, scale.voidage);
   return force_at(d, speed, g.g, yield_part(re, g).g, scale);
+}
+
+void DragModel::drags_per_speed(const double *d, const double *speed, const double *voidage, double *out, int n,
+                                BatchMath kind) const
+{
+  assert(fluid_.yield_stress <= 0.0);
+  constexpr int chunk = 64;
+  double re[chunk];
+  DragCurve g[chunk];
+  for (int start = 0; start < n; start += chunk) {
+    const int m = std::min(n - start, chunk);
+    for (int j = 0; j < m; ++j) re[j] = smooth_reynolds_per_speed(d[start + j]) * speed[start + j];
+    curves(re, voidage + start, g, m, kind);
+    for (int j = 0; j < m; ++j) out[start + j] = smooth_drag_per_speed(d[start + j], {}) * g[j].g;
+  }
 }
 
 double DragModel::static_force(double d, DragScale scale) const

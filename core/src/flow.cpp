@@ -88,8 +88,8 @@ double gaussian_self_mobility(double viscosity, double sigma)
 
 double hard_sphere_structure_factor(double phi)
 {
-  const double p2 = phi * phi;
-  return std::pow(1.0 - phi, 4) / (1.0 + 4.0 * phi + 4.0 * p2 - 4.0 * p2 * phi + p2 * p2);
+  const double p2 = phi * phi, q = 1.0 - phi, q2 = q * q;
+  return q2 * q2 / (1.0 + 4.0 * phi + 4.0 * p2 - 4.0 * p2 * phi + p2 * p2);
 }
 
 double cloud_speed(double us, int n, double a, double r)

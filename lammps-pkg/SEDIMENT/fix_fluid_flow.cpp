@@ -36,6 +36,7 @@ using namespace FixConst;
 
 static inline int wrap(int i, int n)
 {
+  if (i >= 0 && i < n) return i;    // the common case, without a division
   i %= n;
   return i < 0 ? i + n : i;
 }
@@ -266,60 +267,119 @@ double FixFluidFlow::sphere_force(int i, double *force) const
   return 0.0;
 }
 
-// The kernel's nodes around x on each axis, wrapped onto the periodic transform grid, as offsets into
-// the grid's arrays ([k][j][i][c]: 3 doubles per node), and their weights; returns the counts.
-void FixFluidFlow::kernel_nodes(const double *x, int count[3], long node[3][sediment::FlowKernel::max_nodes],
-                                double w[3][sediment::FlowKernel::max_nodes]) const
+// The forces on the fluid of the solve's spheres and their local fractions (sphere_force). Where one
+// fluid/drag holds every sphere of its group wholly immersed without a rotational drag (what fix
+// nve/sphere/fluid's block step takes too), its law gives the drags of the spheres in chunks, its
+// exponentials and logarithms in vectors (DragModel::drags_per_speed).
+void FixFluidFlow::sphere_forces()
 {
-  const int n[3] = {grid[0], grid[1], nzt};
-  const long stride[3] = {3, 3L * n[0], 3L * n[0] * n[1]};
-  for (int d = 0; d < 3; ++d) {
-    int first;
-    count[d] = kernel.weights((x[d] - origin[d]) / spacing[d] - 0.5, first, w[d]);
-    for (int m = 0; m < count[d]; ++m) node[d][m] = stride[d] * wrap(first + m, n[d]);
+  const size_t count = spheres.size();
+  forces.assign(3 * count, 0.0);
+  fractions.assign(count, 0.0);
+  FixFluidDrag *drag = drags.size() == 1 && drags.front()->immersed_everywhere() ? drags.front() : nullptr;
+  if (!drag) {
+    for (size_t s = 0; s < count; ++s) fractions[s] = sphere_force(spheres[s], &forces[3 * s]);
+    return;
   }
+  const FixFluidDrag::Immersed immersed = drag->immersed();
+  const int drag_bit = drag->groupbit;
+  const int *mask = atom->mask;
+  double **v = atom->v;
+  std::vector<double> diameter(count), speed(count), voidage(count), per_speed(count);
+  for (size_t s = 0; s < count; ++s) {
+    const int i = spheres[s];
+    const double *u = velocity[i];
+    double *w = &forces[3 * s];    // the slip, until it is multiplied by the drag per speed below
+    for (int c = 0; c < 3; ++c) w[c] = v[i][c] - u[c];
+    speed[s] = sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]);
+    const bool in_drag = mask[i] & drag_bit;    // else no drag: a diameter of 0 gives none
+    const sediment::SphereDrag sphere = immersed.drag(i);
+    diameter[s] = in_drag ? sphere.diameter : 0.0;
+    voidage[s] = sphere.scale.voidage;
+    fractions[s] = in_drag ? 1.0 - sphere.scale.voidage : 0.0;
+  }
+  if (const double linear = immersed.model->linear_coefficient(1.0); linear > 0.0)
+    for (size_t s = 0; s < count; ++s) per_speed[s] = linear * diameter[s];
+  else
+    immersed.model->drags_per_speed(diameter.data(), speed.data(), voidage.data(), per_speed.data(),
+                                    static_cast<int>(count));
+  for (size_t s = 0; s < count; ++s)
+    for (int c = 0; c < 3; ++c) forces[3 * s + c] *= per_speed[s];
 }
 
-void FixFluidFlow::spread_point(const double *x, const double *force)
+// The kernel's nodes around x on each axis, wrapped onto the periodic transform grid, and their weights.
+FixFluidFlow::Stencil FixFluidFlow::stencil_at(const double *x) const
 {
-  int count[3];
-  long node[3][sediment::FlowKernel::max_nodes];
-  double w[3][sediment::FlowKernel::max_nodes];
-  kernel_nodes(x, count, node, w);
+  constexpr int nodes = sediment::FlowKernel::max_nodes;
+  const int n[3] = {grid[0], grid[1], nzt};
+  const long stride[3] = {3, 3L * n[0], 3L * n[0] * n[1]};
+  Stencil at;
+  for (int d = 0; d < 3; ++d) {
+    int first;
+    kernel.weights((x[d] - origin[d]) / spacing[d] - 0.5, first, at.w[d]);
+    int m = wrap(first, n[d]);
+    for (int a = 0; a < nodes; ++a) {
+      at.node[d][a] = stride[d] * m;
+      if (++m == n[d]) m = 0;
+    }
+  }
+  return at;
+}
+
+void FixFluidFlow::spread_point(const Stencil &at, const double *force)
+{
+  constexpr int nodes = sediment::FlowKernel::max_nodes;
   const double per_volume = 1.0 / (spacing[0] * spacing[1] * spacing[2]);
   const double fx = force[0] * per_volume, fy = force[1] * per_volume, fz = force[2] * per_volume;
-  for (int c = 0; c < count[2]; ++c) {
-    for (int b = 0; b < count[1]; ++b) {
-      double *row = &spread[node[2][c] + node[1][b]];
-      const double wzy = w[2][c] * w[1][b];
-      for (int a = 0; a < count[0]; ++a) {
-        double *at = row + node[0][a];
-        const double weight = wzy * w[0][a];
-        at[0] += weight * fx;
-        at[1] += weight * fy;
-        at[2] += weight * fz;
+  for (int c = 0; c < nodes; ++c) {
+    for (int b = 0; b < nodes; ++b) {
+      double *row = &spread[at.node[2][c] + at.node[1][b]];
+      const double wzy = at.w[2][c] * at.w[1][b];
+      for (int a = 0; a < nodes; ++a) {
+        double *node = row + at.node[0][a];
+        const double weight = wzy * at.w[0][a];
+        node[0] += weight * fx;
+        node[1] += weight * fy;
+        node[2] += weight * fz;
       }
     }
   }
 }
 
-void FixFluidFlow::read_point(const double *x, double *u) const
+// The column's free-slip walls: every sphere's mirror image below the bottom (so above the top, on
+// the doubled periodic axis), whose kernel is that of the sphere reflected. Node k (at lo + (k + 1/2) h)
+// mirrors node -k - 1, plane nzt - 1 - k of the transform grid, with the force's z reversed.
+void FixFluidFlow::add_mirror_image()
 {
-  int count[3];
-  long node[3][sediment::FlowKernel::max_nodes];
-  double w[3][sediment::FlowKernel::max_nodes];
-  kernel_nodes(x, count, node, w);
+  const long plane = 3L * grid[0] * grid[1];
+  for (int k = 0; k < nzt / 2; ++k) {
+    double *a = &spread[plane * k], *b = &spread[plane * (nzt - 1 - k)];
+    for (long m = 0; m < plane; m += 3) {
+      const double ax = a[m], ay = a[m + 1], az = a[m + 2];
+      a[m] += b[m];
+      a[m + 1] += b[m + 1];
+      a[m + 2] -= b[m + 2];
+      b[m] += ax;
+      b[m + 1] += ay;
+      b[m + 2] -= az;
+    }
+  }
+}
+
+void FixFluidFlow::read_point(const Stencil &at, double *u) const
+{
+  constexpr int nodes = sediment::FlowKernel::max_nodes;
   double ux = 0.0, uy = 0.0, uz = 0.0;
-  for (int c = 0; c < count[2]; ++c) {
-    for (int b = 0; b < count[1]; ++b) {
-      const double *row = &flow[node[2][c] + node[1][b]];
-      const double wzy = w[2][c] * w[1][b];
-      for (int a = 0; a < count[0]; ++a) {
-        const double *at = row + node[0][a];
-        const double weight = wzy * w[0][a];
-        ux += weight * at[0];
-        uy += weight * at[1];
-        uz += weight * at[2];
+  for (int c = 0; c < nodes; ++c) {
+    for (int b = 0; b < nodes; ++b) {
+      const double *row = &flow[at.node[2][c] + at.node[1][b]];
+      const double wzy = at.w[2][c] * at.w[1][b];
+      for (int a = 0; a < nodes; ++a) {
+        const double *node = row + at.node[0][a];
+        const double weight = wzy * at.w[0][a];
+        ux += weight * node[0];
+        uy += weight * node[1];
+        uz += weight * node[2];
       }
     }
   }
@@ -337,14 +397,15 @@ void FixFluidFlow::measure_self_flow()
   const double at[3] = {origin[0] + 0.5 * spacing[0], origin[1] + 0.5 * spacing[1], origin[2] + 0.5 * spacing[2]};
   for (int c = 0; c < 3; ++c) {
     std::fill(spread.begin(), spread.end(), 0.0);
+    const Stencil stencil = stencil_at(at);
     if (comm->me == 0) {
       double unit[3] = {0.0, 0.0, 0.0};
       unit[c] = 1.0;
-      spread_point(at, unit);
+      spread_point(stencil, unit);
     }
     transform_solve();
     double u[3];
-    read_point(at, u);
+    read_point(stencil, u);
     self_flow[c] = u[c];
   }
 }
@@ -382,29 +443,26 @@ void FixFluidFlow::solve()
   const int nlocal = atom->nlocal;
   const int *mask = atom->mask;
   double **x = atom->x;
-  std::fill(spread.begin(), spread.end(), 0.0);
-  std::vector<double> forces(3 * static_cast<size_t>(nlocal), 0.0);
-  std::vector<double> fraction(nlocal, 0.0);
-  std::vector<char> inside(nlocal, 0);
   double local[4] = {0.0, 0.0, 0.0, 0.0};    // force on the fluid, spheres outside the column
+  spheres.clear();
   for (int i = 0; i < nlocal; ++i) {
     if (!(mask[i] & groupbit)) continue;
-    if (column && !(x[i][2] >= column_lo && x[i][2] < column_hi)) {
+    if (column && !(x[i][2] >= column_lo && x[i][2] < column_hi))
       local[3] += 1.0;
-      continue;
-    }
-    inside[i] = 1;
-    double *force = &forces[3 * i];
-    fraction[i] = sphere_force(i, force);
+    else
+      spheres.push_back(i);
+  }
+  sphere_forces();
+  std::fill(spread.begin(), spread.end(), 0.0);
+  stencils.resize(spheres.size());
+  for (size_t s = 0; s < spheres.size(); ++s) {
+    stencils[s] = stencil_at(x[spheres[s]]);
+    const double *force = &forces[3 * s];
     if (force[0] == 0.0 && force[1] == 0.0 && force[2] == 0.0) continue;
     for (int c = 0; c < 3; ++c) local[c] += force[c];
-    spread_point(x[i], force);
-    if (column) {    // the mirror image below the bottom (and so above the top): free slip at both
-      const double image[3] = {x[i][0], x[i][1], 2.0 * column_lo - x[i][2]};
-      const double image_force[3] = {force[0], force[1], -force[2]};
-      spread_point(image, image_force);
-    }
+    spread_point(stencils[s], force);
   }
+  if (column) add_mirror_image();
   double total[4];
   MPI_Allreduce(local, total, 4, MPI_DOUBLE, MPI_SUM, world);
 
@@ -432,13 +490,15 @@ void FixFluidFlow::solve()
   // kept clear of it: what the hindrance law already holds; docs/physics.md section 8).
   const double *uniform = fluid->velocity();
   double change[3] = {0.0, 0.0, 0.0};    // sums over the spheres: new . old, new . new, old . old
+  size_t s = 0;                          // the next of `spheres` (in the order of the atoms)
   for (int i = 0; i < nlocal; ++i) {
     if (!(mask[i] & groupbit)) continue;
     double u[3] = {0.0, 0.0, 0.0};
-    if (inside[i]) {
-      read_point(x[i], u);
-      const double own = sediment::hard_sphere_structure_factor(fraction[i]);
-      for (int c = 0; c < 3; ++c) u[c] -= own * self_flow[c] * forces[3 * i + c];
+    if (s < spheres.size() && spheres[s] == i) {
+      read_point(stencils[s], u);
+      const double own = sediment::hard_sphere_structure_factor(fractions[s]);
+      for (int c = 0; c < 3; ++c) u[c] -= own * self_flow[c] * forces[3 * s + c];
+      ++s;
     }
     for (int c = 0; c < 3; ++c) {
       const double target = uniform[c] + u[c];

@@ -86,15 +86,28 @@ class FixFluidFlow : public Fix {
 
   int reversals;             // solves in a row whose fluid velocities reversed and grew (check_stable)
   double reversal_growth;    // and how much the squared velocities grew over them
+  // A point's kernel on the transform grid: per axis, its nodes as offsets into the grid's arrays
+  // ([k][j][i][c]: 3 doubles per node, wrapped onto the periodic grid) and their weights.
+  struct Stencil {
+    long node[3][sediment::FlowKernel::max_nodes];
+    double w[3][sediment::FlowKernel::max_nodes];
+  };
+  // Each solve's spheres in the fluid (local indices, increasing), their kernels, their forces on the
+  // fluid (3 per sphere) and the local solid fractions their hindrance reads (0 without one).
+  std::vector<int> spheres;
+  std::vector<Stencil> stencils;
+  std::vector<double> forces, fractions;
+
   void solve();
   double largest_speed() const;
   void check_stable(const double *change);
   void transform_solve();
   void measure_self_flow();
-  void kernel_nodes(const double *x, int count[3], long node[3][sediment::FlowKernel::max_nodes],
-                    double w[3][sediment::FlowKernel::max_nodes]) const;
-  void spread_point(const double *x, const double *force);
-  void read_point(const double *x, double *u) const;
+  Stencil stencil_at(const double *x) const;
+  void spread_point(const Stencil &at, const double *force);
+  void read_point(const Stencil &at, double *u) const;
+  void add_mirror_image();
+  void sphere_forces();
   double sphere_force(int i, double *force) const;
 };
 

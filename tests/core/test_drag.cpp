@@ -1,13 +1,16 @@
 // SPDX-License-Identifier: GPL-2.0-or-later
 // Drag laws against their closed forms (docs/physics.md sections 2 and 4).
+#include "sediment/batch_math.hpp"
 #include "sediment/drag.hpp"
 #include "sediment/geometry.hpp"
 #include "sediment/terminal.hpp"
 
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <memory>
+#include <vector>
 
 using namespace sediment;
 
@@ -455,6 +458,39 @@ TEST(Hindrance, ContinuousWhereTheSuspensionClears)
         const DragCurve clear = model.curve(re, 1.0), almost = model.curve(re, 1.0 - 1e-12);
         EXPECT_NEAR(almost.g, clear.g, 1e-10 * clear.g) << hindrance_name(hindrance) << " " << re;
         EXPECT_NEAR(almost.re_dg, clear.re_dg, 1e-10 * clear.g) << hindrance_name(hindrance) << " " << re;
+      }
+    }
+}
+
+TEST(DragLaw, DragsPerSpeedOfManySpheresAreEachSpheresForceOverItsSpeed)
+{
+  // fix fluid/flow's force on the fluid: F(s) / s of many spheres at once (their hindrance's
+  // exponentials in vectors), against force() / s one by one, and at s = 0 its limit, the tangent.
+  // Every Newtonian law with every hindrance it takes, on every kind of vector maths.
+  std::vector<double> d, speed, voidage;
+  for (int k = 0; k < 150; ++k) {    // more than one chunk of 64
+    d.push_back(std::array<double, 3>{2e-6, 6e-5, 2e-3}[k % 3]);
+    speed.push_back(k % 7 == 0 ? 0.0 : 1e-5 * std::pow(1.2, k % 60));
+    voidage.push_back(std::array<double, 4>{1.0, 0.97, 0.8, 0.55}[k % 4]);
+  }
+  const int n = static_cast<int>(d.size());
+  for (auto law : {DragLaw::Stokes, DragLaw::SchillerNaumann, DragLaw::Dallavalle, DragLaw::Standard,
+                   DragLaw::DiFelice, DragLaw::ZhangLiSmooth, DragLaw::Bingham})
+    for (auto hindrance : {Hindrance::None, Hindrance::DiFelice, Hindrance::RichardsonZaki, Hindrance::Garside}) {
+      if (!law_takes_hindrance(law, hindrance)) continue;
+      const DragModel model(law, water, HindranceBuoyancy::Plain, hindrance);
+      for (const BatchMath kind : batch_math_kinds) {
+        if (!batch_math_available(kind)) continue;
+        std::vector<double> per_speed(n);
+        model.drags_per_speed(d.data(), speed.data(), voidage.data(), per_speed.data(), n, kind);
+        for (int k = 0; k < n; ++k) {
+          const DragScale scale{1.0, 1.0, voidage[k]};
+          const double expected = speed[k] > 0.0 ? model.force(d[k], speed[k], scale) / speed[k]
+                                                 : model.tangent(d[k], 0.0, scale);
+          EXPECT_NEAR(per_speed[k], expected, 1e-12 * expected)
+              << drag_law_name(law) << " " << static_cast<int>(hindrance) << " " << batch_math_name(kind) << " d "
+              << d[k] << " s " << speed[k] << " voidage " << voidage[k];
+        }
       }
     }
 }

@@ -586,6 +586,12 @@ class DragModel {
     if (law_ != DragLaw::Stokes || fluid_.yield_stress > 0.0 || hindrance_ != Hindrance::None) return 0.0;
     return scale.area * 3.0 * pi * fluid_.viscosity * d;
   }
+  // F(s) / s of n wholly immersed spheres in a Newtonian fluid (no yield stress), diameters d, slip
+  // speeds s >= 0 and voidages of the hindrance, from curves() in chunks: within a few ulp of
+  // force(d, s, scale) / s with scale.voidage (its limit at s = 0). Any law, jumps of Cd included: a
+  // sphere's own drag, not a step across them.
+  void drags_per_speed(const double *d, const double *speed, const double *voidage, double *out, int n,
+                       BatchMath kind = batch_math_kind()) const;
   // Jumps of F in increasing speed; returns how many were written.
   int jumps(double d, std::array<ForceJump, max_jumps> &out, DragScale scale = {}) const;
 
