@@ -69,18 +69,6 @@ void stokes_apply_brick(const StokesOperator &op, const int n[3], const double l
   }
 }
 
-int FlowKernel::weights(double position, int &first, double *w) const
-{
-  const double below = std::floor(position);
-  const double t = position - below, u = 1.0 - t;
-  first = static_cast<int>(below) - 1;
-  w[0] = u * u * u / 6.0;
-  w[1] = (3.0 * t * t * t - 6.0 * t * t + 4.0) / 6.0;
-  w[2] = (3.0 * u * u * u - 6.0 * u * u + 4.0) / 6.0;
-  w[3] = t * t * t / 6.0;
-  return max_nodes;
-}
-
 double gaussian_self_mobility(double viscosity, double sigma)
 {
   return 1.0 / (6.0 * pi * viscosity * sigma * std::sqrt(pi));

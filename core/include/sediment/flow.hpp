@@ -6,6 +6,8 @@
 // fluid/flow, a plain DFT in the tests) and calls these per mode and per sphere.
 #pragma once
 
+#include <cmath>
+
 namespace sediment {
 
 // Whether n is a grid size the FFTs take: n >= 1 with no prime factor other than 2, 3 and 5 (LAMMPS's
@@ -50,7 +52,18 @@ struct FlowKernel {
   double width = 1.0;                    // the whole kernel's standard deviation, in cells (>= 1)
   // Nodes first, ..., first + 3 (unwrapped: the caller wraps them onto a periodic axis) and their
   // weights for a point at `position` (in grid spacings); returns their count, 4.
-  int weights(double position, int &first, double *w) const;
+  // Inline: fix fluid/flow takes them for every sphere and axis at each solve.
+  int weights(double position, int &first, double *w) const
+  {
+    const double below = std::floor(position);
+    const double t = position - below, u = 1.0 - t;
+    first = static_cast<int>(below) - 1;
+    w[0] = u * u * u / 6.0;
+    w[1] = (3.0 * t * t * t - 6.0 * t * t + 4.0) / 6.0;
+    w[2] = (3.0 * u * u * u - 6.0 * u * u + 4.0) / 6.0;
+    w[3] = t * t * t / 6.0;
+    return max_nodes;
+  }
   int max_count() const { return max_nodes; }
   // The variance left to the Fourier-space Gaussian, in cells squared: width^2 - 1/3.
   double fourier_variance() const { return width * width - 1.0 / 3.0; }
