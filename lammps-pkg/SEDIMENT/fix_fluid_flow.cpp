@@ -118,6 +118,7 @@ FixFluidFlow::FixFluidFlow(LAMMPS *lmp, int narg, char **arg) :
   global_freq = 1;
   extvector = 0;
   maxexchange = 3;
+  create_attribute = 1;
   std::fill(diag, diag + NDIAG, 0.0);
   std::fill(self_flow, self_flow + 3, 0.0);
 
@@ -394,6 +395,7 @@ void FixFluidFlow::read_point(const Stencil &at, double *u) const
 // width outgrows on coarse grids.
 void FixFluidFlow::measure_self_flow()
 {
+  std::vector<double> last = flow;    // the last solve's grid, kept for the spheres created before the next
   const double at[3] = {origin[0] + 0.5 * spacing[0], origin[1] + 0.5 * spacing[1], origin[2] + 0.5 * spacing[2]};
   for (int c = 0; c < 3; ++c) {
     std::fill(spread.begin(), spread.end(), 0.0);
@@ -408,6 +410,7 @@ void FixFluidFlow::measure_self_flow()
     read_point(stencil, u);
     self_flow[c] = u[c];
   }
+  flow = std::move(last);
 }
 
 // The flow of the force density in `spread` (summed over the ranks' copies) into `flow` (whole on
@@ -553,6 +556,20 @@ void FixFluidFlow::grow_arrays(int nmax)
 void FixFluidFlow::copy_arrays(int i, int j, int /*delflag*/)
 {
   for (int c = 0; c < 3; ++c) velocity[j][c] = velocity[i][c];
+}
+
+// A sphere created during a run (create_atoms between runs, fix deposit or pour) takes the fluid
+// velocity of the last solve where it is, until the next solve gives it its own: not the row a
+// deleted sphere left behind.
+void FixFluidFlow::set_arrays(int i)
+{
+  if (!fluid) fluid = FixFluid::find(lmp, fluid_id, "Fix fluid/flow");
+  const double *uniform = fluid->velocity();
+  double u[3] = {0.0, 0.0, 0.0};
+  const double *x = atom->x[i];
+  const bool inside = !column || (x[2] >= column_lo && x[2] < column_hi);
+  if (solved && !flow.empty() && inside) read_point(stencil_at(x), u);    // no grid yet after a restart
+  for (int c = 0; c < 3; ++c) velocity[i][c] = uniform[c] + u[c];
 }
 
 int FixFluidFlow::pack_exchange(int i, double *buf)

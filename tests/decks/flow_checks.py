@@ -254,3 +254,24 @@ def flow_ranks(np_ranks: int):
         one, two = (cloud_result(ranks, Path(tmp), n=1000, cells=32)["speed"] for ranks in (1, 2))
     report(f"cloud speed on 1 rank {one!r}, on 2 ranks {two!r}: relative difference {abs(one - two) / one:.1e}")
     assert abs(one - two) < 1e-10 * one
+
+
+@check
+def flow_new_sphere(np_ranks: int):
+    """A sphere created between runs (as by create_atoms, fix deposit or pour) takes the fluid
+    velocity of the last solve where it is: bit for bit a tracer's at that place (in the flow's group,
+    without drag or weight: it reads the grid at each solve and pushes nothing). Not the row a deleted
+    sphere left behind (a grain's, rising where the fluid sinks), nor the unit force's flow a run's init
+    leaves on the grid when it measures the kernel's self-flow."""
+    with tempfile.TemporaryDirectory() as tmp:
+        out = run_deck("flow_new_sphere.lmp", {}, np_ranks, cwd=Path(tmp))
+    line = next(line for line in out.text.splitlines() if line.startswith("RESULT "))
+    words = line.split()[1:]
+    result = {key: float(value) for key, value in zip(words[::2], words[1::2])}
+    tracer = [result[f"tracer_u{axis}"] for axis in "xyz"]
+    new = [result[f"new_u{axis}"] for axis in "xyz"]
+    report(f"new sphere's fluid velocity {new} m/s; the tracer's at the same place {tracer} (grid's largest "
+           f"{result['peak']:.2e} m/s)")
+    assert result["new_x"] == result["tracer_x"]
+    assert new == tracer
+    assert 0.1 * result["peak"] < abs(tracer[2]) <= result["peak"]    # the local flow, not the fluid at rest
