@@ -9,6 +9,10 @@ namespace sediment {
 
 namespace {
 constexpr double pi = 3.14159265358979323846;
+
+// The Nyquist index of an even axis: there k and -k are one mode, which the operator's products
+// k_x k_y would give two values; set to zero, the velocity of a real force is real.
+bool is_nyquist(int m, int n) { return n % 2 == 0 && m == n / 2; }
 }
 
 bool fft_friendly(int n)
@@ -56,8 +60,8 @@ void stokes_apply_brick(const StokesOperator &op, const int n[3], const double l
         const double k[3] = {grid_wavenumber(i, n[0], length[0]), ky, kz};
         const long at = 2L * ((static_cast<long>(kk - lo[2]) * nj + (j - lo[1])) * ni + (i - lo[0]));
         double f[6] = {fx[at], fx[at + 1], fy[at], fy[at + 1], fz[at], fz[at + 1]};
-        double u[6];
-        op.apply(k, f, u, scale);
+        double u[6] = {0.0, 0.0, 0.0, 0.0, 0.0, 0.0};
+        if (!(is_nyquist(i, n[0]) || is_nyquist(j, n[1]) || is_nyquist(kk, n[2]))) op.apply(k, f, u, scale);
         fx[at] = u[0];
         fx[at + 1] = u[1];
         fy[at] = u[2];

@@ -432,10 +432,19 @@ void FixFluidFlow::transform_solve()
   const int lo[3] = {0, 0, plane_lo}, hi[3] = {grid[0] - 1, grid[1] - 1, plane_hi};
   sediment::stokes_apply_brick(stokes, n, transform_length, lo, hi, field[0].data(), field[1].data(), field[2].data(),
                                1.0 / (static_cast<double>(n[0]) * n[1] * n[2]));
-  for (int c = 0; c < 3; ++c) {
-    double *f = field[c].data();
-    fft->compute(f, f, FFT3d::BACKWARD);
-    for (size_t m = 0; m < mine; ++m) slab[3 * m + c] = f[2 * m];
+  // The velocity is real: u_x + i u_y is the inverse transform of U_x + i U_y, so one transform
+  // brings back both (its real and imaginary parts), and u_z takes another.
+  double *xy = field[0].data(), *uy = field[1].data(), *z = field[2].data();
+  for (size_t m = 0; m < mine; ++m) {
+    xy[2 * m] -= uy[2 * m + 1];
+    xy[2 * m + 1] += uy[2 * m];
+  }
+  fft->compute(xy, xy, FFT3d::BACKWARD);
+  fft->compute(z, z, FFT3d::BACKWARD);
+  for (size_t m = 0; m < mine; ++m) {
+    slab[3 * m] = xy[2 * m];
+    slab[3 * m + 1] = xy[2 * m + 1];
+    slab[3 * m + 2] = z[2 * m];
   }
   MPI_Allgatherv(slab.data(), static_cast<int>(slab.size()), MPI_DOUBLE, flow.data(), plane_counts.data(),
                  plane_offsets.data(), MPI_DOUBLE, world);

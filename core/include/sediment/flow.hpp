@@ -34,7 +34,9 @@ struct StokesOperator {
   void apply(const double k[3], const double *f, double *u, double scale = 1.0) const;
 };
 
-// Applies the operator to a brick of a periodic grid in Fourier space, in place: three complex fields
+// Applies the operator to a brick of a periodic grid in Fourier space, in place (and sets every mode
+// at the Nyquist index of an even axis to zero: k and -k are one mode there, so the velocity of a
+// real force stays real, and the fix may bring back two of its components in one transform): three complex fields
 // (x, y, z components), each (re, im) interleaved, index ((k - klo) * nj + (j - jlo)) * ni + (i - ilo)
 // with i fastest, over [ilo, ihi] x [jlo, jhi] x [klo, khi] of the global n[0] x n[1] x n[2] grid of
 // lengths length[3]; scale as above.
