@@ -172,16 +172,15 @@ void FixFluidFlow::init()
     const int plane = 3 * grid[0] * grid[1];
     plane_counts.resize(nprocs);
     plane_offsets.resize(nprocs);
+    std::vector<int> first_plane(nprocs + 1);
+    for (int r = 0; r <= nprocs; ++r) first_plane[r] = static_cast<int>(static_cast<long>(r) * nzt / nprocs);
     for (int r = 0; r < nprocs; ++r) {
-      const int lo = static_cast<int>(static_cast<long>(r) * nzt / nprocs);
-      const int hi = static_cast<int>(static_cast<long>(r + 1) * nzt / nprocs);
-      plane_counts[r] = plane * (hi - lo);
-      plane_offsets[r] = plane * lo;
-      if (r == me) {
-        plane_lo = lo;
-        plane_hi = hi - 1;
-      }
+      plane_counts[r] = plane * (first_plane[r + 1] - first_plane[r]);
+      plane_offsets[r] = plane * first_plane[r];
     }
+    plane_lo = first_plane[me];
+    plane_hi = first_plane[me + 1] - 1;
+    plan_mirror_exchange(first_plane);
     const long nodes = static_cast<long>(grid[0]) * grid[1] * nzt;
     const long mine = static_cast<long>(grid[0]) * grid[1] * (plane_hi - plane_lo + 1);
     spread.assign(3 * nodes, 0.0);
@@ -415,18 +414,82 @@ void FixFluidFlow::measure_self_flow()
 
 // The flow of the force density in `spread` (summed over the ranks' copies) into `flow` (whole on
 // every rank).
+// Which planes go where for separate_xy: plane q of the transform lies on the rank r with
+// first_plane[r] <= q < first_plane[r + 1]. Each rank sends its planes p, in increasing order, to
+// the rank that holds nzt - p (mod nzt); a receiver lists the same planes of each sender in the
+// same order, and so knows which of its own planes each one serves.
+void FixFluidFlow::plan_mirror_exchange(const std::vector<int> &first_plane)
+{
+  const int nprocs = comm->nprocs, me = comm->me;
+  const int plane = 2 * grid[0] * grid[1];    // complex values
+  auto mirror_of = [&](int q) { return (nzt - q) % nzt; };
+  auto owner = [&](int q) {
+    return static_cast<int>(std::upper_bound(first_plane.begin(), first_plane.end(), q) - first_plane.begin()) - 1;
+  };
+  mirror_sent.clear();
+  mirror_serves.clear();
+  mirror_send_counts.assign(nprocs, 0);
+  mirror_send_offsets.assign(nprocs, 0);
+  mirror_recv_counts.assign(nprocs, 0);
+  mirror_recv_offsets.assign(nprocs, 0);
+  for (int r = 0; r < nprocs; ++r) {
+    mirror_send_offsets[r] = plane * static_cast<int>(mirror_sent.size());
+    for (int p = plane_lo; p <= plane_hi; ++p)
+      if (owner(mirror_of(p)) == r) mirror_sent.push_back(p);
+    mirror_send_counts[r] = plane * static_cast<int>(mirror_sent.size()) - mirror_send_offsets[r];
+    mirror_recv_offsets[r] = plane * static_cast<int>(mirror_serves.size());
+    for (int p = first_plane[r]; p < first_plane[r + 1]; ++p)
+      if (owner(mirror_of(p)) == me) mirror_serves.push_back(mirror_of(p));
+    mirror_recv_counts[r] = plane * static_cast<int>(mirror_serves.size()) - mirror_recv_offsets[r];
+  }
+  mirror_out.assign(static_cast<size_t>(plane) * mirror_sent.size(), 0.0);
+  mirror_in.assign(static_cast<size_t>(plane) * mirror_serves.size(), 0.0);
+}
+
+// field[0] holds Z = F_x + i F_y, the transform of f_x + i f_y (both real). Since F(-k) is the
+// conjugate of F(k) for a real f, F_x = (Z(k) + conj Z(-k)) / 2 and F_y = (Z(k) - conj Z(-k)) / 2i:
+// written into field[0] and field[1], with Z(-k) from the planes nzt - k (mod nzt), which may lie on
+// other ranks (plan_mirror_exchange).
+void FixFluidFlow::separate_xy()
+{
+  const int n0 = grid[0], n1 = grid[1];
+  const size_t plane = 2L * n0 * n1;
+  for (size_t s = 0; s < mirror_sent.size(); ++s)
+    std::copy_n(&field[0][plane * (mirror_sent[s] - plane_lo)], plane, &mirror_out[plane * s]);
+  MPI_Alltoallv(mirror_out.data(), mirror_send_counts.data(), mirror_send_offsets.data(), MPI_DOUBLE,
+                mirror_in.data(), mirror_recv_counts.data(), mirror_recv_offsets.data(), MPI_DOUBLE, world);
+  for (size_t s = 0; s < mirror_serves.size(); ++s) {
+    const double *zm = &mirror_in[plane * s];
+    double *zx = &field[0][plane * (mirror_serves[s] - plane_lo)];
+    double *zy = &field[1][plane * (mirror_serves[s] - plane_lo)];
+    for (int j = 0; j < n1; ++j)
+      for (int i = 0; i < n0; ++i) {
+        const size_t m = 2 * (static_cast<size_t>(j) * n0 + i);
+        const size_t mm = 2 * (static_cast<size_t>((n1 - j) % n1) * n0 + (n0 - i) % n0);
+        const double a = zx[m], b = zx[m + 1], c = zm[mm], d = zm[mm + 1];
+        zx[m] = 0.5 * (a + c);
+        zx[m + 1] = 0.5 * (b - d);
+        zy[m] = 0.5 * (b + d);
+        zy[m + 1] = 0.5 * (c - a);
+      }
+  }
+}
+
 void FixFluidFlow::transform_solve()
 {
   MPI_Reduce_scatter(spread.data(), slab.data(), plane_counts.data(), MPI_DOUBLE, MPI_SUM, world);
+  // f_x + i f_y in one transform and f_z in another, told apart in Fourier space (separate_xy)
   const size_t mine = slab.size() / 3;
-  for (int c = 0; c < 3; ++c) {
-    double *f = field[c].data();
-    for (size_t m = 0; m < mine; ++m) {
-      f[2 * m] = slab[3 * m + c];
-      f[2 * m + 1] = 0.0;
-    }
-    fft->compute(f, f, FFT3d::FORWARD);
+  double *xy = field[0].data(), *z = field[2].data();
+  for (size_t m = 0; m < mine; ++m) {
+    xy[2 * m] = slab[3 * m];
+    xy[2 * m + 1] = slab[3 * m + 1];
+    z[2 * m] = slab[3 * m + 2];
+    z[2 * m + 1] = 0.0;
   }
+  fft->compute(xy, xy, FFT3d::FORWARD);
+  fft->compute(z, z, FFT3d::FORWARD);
+  separate_xy();
   const int n[3] = {grid[0], grid[1], nzt};
   const double transform_length[3] = {length[0], length[1], column ? 2.0 * length[2] : length[2]};
   const int lo[3] = {0, 0, plane_lo}, hi[3] = {grid[0] - 1, grid[1] - 1, plane_hi};
@@ -434,7 +497,7 @@ void FixFluidFlow::transform_solve()
                                1.0 / (static_cast<double>(n[0]) * n[1] * n[2]));
   // The velocity is real: u_x + i u_y is the inverse transform of U_x + i U_y, so one transform
   // brings back both (its real and imaginary parts), and u_z takes another.
-  double *xy = field[0].data(), *uy = field[1].data(), *z = field[2].data();
+  const double *uy = field[1].data();
   for (size_t m = 0; m < mine; ++m) {
     xy[2 * m] -= uy[2 * m + 1];
     xy[2 * m + 1] += uy[2 * m];

@@ -79,6 +79,13 @@ class FixFluidFlow : public Fix {
   std::vector<double> slab;       // this rank's planes of it, then of the velocity
   std::vector<double> field[3];   // this rank's planes, complex (re, im), one per component
   std::vector<double> flow;       // global velocity on the grid, [k][j][i][c]
+  // The planes nzt - k (mod nzt) this rank needs for its planes k (the waves -k of its modes), to
+  // tell the transforms of f_x and f_y apart when f_x + i f_y is transformed as one: which of its
+  // own planes it sends (in order, counts and offsets per rank in doubles), and which of its
+  // planes each received one serves.
+  std::vector<int> mirror_sent, mirror_serves;
+  std::vector<int> mirror_send_counts, mirror_send_offsets, mirror_recv_counts, mirror_recv_offsets;
+  std::vector<double> mirror_out, mirror_in;
   double origin[3], spacing[3], length[3];
   double self_flow[3];    // per axis: the flow a unit force gives back where it is spread (images too)
   // Diagnostics of the last solve (compute_vector)
@@ -103,6 +110,8 @@ class FixFluidFlow : public Fix {
   double largest_speed() const;
   void check_stable(const double *change);
   void transform_solve();
+  void plan_mirror_exchange(const std::vector<int> &first_plane);
+  void separate_xy();
   void measure_self_flow();
   Stencil stencil_at(const double *x) const;
   void spread_point(const Stencil &at, const double *force);
