@@ -1,12 +1,13 @@
 // SPDX-License-Identifier: GPL-2.0-or-later
 /* ----------------------------------------------------------------------
    SEDIMENT package: fix fluid/flow
-   One solve per step, at the end of the step: every rank spreads its spheres'
-   forces onto a copy of the whole grid, a reduce-scatter sums the copies into
-   each rank's slab of planes (the FFT's layout, in = out), the slabs are
-   transformed, the Stokes operator applied mode by mode (sediment/flow.hpp),
-   transformed back, and gathered whole on every rank, which reads the velocity
-   at its spheres. Memory and communication per rank are O(grid) per step.
+   A solve at the end of a step (each step, every N, or once the spheres have
+   drifted): every rank spreads its spheres' forces onto a copy of the whole
+   grid, a reduce-scatter sums the copies into each rank's slab of planes (the
+   FFT's layout, in = out), the slabs are transformed (four FFTs: separate_xy),
+   the Stokes operator applied mode by mode (sediment/flow.hpp), transformed
+   back, and gathered whole on every rank, which reads the velocity at its
+   spheres. Memory and communication per rank are O(grid) per solve.
 ------------------------------------------------------------------------- */
 
 #include "fix_fluid_flow.h"
@@ -412,8 +413,6 @@ void FixFluidFlow::measure_self_flow()
   flow = std::move(last);
 }
 
-// The flow of the force density in `spread` (summed over the ranks' copies) into `flow` (whole on
-// every rank).
 // Which planes go where for separate_xy: plane q of the transform lies on the rank r with
 // first_plane[r] <= q < first_plane[r + 1]. Each rank sends its planes p, in increasing order, to
 // the rank that holds nzt - p (mod nzt); a receiver lists the same planes of each sender in the
@@ -475,6 +474,8 @@ void FixFluidFlow::separate_xy()
   }
 }
 
+// The flow of the force density in `spread` (summed over the ranks' copies) into `flow` (whole on
+// every rank).
 void FixFluidFlow::transform_solve()
 {
   MPI_Reduce_scatter(spread.data(), slab.data(), plane_counts.data(), MPI_DOUBLE, MPI_SUM, world);
@@ -703,6 +704,10 @@ int FixFluidFlow::maxsize_restart()
 
 double FixFluidFlow::memory_usage()
 {
-  const double grids = static_cast<double>(spread.size() + flow.size() + slab.size() + 3 * field[0].size());
-  return (3.0 * atom->nmax + grids) * sizeof(double);
+  const double grids = static_cast<double>(spread.size() + flow.size() + slab.size() + 3 * field[0].size() +
+                                           mirror_out.size() + mirror_in.size());
+  const double per_sphere = static_cast<double>(stencils.capacity()) * sizeof(Stencil) +
+      static_cast<double>(forces.capacity() + fractions.capacity()) * sizeof(double) +
+      static_cast<double>(spheres.capacity()) * sizeof(int);
+  return (3.0 * atom->nmax + grids) * sizeof(double) + per_sphere;
 }
