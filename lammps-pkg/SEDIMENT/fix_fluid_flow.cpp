@@ -51,6 +51,7 @@ FixFluidFlow::FixFluidFlow(LAMMPS *lmp, int narg, char **arg) :
     error->all(FLERR, "Fix fluid/flow: expected 'fix ID group fluid/flow FLUID-ID grid NX NY NZ keyword value ...'");
   fluid_id = utils::strdup(arg[3]);
   StyleArgs args(lmp, FLERR, "Fix fluid/flow", narg, arg, 4);
+  bool every_given = false;
   while (args.more()) {
     int nvalues = 1;
     if (args.is("grid")) {
@@ -86,6 +87,7 @@ FixFluidFlow::FixFluidFlow(LAMMPS *lmp, int narg, char **arg) :
     } else if (args.is("every")) {
       args.need(1, "a step count");
       nevery = args.count(1, 1000000);
+      every_given = true;
     } else if (args.is("drift")) {
       args.need(1, "a distance in cells");
       drift_limit = args.positive(1, "drift");
@@ -94,11 +96,14 @@ FixFluidFlow::FixFluidFlow(LAMMPS *lmp, int narg, char **arg) :
     }
     args.next(nvalues);
   }
-  if (drift_limit > 0.0 && nevery > 1)
+  if (drift_limit > 0.0 && every_given)
     error->all(FLERR, "Fix fluid/flow: give 'every N' or 'drift D', not both (drift chooses the steps between solves)");
   if (domain->dimension != 3) error->all(FLERR, "Fix fluid/flow requires a 3d simulation");
   if (!domain->xperiodic || !domain->yperiodic)
     error->all(FLERR, "Fix fluid/flow requires a box periodic in x and y (boundary p p ...)");
+  if (column && domain->zperiodic)
+    error->all(FLERR, "Fix fluid/flow: keyword 'column' closes the fluid at its bottom and top, in a box not periodic "
+               "in z (boundary p p f); this box is periodic in z");
   if (!column && !domain->zperiodic)
     error->all(FLERR, "Fix fluid/flow: a box not periodic in z needs keyword 'column ZLO ZHI' (the closed column)");
   if (!atom->radius_flag || !atom->rmass_flag)
@@ -289,15 +294,19 @@ void FixFluidFlow::sphere_forces()
   std::vector<double> diameter(count), speed(count), voidage(count), per_speed(count);
   for (size_t s = 0; s < count; ++s) {
     const int i = spheres[s];
+    if (!(mask[i] & drag_bit)) {    // no drag, no force: a diameter, slip and speed of 0, whatever its velocity
+      diameter[s] = speed[s] = 0.0;
+      voidage[s] = 1.0;
+      continue;
+    }
     const double *u = velocity[i];
     double *w = &forces[3 * s];    // the slip, until it is multiplied by the drag per speed below
     for (int c = 0; c < 3; ++c) w[c] = v[i][c] - u[c];
     speed[s] = sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]);
-    const bool in_drag = mask[i] & drag_bit;    // else no drag: a diameter of 0 gives none
     const sediment::SphereDrag sphere = immersed.drag(i);
-    diameter[s] = in_drag ? sphere.diameter : 0.0;
+    diameter[s] = sphere.diameter;
     voidage[s] = sphere.scale.voidage;
-    fractions[s] = in_drag ? 1.0 - sphere.scale.voidage : 0.0;
+    fractions[s] = 1.0 - sphere.scale.voidage;
   }
   if (const double linear = immersed.model->linear_coefficient(1.0); linear > 0.0)
     for (size_t s = 0; s < count; ++s) per_speed[s] = linear * diameter[s];
@@ -317,7 +326,13 @@ FixFluidFlow::Stencil FixFluidFlow::stencil_at(const double *x) const
   Stencil at;
   for (int d = 0; d < 3; ++d) {
     int first;
-    kernel.weights((x[d] - origin[d]) / spacing[d] - 0.5, first, at.w[d]);
+    double position = (x[d] - origin[d]) / spacing[d] - 0.5;
+    // A sphere far outside the box (flung away, before LAMMPS finds it lost) is read on the periodic
+    // grid, and one at a non-finite place (not stepped by this package's integrator, which stops the
+    // run) at its first node: its nodes' indices stay ints within the grid.
+    if (!(position >= -n[d] && position < 2.0 * n[d]))
+      position = std::isfinite(position) ? position - n[d] * std::floor(position / n[d]) : 0.0;
+    kernel.weights(position, first, at.w[d]);
     int m = wrap(first, n[d]);
     for (int a = 0; a < nodes; ++a) {
       at.node[d][a] = stride[d] * m;
@@ -570,7 +585,8 @@ void FixFluidFlow::solve()
   for (int i = 0; i < nlocal; ++i) {
     if (!(mask[i] & groupbit)) continue;
     double u[3] = {0.0, 0.0, 0.0};
-    if (s < spheres.size() && spheres[s] == i) {
+    const bool inside = s < spheres.size() && spheres[s] == i;    // else outside the column: the uniform flow
+    if (inside) {
       read_point(stencils[s], u);
       const double own = sediment::hard_sphere_structure_factor(fractions[s]);
       for (int c = 0; c < 3; ++c) u[c] -= own * self_flow[c] * forces[3 * s + c];
@@ -579,7 +595,7 @@ void FixFluidFlow::solve()
     for (int c = 0; c < 3; ++c) {
       const double target = uniform[c] + u[c];
       const double old = velocity[i][c] - uniform[c];
-      velocity[i][c] = relax < 1.0 ? velocity[i][c] + relax * (target - velocity[i][c]) : target;
+      velocity[i][c] = relax < 1.0 && inside ? velocity[i][c] + relax * (target - velocity[i][c]) : target;
       const double now = velocity[i][c] - uniform[c];
       change[0] += now * old;
       change[1] += now * now;
@@ -636,8 +652,11 @@ void FixFluidFlow::copy_arrays(int i, int j, int /*delflag*/)
 // deleted sphere left behind.
 void FixFluidFlow::set_arrays(int i)
 {
-  if (!fluid) fluid = FixFluid::find(lmp, fluid_id, "Fix fluid/flow");
-  const double *uniform = fluid->velocity();
+  // The fluid is looked up by its ID: it may be defined after this fix, or replaced since the last
+  // run's init (and init then sets every sphere's velocity, if nothing was solved yet).
+  const auto *now = dynamic_cast<const FixFluid *>(sediment_fix_by_id(modify, fluid_id));
+  static const double at_rest[3] = {0.0, 0.0, 0.0};
+  const double *uniform = now ? now->velocity() : at_rest;
   double u[3] = {0.0, 0.0, 0.0};
   const double *x = atom->x[i];
   const bool inside = !column || (x[2] >= column_lo && x[2] < column_hi);

@@ -235,6 +235,8 @@ BAD_INPUT = [
     (FLOW + "fix u all fluid/flow f grid 8 8 8 every 0", "Fix fluid/flow: every count 0 must be from 1 to 1000000"),
     (FLOW + "fix u all fluid/flow f grid 8 8 8 drift -0.1", "Fix fluid/flow: drift must be finite and > 0"),
     (FLOW + "fix u all fluid/flow f grid 8 8 8 drift 0.1 every 4", "Fix fluid/flow: give 'every N' or 'drift D', not both"),
+    (FLOW + "fix u all fluid/flow f grid 8 8 8 every 1 drift 0.1", "Fix fluid/flow: give 'every N' or 'drift D', not both"),
+    (FLOW + "fix u all fluid/flow f grid 8 8 8 column 0 1e-3", "Fix fluid/flow: keyword 'column' closes the fluid at its"),
     (FLOW + "fix u all fluid/flow f grid 2 2 2", "Fix fluid/flow: grid size 2 in x is smaller than the kernel's 4 nodes"),
     ("fix f all fluid density 1000 viscosity -1e-3\nfix u all fluid/flow f grid 8 8 8", "Fix fluid: viscosity must be finite and > 0"),
     ("fix u all fluid/flow water grid 8 8 8\nrun 0", "Fix fluid/flow: fluid fix 'water' does not exist"),
