@@ -45,7 +45,7 @@ static inline int wrap(int i, int n)
 FixFluidFlow::FixFluidFlow(LAMMPS *lmp, int narg, char **arg) :
     Fix(lmp, narg, arg), fluid_id(nullptr), fluid(nullptr), nzt(0), column(false), column_lo(0.0), column_hi(0.0),
     relax(1.0), drift_limit(0.0), drift(0.0), solved_speed(0.0), velocity(nullptr), solved(false), fft(nullptr),
-    plane_lo(0), plane_hi(-1), reversals(0), reversal_growth(1.0)
+    plane_lo(0), plane_hi(-1), last_solve(-1), warned_carry(false), carries(0), carry_start(0.0), reversals(0), reversal_growth(1.0)
 {
   if (narg < 8 || strcmp(arg[4], "grid") != 0)
     error->all(FLERR, "Fix fluid/flow: expected 'fix ID group fluid/flow FLUID-ID grid NX NY NZ keyword value ...'");
@@ -215,6 +215,7 @@ void FixFluidFlow::setup(int /*vflag*/)
   if (drags.empty())
     error->all(FLERR, "Fix fluid/flow: no fix fluid/drag takes its drag from fluid '{}' (the flow is driven by the drag)",
                fluid_id);
+  if (last_solve < 0) last_solve = update->ntimestep;    // a new fix, or one read from a restart
   // A run continues the flow it has (from the last run, or a restart): a new one starts from one solve.
   if (!solved) {
     const double keep = relax;
@@ -575,6 +576,7 @@ void FixFluidFlow::solve()
   diag[FLUX] = flux;
   diag[PEAK] = peak;
   diag[OUTSIDE] = total[3];
+  check_carry(peak);
 
   // Each sphere's fluid velocity: the uniform flow of fix fluid plus what the grid gives it, less what
   // its own force and its periodic images give it, S(0) times over in a suspension (the neighbours
@@ -606,6 +608,34 @@ void FixFluidFlow::solve()
   solved = true;
   drift = 0.0;
   diag[SOLVES] += 1.0;
+}
+
+// The flow carries the spheres: across a cell or more between solves, the density it is solved from
+// jumps, and a dense scene can run away (doc page, Stability). Warned once, with the numbers; a run
+// in which it has done so at four solves in a row while the grid's largest velocity grew a hundredfold
+// stops, before its results go wrong.
+void FixFluidFlow::check_carry(double peak)
+{
+  const bigint steps = std::max<bigint>(1, update->ntimestep - last_solve);
+  last_solve = update->ntimestep;
+  const double cells = peak * update->dt * static_cast<double>(steps) / spacing[0];
+  if (!(cells > 1.0)) {
+    carries = 0;
+    return;
+  }
+  if (carries++ == 0) carry_start = peak;
+  if (carries >= 4 && peak > 100.0 * carry_start)
+    error->all(FLERR, "Fix fluid/flow: the flow has carried spheres a cell or more between each of the last {} solves "
+               "and its largest velocity grew from {:.3g} to {:.3g} (step {}): the scene runs away; take a smaller "
+               "timestep, a coarser grid, or solve more often (see the doc page)", carries, carry_start, peak,
+               update->ntimestep);
+  if (warned_carry) return;
+  warned_carry = true;
+  if (comm->me == 0)
+    error->warning(FLERR, "Fix fluid/flow: the flow carries spheres {:.3g} cells between solves (largest velocity on "
+                   "the grid {:.3g} x {} steps of {:.3g} / cell {:.3g}, step {}); above one cell it cannot follow "
+                   "the density it is solved from, and a dense scene can run away: take a smaller timestep, a coarser "
+                   "grid, or solve more often", cells, peak, steps, update->dt, spacing[0], update->ntimestep);
 }
 
 // The lagged solve's instability (doc page, Stability): the spheres' fluid velocities reverse from

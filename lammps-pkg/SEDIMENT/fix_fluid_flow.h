@@ -92,6 +92,10 @@ class FixFluidFlow : public Fix {
   enum { FX, FY, FZ, FLUX, PEAK, OUTSIDE, SOLVES, NDIAG };
   double diag[NDIAG];
 
+  bigint last_solve;         // the step of the last solve (-1: none yet in this fix)
+  bool warned_carry;         // the warning that the flow carries spheres a cell between solves was given
+  int carries;               // solves in a row at which it did (check_carry)
+  double carry_start;        // and the grid's largest velocity at the first of them
   int reversals;             // solves in a row whose fluid velocities reversed and grew (check_stable)
   double reversal_growth;    // and how much the squared velocities grew over them
   // A point's kernel on the transform grid: per axis, its nodes as offsets into the grid's arrays
@@ -109,6 +113,7 @@ class FixFluidFlow : public Fix {
   void solve();
   double largest_speed() const;
   void check_stable(const double *change);
+  void check_carry(double peak);
   void transform_solve();
   void plan_mirror_exchange(const std::vector<int> &first_plane);
   void separate_xy();

@@ -165,6 +165,47 @@ print "RESULT peak $(f_flow[5])"
         assert 0 < stable.results["peak"] < 0.1
 
 
+@check
+def flow_runaway(np_ranks: int):
+    """A dense scene (3000 spheres of 100 um at 20 % solids, Richardson & Zaki, 9 cells a side) at a
+    step where the flow carries them more than a cell between solves (dt 2e-2 s): the density the flow
+    is solved from jumps, and the flow runs away without reversing (0.018, 0.043, 0.090, 0.24, 0.83 m/s).
+    The fix warns at the first such solve and stops the run once it has grown a hundredfold over four
+    or more (not a result gone wrong, nor atoms lost). At dt 2e-3 s (0.16 cells) it runs, unwarned."""
+    deck = """units si
+atom_style sphere
+atom_modify map array
+boundary p p p
+region box block 0 2e-3 0 2e-3 0 2e-3
+create_box 1 box
+create_atoms 1 random 3000 777 NULL
+set group all diameter 1e-4
+set group all density 2650
+comm_modify cutoff 1e-4
+fix fall all gravity 9.81 vector 0 0 -1
+fix water all fluid density 1000 viscosity 1e-3
+compute conc all concentration/grid layers z 1
+fix buoy all fluid/buoyancy water
+fix drag all fluid/drag water law stokes hindrance richardson-zaki concentration c_conc
+fix flow all fluid/flow water grid 9 9 9
+fix step all nve/sphere/fluid
+thermo 1
+timestep ${dt}
+run 8
+print "RESULT peak $(f_flow[5])"
+"""
+    with tempfile.TemporaryDirectory() as tmp:
+        path = Path(tmp) / "dense.lmp"
+        path.write_text(deck)
+        out = run_deck(path, {"dt": 2e-2}, np_ranks, expect_failure=True, cwd=Path(tmp))
+        assert "WARNING: Fix fluid/flow: the flow carries spheres 1.6 cells between solves" in out.text, out.text[-2000:]
+        assert "the scene runs away" in out.text, out.error
+        calm = run_deck(path, {"dt": 2e-3}, np_ranks, cwd=Path(tmp))
+    report(f"dense scene at dt 2e-2 s: warned, then stopped ({out.error.strip()[:100]}...); at dt 2e-3 s ran "
+           f"unwarned, largest fluid velocity {calm.results['peak']:.3g} m/s")
+    assert "carries spheres" not in calm.text and 0 < calm.results["peak"] < 0.05
+
+
 def hard_sphere_suspension(n: int, phi: float, d: float, seed: int) -> tuple[np.ndarray, float]:
     """n spheres of diameter d at solid fraction phi in a periodic cube, placed one by one at random
     where they overlap none placed before (random sequential addition): positions and the side."""
