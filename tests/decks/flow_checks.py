@@ -206,6 +206,47 @@ print "RESULT peak $(f_flow[5])"
     assert "carries spheres" not in calm.text and 0 < calm.results["peak"] < 0.05
 
 
+@check
+def flow_outside_column(np_ranks: int):
+    """Spheres of the group that have left the column (fallen below its bottom, onto the box's floor)
+    put no force on the fluid and see its uniform velocity (here at rest) exactly, with relax below 1
+    too: relaxed towards it, they kept part of the grid's velocity from before they left (9.4e-4 m/s
+    in the hostile round)."""
+    deck = """units si
+atom_style sphere
+atom_modify map array
+boundary p p f
+region box block 0 4e-3 0 4e-3 0 4e-3
+create_box 1 box
+create_atoms 1 random 300 4321 NULL
+set group all diameter 1e-4
+set group all density 2650
+comm_modify cutoff 1e-4
+fix fall all gravity 9.81 vector 0 0 -1
+fix water all fluid density 1000 viscosity 1e-3
+fix buoy all fluid/buoyancy water
+fix drag all fluid/drag water law stokes
+fix flow all fluid/flow water grid 16 16 12 column 1e-3 4e-3 relax 0.1
+fix step all nve/sphere/fluid floor z 0
+timestep 1e-3
+run 100
+write_dump all custom ${state} id z f_flow[1] f_flow[2] f_flow[3] modify sort id format float %.17g
+print "RESULT outside $(f_flow[6]) peak $(f_flow[5])"
+"""
+    with tempfile.TemporaryDirectory() as tmp:
+        path = Path(tmp) / "outside.lmp"
+        path.write_text(deck)
+        out = run_deck(path, {"state": Path(tmp) / "state.txt"}, np_ranks, cwd=Path(tmp))
+        rows = np.loadtxt(Path(tmp) / "state.txt", skiprows=9)
+    outside = rows[rows[:, 1] < 1e-3]
+    inside = rows[rows[:, 1] >= 1e-3]
+    report(f"{len(outside)} spheres below the column (f_flow[6] {out.results['outside']:.0f}): largest fluid velocity "
+           f"{np.abs(outside[:, 2:]).max():.1e} m/s; inside, up to {np.abs(inside[:, 2:]).max():.2e} m/s")
+    assert len(outside) == out.results["outside"] > 50
+    assert np.all(outside[:, 2:] == 0.0)
+    assert np.abs(inside[:, 2:]).max() > 1e-4
+
+
 def hard_sphere_suspension(n: int, phi: float, d: float, seed: int) -> tuple[np.ndarray, float]:
     """n spheres of diameter d at solid fraction phi in a periodic cube, placed one by one at random
     where they overlap none placed before (random sequential addition): positions and the side."""
