@@ -165,6 +165,30 @@ print "RESULT peak $(f_flow[5])"
         assert 0 < stable.results["peak"] < 0.1
 
 
+
+def quartz_deck(boundary: str, side: float, count: int, seed: int, drag: str, flow: str, integrator: str,
+                run: str) -> str:
+    """A deck of `count` quartz spheres of 100 um at random (seed) in a cubic box of `side` with
+    `boundary`, falling in water under gravity and buoyancy, with the `drag` lines, fix fluid/flow's
+    arguments after the fluid (`flow`), fix nve/sphere/fluid's keywords (`integrator`), then `run`."""
+    return f"""units si
+atom_style sphere
+atom_modify map array
+boundary {boundary}
+region box block 0 {side} 0 {side} 0 {side}
+create_box 1 box
+create_atoms 1 random {count} {seed} NULL
+set group all diameter 1e-4
+set group all density 2650
+comm_modify cutoff 1e-4
+fix fall all gravity 9.81 vector 0 0 -1
+fix water all fluid density 1000 viscosity 1e-3
+fix buoy all fluid/buoyancy water
+{drag}
+fix flow all fluid/flow water {flow}
+fix step all nve/sphere/fluid {integrator}
+{run}"""
+
 @check
 def flow_runaway(np_ranks: int):
     """A dense scene (3000 spheres of 100 um at 20 % solids, Richardson & Zaki, 9 cells a side) at a
@@ -173,28 +197,15 @@ def flow_runaway(np_ranks: int):
     The fix warns at the first such solve and stops the run once it has grown tenfold over four or
     more: at step 4, before step 5 loses atoms across the box (the current LAMMPS reports them). Not a
     result gone wrong, nor atoms lost. At dt 2e-3 s (0.16 cells) it runs, unwarned."""
-    deck = """units si
-atom_style sphere
-atom_modify map array
-boundary p p p
-region box block 0 2e-3 0 2e-3 0 2e-3
-create_box 1 box
-create_atoms 1 random 3000 777 NULL
-set group all diameter 1e-4
-set group all density 2650
-comm_modify cutoff 1e-4
-fix fall all gravity 9.81 vector 0 0 -1
-fix water all fluid density 1000 viscosity 1e-3
-compute conc all concentration/grid layers z 1
-fix buoy all fluid/buoyancy water
-fix drag all fluid/drag water law stokes hindrance richardson-zaki concentration c_conc
-fix flow all fluid/flow water grid 9 9 9
-fix step all nve/sphere/fluid
-thermo 1
+    deck = quartz_deck(boundary="p p p", side=2e-3, count=3000, seed=777,
+                       drag="compute conc all concentration/grid layers z 1\n"
+                            "fix drag all fluid/drag water law stokes hindrance richardson-zaki concentration c_conc",
+                       flow="grid 9 9 9", integrator="",
+                       run="""thermo 1
 timestep ${dt}
 run 8
 print "RESULT peak $(f_flow[5])"
-"""
+""")
     with tempfile.TemporaryDirectory() as tmp:
         path = Path(tmp) / "dense.lmp"
         path.write_text(deck)
@@ -213,27 +224,14 @@ def flow_outside_column(np_ranks: int):
     put no force on the fluid and see its uniform velocity (here at rest) exactly, with relax below 1
     too: relaxed towards it, they kept part of the grid's velocity from before they left (9.4e-4 m/s
     in the hostile round)."""
-    deck = """units si
-atom_style sphere
-atom_modify map array
-boundary p p f
-region box block 0 4e-3 0 4e-3 0 4e-3
-create_box 1 box
-create_atoms 1 random 300 4321 NULL
-set group all diameter 1e-4
-set group all density 2650
-comm_modify cutoff 1e-4
-fix fall all gravity 9.81 vector 0 0 -1
-fix water all fluid density 1000 viscosity 1e-3
-fix buoy all fluid/buoyancy water
-fix drag all fluid/drag water law stokes
-fix flow all fluid/flow water grid 16 16 12 column 1e-3 4e-3 relax 0.1
-fix step all nve/sphere/fluid floor z 0
-timestep 1e-3
+    deck = quartz_deck(boundary="p p f", side=4e-3, count=300, seed=4321,
+                       drag="fix drag all fluid/drag water law stokes",
+                       flow="grid 16 16 12 column 1e-3 4e-3 relax 0.1", integrator="floor z 0",
+                       run="""timestep 1e-3
 run 100
 write_dump all custom ${state} id z f_flow[1] f_flow[2] f_flow[3] modify sort id format float %.17g
 print "RESULT outside $(f_flow[6]) peak $(f_flow[5])"
-"""
+""")
     with tempfile.TemporaryDirectory() as tmp:
         path = Path(tmp) / "outside.lmp"
         path.write_text(deck)
