@@ -18,6 +18,7 @@
 
 #include "fix_fluid.h"
 #include "fix_fluid_drag.h"
+#include "fix_nve_sphere_fluid.h"
 
 #include "atom.h"
 #include "comm.h"
@@ -51,7 +52,7 @@ FixFluidFlow::FixFluidFlow(LAMMPS *lmp, int narg, char **arg) :
     error->all(FLERR, "Fix fluid/flow: expected 'fix ID group fluid/flow FLUID-ID grid NX NY NZ keyword value ...'");
   fluid_id = utils::strdup(arg[3]);
   StyleArgs args(lmp, FLERR, "Fix fluid/flow", narg, arg, 4);
-  bool every_given = false;
+  bool every_given = false, drift_given = false;
   while (args.more()) {
     int nvalues = 1;
     if (args.is("grid")) {
@@ -91,13 +92,17 @@ FixFluidFlow::FixFluidFlow(LAMMPS *lmp, int narg, char **arg) :
     } else if (args.is("drift")) {
       args.need(1, "a distance in cells");
       drift_limit = args.positive(1, "drift");
+      drift_given = true;
     } else {
       args.unknown("grid, column, brinkman, width, relax, every or drift");
     }
     args.next(nvalues);
   }
-  if (drift_limit > 0.0 && every_given)
+  if (drift_given && every_given)
     error->all(FLERR, "Fix fluid/flow: give 'every N' or 'drift D', not both (drift chooses the steps between solves)");
+  // By default the fix chooses the steps between solves: the flow is then never more than a tenth of a
+  // cell behind the spheres, which changes a scene's answers by 1e-4 or less (benchmarks/flow_drift.py)
+  if (!every_given && !drift_given) drift_limit = DEFAULT_DRIFT;
   if (domain->dimension != 3) error->all(FLERR, "Fix fluid/flow requires a 3d simulation");
   if (!domain->xperiodic || !domain->yperiodic)
     error->all(FLERR, "Fix fluid/flow requires a box periodic in x and y (boundary p p ...)");
@@ -215,6 +220,9 @@ void FixFluidFlow::setup(int /*vflag*/)
   if (drags.empty())
     error->all(FLERR, "Fix fluid/flow: no fix fluid/drag takes its drag from fluid '{}' (the flow is driven by the drag)",
                fluid_id);
+  floors.clear();
+  for (Fix *fix : sediment_fixes_of_style(lmp, "nve/sphere/fluid"))
+    if (auto integrator = static_cast<FixNVESphereFluid *>(fix); integrator->has_floor()) floors.push_back(integrator);
   if (last_solve < 0) last_solve = update->ntimestep;    // a new fix, or one read from a restart
   // A run continues the flow it has (from the last run, or a restart): a new one starts from one solve.
   if (!solved) {
@@ -530,16 +538,28 @@ void FixFluidFlow::transform_solve()
                  plane_offsets.data(), MPI_DOUBLE, world);
 }
 
+// Spheres the flow leaves out: outside the column, and those stopped on a floor of fix
+// nve/sphere/fluid (the deposit, whose weight the floor carries). Held there whatever the fluid does,
+// such a sphere's drag against the flow would only resist it, and a deposit's many resist it so
+// stiffly that the lagged flow diverges within a few solves of the first landings.
+bool FixFluidFlow::left_out(int i) const
+{
+  if (column && !(atom->x[i][2] >= column_lo && atom->x[i][2] < column_hi)) return true;
+  for (const FixNVESphereFluid *floor : floors)
+    if (floor->at_rest_on_floor(i)) return true;
+  return false;
+}
+
 void FixFluidFlow::solve()
 {
   const int nlocal = atom->nlocal;
   const int *mask = atom->mask;
   double **x = atom->x;
-  double local[4] = {0.0, 0.0, 0.0, 0.0};    // force on the fluid, spheres outside the column
+  double local[4] = {0.0, 0.0, 0.0, 0.0};    // force on the fluid, spheres left out
   spheres.clear();
   for (int i = 0; i < nlocal; ++i) {
     if (!(mask[i] & groupbit)) continue;
-    if (column && !(x[i][2] >= column_lo && x[i][2] < column_hi))
+    if (left_out(i))
       local[3] += 1.0;
     else
       spheres.push_back(i);
@@ -575,7 +595,7 @@ void FixFluidFlow::solve()
   for (int c = 0; c < 3; ++c) diag[FX + c] = total[c];
   diag[FLUX] = flux;
   diag[PEAK] = peak;
-  diag[OUTSIDE] = total[3];
+  diag[LEFT_OUT] = total[3];
   check_carry(peak);
 
   // Each sphere's fluid velocity: the uniform flow of fix fluid plus what the grid gives it, less what
@@ -587,7 +607,7 @@ void FixFluidFlow::solve()
   for (int i = 0; i < nlocal; ++i) {
     if (!(mask[i] & groupbit)) continue;
     double u[3] = {0.0, 0.0, 0.0};
-    const bool inside = s < spheres.size() && spheres[s] == i;    // else outside the column: the uniform flow
+    const bool inside = s < spheres.size() && spheres[s] == i;    // else left out: the uniform flow
     if (inside) {
       read_point(stencils[s], u);
       const double own = sediment::hard_sphere_structure_factor(fractions[s]);
@@ -663,7 +683,7 @@ void FixFluidFlow::check_stable(const double *local)
 double FixFluidFlow::compute_vector(int n)
 {
   // force on the fluid (x, y, z), largest |mean u_z| over a plane of nodes, largest |u| component on
-  // the grid, spheres of the group outside the column (all of the last solve); solves so far
+  // the grid, spheres of the group left out (outside the column or on a floor; all of the last solve); solves so far
   return diag[n];
 }
 

@@ -58,6 +58,7 @@ class FixFluidFlow : public Fix {
   char *fluid_id;
   class FixFluid *fluid;
   std::vector<class FixFluidDrag *> drags;    // the fluid/drag fixes of this fluid (setup())
+  std::vector<class FixNVESphereFluid *> floors;    // the nve/sphere/fluid fixes with a floor (setup())
   int grid[3];           // cells of the fluid: x, y, and z of the box (periodic) or of the column
   int nzt;               // planes of the transform: grid[2], or 2 grid[2] with the column's mirror
   bool column;           // closed in z: free slip at column_lo and column_hi
@@ -65,6 +66,7 @@ class FixFluidFlow : public Fix {
   double relax;          // u <- (1 - relax) u + relax u_solved
   double drift_limit;    // > 0: solve once the spheres may have moved this many cells since the last solve,
                          // or their largest speed has changed by this fraction
+  static constexpr double DEFAULT_DRIFT = 0.1;    // without every or drift
   double drift;          // cells the fastest sphere of each step has moved since the last solve, summed
   double solved_speed;   // the largest speed at the last solve
   sediment::StokesOperator stokes;
@@ -89,7 +91,7 @@ class FixFluidFlow : public Fix {
   double origin[3], spacing[3], length[3];
   double self_flow[3];    // per axis: the flow a unit force gives back where it is spread (images too)
   // Diagnostics of the last solve (compute_vector)
-  enum { FX, FY, FZ, FLUX, PEAK, OUTSIDE, SOLVES, NDIAG };
+  enum { FX, FY, FZ, FLUX, PEAK, LEFT_OUT, SOLVES, NDIAG };
   double diag[NDIAG];
 
   bigint last_solve;         // the step of the last solve (-1: none yet in this fix)
@@ -111,6 +113,7 @@ class FixFluidFlow : public Fix {
   std::vector<double> forces, fractions;
 
   void solve();
+  bool left_out(int i) const;
   double largest_speed() const;
   void check_stable(const double *change);
   void check_carry(double peak);

@@ -664,6 +664,13 @@ void FixNVESphereFluid::find_non_finite() const
   }
 }
 
+bool FixNVESphereFluid::at_rest_on_floor(int i) const
+{
+  const double *v = atom->v[i];
+  return floor_axis >= 0 && (atom->mask[i] & groupbit) && atom->x[i][floor_axis] == floor_level + atom->radius[i] &&
+      v[0] == 0.0 && v[1] == 0.0 && v[2] == 0.0;
+}
+
 double FixNVESphereFluid::compute_vector(int n)
 {
   return counts.total(n, world);

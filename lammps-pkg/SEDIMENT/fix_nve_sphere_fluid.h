@@ -40,6 +40,11 @@ class FixNVESphereFluid : public Fix {
   int unpack_exchange(int, double *) override;
   double memory_usage() override;
 
+  // Whether sphere i lies stopped on this fix's floor (its lowest point on it, at rest): part of the
+  // deposit, which fix fluid/flow leaves out of the fluid it resolves.
+  bool at_rest_on_floor(int i) const;
+  bool has_floor() const { return floor_axis >= 0; }
+
  private:
   // Per atom, from the first half of the step to the second: the weights of the new force along and
   // across the slip (per unit mass) and the slip's direction, packed in 4 doubles

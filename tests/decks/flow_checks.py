@@ -226,7 +226,7 @@ def flow_outside_column(np_ranks: int):
     in the hostile round)."""
     deck = quartz_deck(boundary="p p f", side=4e-3, count=300, seed=4321,
                        drag="fix drag all fluid/drag water law stokes",
-                       flow="grid 16 16 12 column 1e-3 4e-3 relax 0.1", integrator="floor z 0",
+                       flow="grid 16 16 12 column 1e-3 4e-3 relax 0.1 every 1", integrator="floor z 0",
                        run="""timestep 1e-3
 run 100
 write_dump all custom ${state} id z f_flow[1] f_flow[2] f_flow[3] modify sort id format float %.17g
@@ -244,6 +244,38 @@ print "RESULT outside $(f_flow[6]) peak $(f_flow[5])"
     assert len(outside) == out.results["outside"] > 50
     assert np.all(outside[:, 2:] == 0.0)
     assert np.abs(inside[:, 2:]).max() > 1e-4
+
+
+@check
+def flow_deposit(np_ranks: int):
+    """Grains settling in a closed column onto the floor of fix nve/sphere/fluid at its bottom: those
+    stopped on the floor are the deposit, which the flow leaves out (no force on the fluid, which they
+    see at its uniform velocity, here at rest), as it leaves out grains below a column. Held on the
+    floor whatever the fluid does, their drags could only resist the flow, and so stiffly that the
+    flow grew from solve to solve from the first landings, at steps of 10 ms, 6.7 relaxation times (the
+    build before: the grid's largest velocity 0.012, 0.047, 0.30, 2.2 m/s at steps 3 to 6, and the run
+    stopped as a runaway at step 7)."""
+    deck = quartz_deck(boundary="p p f", side=4e-3, count=1000, seed=2468,
+                       drag="fix drag all fluid/drag water law stokes",
+                       flow="grid 16 16 16 column 0 4e-3", integrator="floor z 0",
+                       run="""timestep 1e-2
+thermo 10
+run 30
+write_dump all custom ${state} id z vz f_flow[1] f_flow[2] f_flow[3] modify sort id format float %.17g
+print "RESULT left_out $(f_flow[6]) peak $(f_flow[5])"
+""")
+    with tempfile.TemporaryDirectory() as tmp:
+        path = Path(tmp) / "deposit.lmp"
+        path.write_text(deck)
+        out = run_deck(path, {"state": Path(tmp) / "state.txt"}, np_ranks, cwd=Path(tmp))
+        rows = np.loadtxt(Path(tmp) / "state.txt", skiprows=9)
+    resting = (rows[:, 1] == 5e-5) & (rows[:, 2] == 0.0)
+    report(f"{resting.sum()} of {len(rows)} grains at rest on the floor (f_flow[6] {out.results['left_out']:.0f}): "
+           f"fluid velocity there {np.abs(rows[resting, 3:]).max():.1e} m/s; largest on the grid at the end "
+           f"{out.results['peak']:.2e} m/s")
+    assert out.results["left_out"] == resting.sum() > 300 and not np.all(resting)
+    assert np.all(rows[resting, 3:] == 0.0)
+    assert 0 < out.results["peak"] < 0.01
 
 
 def hard_sphere_suspension(n: int, phi: float, d: float, seed: int) -> tuple[np.ndarray, float]:
