@@ -300,7 +300,7 @@ void FixFluidFlow::sphere_forces()
   const int drag_bit = drag->groupbit;
   const int *mask = atom->mask;
   double **v = atom->v;
-  std::vector<double> diameter(count), speed(count), voidage(count), per_speed(count);
+  for (auto *column : {&diameter, &speed, &voidage, &per_speed}) column->resize(count);
   for (size_t s = 0; s < count; ++s) {
     const int i = spheres[s];
     if (!(mask[i] & drag_bit)) {    // no drag, no force: a diameter, slip and speed of 0, whatever its velocity
@@ -777,7 +777,8 @@ double FixFluidFlow::memory_usage()
   const double grids = static_cast<double>(spread.size() + flow.size() + slab.size() + 3 * field[0].size() +
                                            mirror_out.size() + mirror_in.size());
   const double per_sphere = static_cast<double>(stencils.capacity()) * sizeof(Stencil) +
-      static_cast<double>(forces.capacity() + fractions.capacity()) * sizeof(double) +
+      static_cast<double>(forces.capacity() + fractions.capacity() + diameter.capacity() + speed.capacity() +
+                          voidage.capacity() + per_speed.capacity()) * sizeof(double) +
       static_cast<double>(spheres.capacity()) * sizeof(int);
   return (3.0 * atom->nmax + grids) * sizeof(double) + per_sphere;
 }

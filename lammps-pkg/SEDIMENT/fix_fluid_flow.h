@@ -111,6 +111,7 @@ class FixFluidFlow : public Fix {
   std::vector<int> spheres;
   std::vector<Stencil> stencils;
   std::vector<double> forces, fractions;
+  std::vector<double> diameter, speed, voidage, per_speed;    // sphere_forces' columns for the drag law
 
   void solve();
   bool left_out(int i) const;
