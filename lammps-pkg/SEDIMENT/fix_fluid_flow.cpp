@@ -2,12 +2,15 @@
 /* ----------------------------------------------------------------------
    SEDIMENT package: fix fluid/flow
    A solve at the end of a step (each step, every N, or once the spheres have
-   drifted): every rank spreads its spheres' forces onto a copy of the whole
-   grid, a reduce-scatter sums the copies into each rank's slab of planes (the
-   FFT's layout, in = out), the slabs are transformed (four FFTs: separate_xy),
-   the Stokes operator applied mode by mode (sediment/flow.hpp), transformed
-   back, and gathered whole on every rank, which reads the velocity at its
-   spheres. Memory and communication per rank are O(grid) per solve.
+   drifted): every rank spreads its spheres' forces onto its brick of the grid
+   (the nodes their kernels touch, and its subdomain's), the bricks' planes are
+   sent to the ranks holding them in the FFT's slabs of planes (in = out) and
+   summed there (with the column's mirror image), the slabs are transformed
+   (four FFTs: separate_xy), the Stokes operator applied mode by mode
+   (sediment/flow.hpp), transformed back, and each brick's velocity is sent
+   back to the rank that reads it at its spheres. Memory and communication per
+   rank are those of its brick and its slab: O(grid / ranks) where the ranks
+   split the box along z, as LAMMPS does a tall column.
 ------------------------------------------------------------------------- */
 
 #include "fix_fluid_flow.h"
@@ -180,22 +183,12 @@ void FixFluidFlow::init()
     const int nprocs = comm->nprocs, me = comm->me;
     if (nzt < nprocs)
       error->all(FLERR, "Fix fluid/flow: {} planes of the transform cannot be split over {} ranks", nzt, nprocs);
-    const int plane = 3 * grid[0] * grid[1];
-    plane_counts.resize(nprocs);
-    plane_offsets.resize(nprocs);
-    std::vector<int> first_plane(nprocs + 1);
+    first_plane.resize(nprocs + 1);
     for (int r = 0; r <= nprocs; ++r) first_plane[r] = static_cast<int>(static_cast<long>(r) * nzt / nprocs);
-    for (int r = 0; r < nprocs; ++r) {
-      plane_counts[r] = plane * (first_plane[r + 1] - first_plane[r]);
-      plane_offsets[r] = plane * first_plane[r];
-    }
     plane_lo = first_plane[me];
     plane_hi = first_plane[me + 1] - 1;
     plan_mirror_exchange(first_plane);
-    const long nodes = static_cast<long>(grid[0]) * grid[1] * nzt;
     const long mine = static_cast<long>(grid[0]) * grid[1] * (plane_hi - plane_lo + 1);
-    spread.assign(3 * nodes, 0.0);
-    flow.assign(3 * nodes, 0.0);
     slab.assign(3 * mine, 0.0);
     for (auto &f : field) f.assign(2 * mine, 0.0);
     int buffer = 0;
@@ -326,12 +319,12 @@ void FixFluidFlow::sphere_forces()
     for (int c = 0; c < 3; ++c) forces[3 * s + c] *= per_speed[s];
 }
 
-// The kernel's nodes around x on each axis, wrapped onto the periodic transform grid, and their weights.
+// The kernel's nodes around x on each axis, wrapped onto the periodic transform grid (their global
+// indices, until place() makes them offsets into a brick), and their weights.
 FixFluidFlow::Stencil FixFluidFlow::stencil_at(const double *x) const
 {
   constexpr int nodes = sediment::FlowKernel::max_nodes;
   const int n[3] = {grid[0], grid[1], nzt};
-  const long stride[3] = {3, 3L * n[0], 3L * n[0] * n[1]};
   Stencil at;
   for (int d = 0; d < 3; ++d) {
     int first;
@@ -344,21 +337,239 @@ FixFluidFlow::Stencil FixFluidFlow::stencil_at(const double *x) const
     kernel.weights(position, first, at.w[d]);
     int m = wrap(first, n[d]);
     for (int a = 0; a < nodes; ++a) {
-      at.node[d][a] = stride[d] * m;
+      at.node[d][a] = m;
       if (++m == n[d]) m = 0;
     }
   }
   return at;
 }
 
-void FixFluidFlow::spread_point(const Stencil &at, const double *force)
+// A rank's brick: per axis the nodes of the kernels `at` (global indices) and, with `subdomain`, those
+// of every point of its subdomain (where a sphere created between solves reads the last one's flow).
+void FixFluidFlow::build_brick(Brick &b, const std::vector<Stencil> &at, bool subdomain) const
+{
+  const int n[3] = {grid[0], grid[1], nzt};
+  std::vector<char> held[3];
+  for (int d = 0; d < 3; ++d) held[d].assign(n[d], 0);
+  for (const Stencil &s : at)
+    for (int d = 0; d < 3; ++d)
+      for (long node : s.node[d]) held[d][node] = 1;
+  for (int d = 0; subdomain && d < 3; ++d) {
+    double lo = domain->sublo[d], hi = domain->subhi[d];
+    if (d == 2 && column) {
+      lo = std::max(lo, column_lo);
+      hi = std::min(hi, column_hi);
+    }
+    if (!(hi >= lo)) continue;    // no part of the column here
+    const double first = std::floor((lo - origin[d]) / spacing[d] - 0.5) - 1.0;
+    const double last = std::floor((hi - origin[d]) / spacing[d] - 0.5) + sediment::FlowKernel::max_nodes - 2.0;
+    if (last - first + 1.0 >= n[d])
+      std::fill(held[d].begin(), held[d].end(), 1);
+    else
+      for (double m = first; m <= last; m += 1.0) held[d][wrap(static_cast<int>(m), n[d])] = 1;
+  }
+  for (int d = 0; d < 3; ++d) {
+    b.nodes[d].clear();
+    b.local[d].assign(n[d], -1);
+    for (int m = 0; m < n[d]; ++m)
+      if (held[d][m]) {
+        b.local[d][m] = static_cast<int>(b.nodes[d].size());
+        b.nodes[d].push_back(m);
+      }
+  }
+}
+
+// Whether b holds every node of the kernel at (global indices).
+bool FixFluidFlow::holds(const Stencil &at, const Brick &b)
+{
+  for (int d = 0; d < 3; ++d)
+    for (long node : at.node[d])
+      if (b.local[d].empty() || b.local[d][node] < 0) return false;
+  return true;
+}
+
+// The kernel's global indices made offsets into the values of b ([k][j][i][c]), which holds them.
+void FixFluidFlow::place(Stencil &at, const Brick &b)
+{
+  const long stride[3] = {3, 3L * static_cast<long>(b.nodes[0].size()),
+                          3L * static_cast<long>(b.nodes[0].size() * b.nodes[1].size())};
+  for (int d = 0; d < 3; ++d)
+    for (long &node : at.node[d]) node = stride[d] * b.local[d][node];
+}
+
+// The rank holding plane q of the transform.
+int FixFluidFlow::owner(int q) const
+{
+  return static_cast<int>(std::upper_bound(first_plane.begin(), first_plane.end(), q) - first_plane.begin()) - 1;
+}
+
+// Every rank's node lists (bricks), for routing the planes both ways.
+void FixFluidFlow::gather_bricks(const Brick &b)
+{
+  const int nprocs = comm->nprocs;
+  const int mine[3] = {static_cast<int>(b.nodes[0].size()), static_cast<int>(b.nodes[1].size()),
+                       static_cast<int>(b.nodes[2].size())};
+  bricks.size.resize(3 * nprocs);
+  bricks.offset.resize(3 * nprocs);
+  MPI_Allgather(mine, 3, MPI_INT, bricks.size.data(), 3, MPI_INT, world);
+  std::vector<int> counts(nprocs), starts(nprocs);
+  int total = 0;
+  for (int r = 0; r < nprocs; ++r) {
+    starts[r] = total;
+    for (int d = 0; d < 3; ++d) {
+      bricks.offset[3 * r + d] = total;
+      total += bricks.size[3 * r + d];
+    }
+    counts[r] = total - starts[r];
+  }
+  std::vector<int> flat;
+  flat.reserve(mine[0] + mine[1] + mine[2]);
+  for (const auto &nodes : b.nodes) flat.insert(flat.end(), nodes.begin(), nodes.end());
+  bricks.nodes.resize(total);
+  MPI_Allgatherv(flat.data(), static_cast<int>(flat.size()), MPI_INT, bricks.nodes.data(), counts.data(), starts.data(),
+                 MPI_INT, world);
+}
+
+// Plane k of rank r's brick, z index q: whether it goes to this rank's slab as itself, and as the
+// column's mirror image (plane nzt - 1 - q, vertical force reversed).
+void FixFluidFlow::routes(int q, int to, bool mirror, bool &direct, bool &mirrored) const
+{
+  direct = owner(q) == to;
+  mirrored = mirror && column && owner(nzt - 1 - q) == to;
+}
+
+// The force density on every rank's brick (this rank's: `force` on b) summed into the slabs, with the
+// column's mirror image where `mirror`. Each plane of a brick goes once to each other rank that takes
+// it (this rank's own are read where they are), and ranks and planes are summed in order, so that
+// any number of ranks sums as one grid would.
+void FixFluidFlow::sum_into_slabs(const Brick &b, const std::vector<double> &force, bool mirror)
+{
+  const int nprocs = comm->nprocs, me = comm->me;
+  const long plane = 3L * static_cast<long>(b.nodes[0].size() * b.nodes[1].size());
+  const std::vector<int> &zs = b.nodes[2];
+  bool direct, mirrored;
+  for (auto *counts : {&send_counts, &send_offsets, &recv_counts, &recv_offsets}) counts->assign(nprocs, 0);
+  for (int pass = 0; pass < 2; ++pass) {    // the counts, then the planes
+    long at = 0;
+    for (int r = 0; r < nprocs; ++r) {
+      send_offsets[r] = static_cast<int>(at);
+      for (size_t k = 0; r != me && k < zs.size(); ++k) {
+        routes(zs[k], r, mirror, direct, mirrored);
+        if (!direct && !mirrored) continue;
+        if (pass == 1) std::copy_n(&force[plane * k], plane, &sent[at]);
+        at += plane;
+      }
+      send_counts[r] = static_cast<int>(at) - send_offsets[r];
+    }
+    if (pass == 0) sent.resize(at);
+  }
+  long total = 0;
+  for (int s = 0; s < nprocs; ++s) {
+    recv_offsets[s] = static_cast<int>(total);
+    const int *qs = &bricks.nodes[bricks.offset[3 * s + 2]];
+    for (int k = 0; s != me && k < bricks.size[3 * s + 2]; ++k) {
+      routes(qs[k], me, mirror, direct, mirrored);
+      if (direct || mirrored) total += 3L * bricks.size[3 * s] * bricks.size[3 * s + 1];
+    }
+    recv_counts[s] = static_cast<int>(total) - recv_offsets[s];
+  }
+  received.resize(total);
+  MPI_Alltoallv(sent.data(), send_counts.data(), send_offsets.data(), MPI_DOUBLE, received.data(),
+                recv_counts.data(), recv_offsets.data(), MPI_DOUBLE, world);
+  std::fill(slab.begin(), slab.end(), 0.0);
+  const long full = 3L * grid[0] * grid[1];
+  for (int s = 0; s < nprocs; ++s) {
+    const int nx = bricks.size[3 * s], ny = bricks.size[3 * s + 1];
+    const int *xs = &bricks.nodes[bricks.offset[3 * s]], *ys = &bricks.nodes[bricks.offset[3 * s + 1]];
+    const int *qs = &bricks.nodes[bricks.offset[3 * s + 2]];
+    const double *block = received.data() + recv_offsets[s];
+    for (int k = 0; k < bricks.size[3 * s + 2]; ++k) {
+      routes(qs[k], me, mirror, direct, mirrored);
+      if (!direct && !mirrored) continue;
+      const double *values = s == me ? &force[plane * k] : block;
+      for (int pass = 0; pass < 2; ++pass) {
+        if (!(pass == 0 ? direct : mirrored)) continue;
+        const double sign = pass == 0 ? 1.0 : -1.0;
+        double *to = &slab[full * ((pass == 0 ? qs[k] : nzt - 1 - qs[k]) - plane_lo)];
+        const double *from = values;
+        for (int j = 0; j < ny; ++j)
+          for (int i = 0; i < nx; ++i, from += 3) {
+            double *node = to + 3L * (static_cast<long>(ys[j]) * grid[0] + xs[i]);
+            node[0] += from[0];
+            node[1] += from[1];
+            node[2] += sign * from[2];
+          }
+      }
+      if (s != me) block += 3L * nx * ny;
+    }
+  }
+}
+
+// The velocity in the slabs sent to every rank's brick (this rank's into `velocity` on b; its own
+// planes copied where they are).
+void FixFluidFlow::read_from_slabs(const Brick &b, std::vector<double> &velocity)
+{
+  const int nprocs = comm->nprocs, me = comm->me;
+  const long full = 3L * grid[0] * grid[1];
+  // Brick r's nodes of the slab's plane q, in its order ([j][i][c]), into `into`.
+  auto copy_plane = [&](int r, int q, double *into) {
+    const int nx = bricks.size[3 * r], ny = bricks.size[3 * r + 1];
+    const int *xs = &bricks.nodes[bricks.offset[3 * r]], *ys = &bricks.nodes[bricks.offset[3 * r + 1]];
+    const double *from = &slab[full * (q - plane_lo)];
+    for (int j = 0; j < ny; ++j)
+      for (int i = 0; i < nx; ++i, into += 3) std::copy_n(from + 3L * (static_cast<long>(ys[j]) * grid[0] + xs[i]), 3, into);
+  };
+  long at = 0;
+  for (int r = 0; r < nprocs; ++r) {
+    send_offsets[r] = static_cast<int>(at);
+    for (int k = 0; r != me && k < bricks.size[3 * r + 2]; ++k)
+      if (owner(bricks.nodes[bricks.offset[3 * r + 2] + k]) == me) at += 3L * bricks.size[3 * r] * bricks.size[3 * r + 1];
+    send_counts[r] = static_cast<int>(at) - send_offsets[r];
+  }
+  sent.resize(at);
+  for (int r = 0; r < nprocs; ++r) {
+    double *into = sent.data() + send_offsets[r];
+    const int *qs = &bricks.nodes[bricks.offset[3 * r + 2]];
+    for (int k = 0; r != me && k < bricks.size[3 * r + 2]; ++k)
+      if (owner(qs[k]) == me) {
+        copy_plane(r, qs[k], into);
+        into += 3L * bricks.size[3 * r] * bricks.size[3 * r + 1];
+      }
+  }
+  const long plane = 3L * static_cast<long>(b.nodes[0].size() * b.nodes[1].size());
+  long total = 0;
+  for (int s = 0; s < nprocs; ++s) {
+    recv_offsets[s] = static_cast<int>(total);
+    for (int q : b.nodes[2])
+      if (s != me && owner(q) == s) total += plane;
+    recv_counts[s] = static_cast<int>(total) - recv_offsets[s];
+  }
+  received.resize(total);
+  MPI_Alltoallv(sent.data(), send_counts.data(), send_offsets.data(), MPI_DOUBLE, received.data(),
+                recv_counts.data(), recv_offsets.data(), MPI_DOUBLE, world);
+  velocity.resize(3 * b.size());
+  for (int s = 0; s < nprocs; ++s) {
+    const double *block = received.data() + recv_offsets[s];
+    for (size_t k = 0; k < b.nodes[2].size(); ++k) {
+      if (owner(b.nodes[2][k]) != s) continue;
+      if (s == me) {
+        copy_plane(me, b.nodes[2][k], &velocity[plane * k]);
+      } else {
+        std::copy_n(block, plane, &velocity[plane * k]);
+        block += plane;
+      }
+    }
+  }
+}
+
+void FixFluidFlow::spread_point(const Stencil &at, const double *force, std::vector<double> &density) const
 {
   constexpr int nodes = sediment::FlowKernel::max_nodes;
   const double per_volume = 1.0 / (spacing[0] * spacing[1] * spacing[2]);
   const double fx = force[0] * per_volume, fy = force[1] * per_volume, fz = force[2] * per_volume;
   for (int c = 0; c < nodes; ++c) {
     for (int b = 0; b < nodes; ++b) {
-      double *row = &spread[at.node[2][c] + at.node[1][b]];
+      double *row = &density[at.node[2][c] + at.node[1][b]];
       const double wzy = at.w[2][c] * at.w[1][b];
       for (int a = 0; a < nodes; ++a) {
         double *node = row + at.node[0][a];
@@ -371,33 +582,13 @@ void FixFluidFlow::spread_point(const Stencil &at, const double *force)
   }
 }
 
-// The column's free-slip walls: every sphere's mirror image below the bottom (so above the top, on
-// the doubled periodic axis), whose kernel is that of the sphere reflected. Node k (at lo + (k + 1/2) h)
-// mirrors node -k - 1, plane nzt - 1 - k of the transform grid, with the force's z reversed.
-void FixFluidFlow::add_mirror_image()
-{
-  const long plane = 3L * grid[0] * grid[1];
-  for (int k = 0; k < nzt / 2; ++k) {
-    double *a = &spread[plane * k], *b = &spread[plane * (nzt - 1 - k)];
-    for (long m = 0; m < plane; m += 3) {
-      const double ax = a[m], ay = a[m + 1], az = a[m + 2];
-      a[m] += b[m];
-      a[m + 1] += b[m + 1];
-      a[m + 2] -= b[m + 2];
-      b[m] += ax;
-      b[m + 1] += ay;
-      b[m + 2] -= az;
-    }
-  }
-}
-
-void FixFluidFlow::read_point(const Stencil &at, double *u) const
+void FixFluidFlow::read_point(const Stencil &at, const std::vector<double> &velocity, double *u) const
 {
   constexpr int nodes = sediment::FlowKernel::max_nodes;
   double ux = 0.0, uy = 0.0, uz = 0.0;
   for (int c = 0; c < nodes; ++c) {
     for (int b = 0; b < nodes; ++b) {
-      const double *row = &flow[at.node[2][c] + at.node[1][b]];
+      const double *row = &velocity[at.node[2][c] + at.node[1][b]];
       const double wzy = at.w[2][c] * at.w[1][b];
       for (int a = 0; a < nodes; ++a) {
         const double *node = row + at.node[0][a];
@@ -419,22 +610,25 @@ void FixFluidFlow::read_point(const Stencil &at, double *u) const
 // width outgrows on coarse grids.
 void FixFluidFlow::measure_self_flow()
 {
-  std::vector<double> last = flow;    // the last solve's grid, kept for the spheres created before the next
   const double at[3] = {origin[0] + 0.5 * spacing[0], origin[1] + 0.5 * spacing[1], origin[2] + 0.5 * spacing[2]};
+  std::vector<Stencil> unit(comm->me == 0 ? 1 : 0, stencil_at(at));    // spread and read on rank 0
+  Brick b;
+  build_brick(b, unit, false);
+  gather_bricks(b);
+  for (Stencil &s : unit) place(s, b);
+  std::vector<double> force, velocity;
   for (int c = 0; c < 3; ++c) {
-    std::fill(spread.begin(), spread.end(), 0.0);
-    const Stencil stencil = stencil_at(at);
-    if (comm->me == 0) {
-      double unit[3] = {0.0, 0.0, 0.0};
-      unit[c] = 1.0;
-      spread_point(stencil, unit);
-    }
+    force.assign(3 * b.size(), 0.0);
+    double u[3] = {0.0, 0.0, 0.0};
+    u[c] = 1.0;
+    for (const Stencil &s : unit) spread_point(s, u, force);
+    sum_into_slabs(b, force, false);
     transform_solve();
-    double u[3];
-    read_point(stencil, u);
+    read_from_slabs(b, velocity);
+    for (const Stencil &s : unit) read_point(s, velocity, u);
     self_flow[c] = u[c];
   }
-  flow = std::move(last);
+  MPI_Bcast(self_flow, 3, MPI_DOUBLE, 0, world);
 }
 
 // Which planes go where for separate_xy: plane q of the transform lies on the rank r with
@@ -498,11 +692,9 @@ void FixFluidFlow::separate_xy()
   }
 }
 
-// The flow of the force density in `spread` (summed over the ranks' copies) into `flow` (whole on
-// every rank).
+// The flow of the force density in this rank's slab, into the slab.
 void FixFluidFlow::transform_solve()
 {
-  MPI_Reduce_scatter(spread.data(), slab.data(), plane_counts.data(), MPI_DOUBLE, MPI_SUM, world);
   // f_x + i f_y in one transform and f_z in another, told apart in Fourier space (separate_xy)
   const size_t mine = slab.size() / 3;
   double *xy = field[0].data(), *z = field[2].data();
@@ -534,8 +726,6 @@ void FixFluidFlow::transform_solve()
     slab[3 * m + 1] = xy[2 * m + 1];
     slab[3 * m + 2] = z[2 * m];
   }
-  MPI_Allgatherv(slab.data(), static_cast<int>(slab.size()), MPI_DOUBLE, flow.data(), plane_counts.data(),
-                 plane_offsets.data(), MPI_DOUBLE, world);
 }
 
 // Spheres the flow leaves out: outside the column, and those stopped on a floor of fix
@@ -565,38 +755,44 @@ void FixFluidFlow::solve()
       spheres.push_back(i);
   }
   sphere_forces();
-  std::fill(spread.begin(), spread.end(), 0.0);
   stencils.resize(spheres.size());
+  for (size_t s = 0; s < spheres.size(); ++s) stencils[s] = stencil_at(x[spheres[s]]);
+  build_brick(brick, stencils, true);
+  gather_bricks(brick);
+  spread.assign(3 * brick.size(), 0.0);
   for (size_t s = 0; s < spheres.size(); ++s) {
-    stencils[s] = stencil_at(x[spheres[s]]);
+    place(stencils[s], brick);
     const double *force = &forces[3 * s];
     if (force[0] == 0.0 && force[1] == 0.0 && force[2] == 0.0) continue;
     for (int c = 0; c < 3; ++c) local[c] += force[c];
-    spread_point(stencils[s], force);
+    spread_point(stencils[s], force, spread);
   }
-  if (column) add_mirror_image();
   double total[4];
   MPI_Allreduce(local, total, 4, MPI_DOUBLE, MPI_SUM, world);
 
+  sum_into_slabs(brick, spread, true);
   transform_solve();
 
   // Diagnostics: the largest mean vertical velocity over a plane of nodes in the fluid (zero: no
   // net flux) and the largest speed component on the grid.
-  double flux = 0.0, peak = 0.0;
+  double largest[2] = {0.0, 0.0}, overall[2];    // flux, peak
   const long plane = static_cast<long>(grid[0]) * grid[1];
-  for (int k = 0; k < grid[2]; ++k) {
+  for (int q = plane_lo; q <= std::min(plane_hi, grid[2] - 1); ++q) {
+    const double *u = &slab[3 * plane * (q - plane_lo)];
     double sum = 0.0;
-    for (long m = k * plane; m < (k + 1) * plane; ++m) {
-      sum += flow[3 * m + 2];
-      for (int c = 0; c < 3; ++c) peak = std::max(peak, std::abs(flow[3 * m + c]));
+    for (long m = 0; m < plane; ++m) {
+      sum += u[3 * m + 2];
+      for (int c = 0; c < 3; ++c) largest[1] = std::max(largest[1], std::abs(u[3 * m + c]));
     }
-    flux = std::max(flux, std::abs(sum / plane));
+    largest[0] = std::max(largest[0], std::abs(sum / plane));
   }
+  MPI_Allreduce(largest, overall, 2, MPI_DOUBLE, MPI_MAX, world);
+  read_from_slabs(brick, flow);
   for (int c = 0; c < 3; ++c) diag[FX + c] = total[c];
-  diag[FLUX] = flux;
-  diag[PEAK] = peak;
+  diag[FLUX] = overall[0];
+  diag[PEAK] = overall[1];
   diag[LEFT_OUT] = total[3];
-  check_carry(peak);
+  check_carry(overall[1]);
 
   // Each sphere's fluid velocity: the uniform flow of fix fluid plus what the grid gives it, less what
   // its own force and its periodic images give it, S(0) times over in a suspension (the neighbours
@@ -609,7 +805,7 @@ void FixFluidFlow::solve()
     double u[3] = {0.0, 0.0, 0.0};
     const bool inside = s < spheres.size() && spheres[s] == i;    // else left out: the uniform flow
     if (inside) {
-      read_point(stencils[s], u);
+      read_point(stencils[s], flow, u);
       const double own = sediment::hard_sphere_structure_factor(fractions[s]);
       for (int c = 0; c < 3; ++c) u[c] -= own * self_flow[c] * forces[3 * s + c];
       ++s;
@@ -711,7 +907,12 @@ void FixFluidFlow::set_arrays(int i)
   double u[3] = {0.0, 0.0, 0.0};
   const double *x = atom->x[i];
   const bool inside = !column || (x[2] >= column_lo && x[2] < column_hi);
-  if (solved && !flow.empty() && inside) read_point(stencil_at(x), u);    // no grid yet after a restart
+  // The last solve's grid where this rank holds it (its subdomain's nodes: where spheres are created);
+  // none yet after a restart
+  if (Stencil at = stencil_at(x); solved && inside && !flow.empty() && holds(at, brick)) {
+    place(at, brick);
+    read_point(at, flow, u);
+  }
   for (int c = 0; c < 3; ++c) velocity[i][c] = uniform[c] + u[c];
 }
 
@@ -774,8 +975,10 @@ int FixFluidFlow::maxsize_restart()
 
 double FixFluidFlow::memory_usage()
 {
-  const double grids = static_cast<double>(spread.size() + flow.size() + slab.size() + 3 * field[0].size() +
-                                           mirror_out.size() + mirror_in.size());
+  const double grids = static_cast<double>(spread.capacity() + flow.capacity() + slab.size() + 3 * field[0].size() +
+                                           mirror_out.size() + mirror_in.size() + sent.capacity() +
+                                           received.capacity()) +
+      static_cast<double>(bricks.nodes.capacity()) * sizeof(int) / sizeof(double);
   const double per_sphere = static_cast<double>(stencils.capacity()) * sizeof(Stencil) +
       static_cast<double>(forces.capacity() + fractions.capacity() + diameter.capacity() + speed.capacity() +
                           voidage.capacity() + per_speed.capacity()) * sizeof(double) +

@@ -75,12 +75,27 @@ class FixFluidFlow : public Fix {
   bool solved;           // velocity holds a solve (or was read from a restart)
   class FFT3d *fft;
   int plane_lo, plane_hi;         // this rank's planes of the transform grid
-  std::vector<int> plane_counts;  // doubles per rank in the reduce-scatter and the gather
-  std::vector<int> plane_offsets;
-  std::vector<double> spread;     // global force density, [k][j][i][c]
-  std::vector<double> slab;       // this rank's planes of it, then of the velocity
+  std::vector<int> first_plane;   // rank r's planes are first_plane[r] to first_plane[r + 1] - 1
+  std::vector<double> slab;       // this rank's planes of the force density, then of the velocity, [k][j][i][c]
   std::vector<double> field[3];   // this rank's planes, complex (re, im), one per component
-  std::vector<double> flow;       // global velocity on the grid, [k][j][i][c]
+  // The nodes of the transform grid a rank spreads onto and reads from: per axis, the global indices
+  // its spheres' kernels touch and those of its subdomain (where a sphere created between solves
+  // reads the last solve's flow); a brick of the grid, wrapped, with gaps where no sphere is near.
+  struct Brick {
+    std::vector<int> nodes[3];    // global indices held, increasing
+    std::vector<int> local[3];    // global index -> its place in nodes (-1: not held)
+    long size() const { return static_cast<long>(nodes[0].size() * nodes[1].size() * nodes[2].size()); }
+  };
+  // Every rank's node lists: rank r's along axis d are size[3 r + d] values of nodes from offset[3 r + d].
+  struct Bricks {
+    std::vector<int> size, offset, nodes;
+  };
+  Brick brick;                    // this rank's, at the last solve
+  Bricks bricks;
+  std::vector<double> spread;     // the force density on brick's nodes, [k][j][i][c]
+  std::vector<double> flow;       // the last solve's velocity on brick's nodes, [k][j][i][c]
+  std::vector<double> sent, received;    // planes in flight between bricks and slabs
+  std::vector<int> send_counts, send_offsets, recv_counts, recv_offsets;
   // The planes nzt - k (mod nzt) this rank needs for its planes k (the waves -k of its modes), to
   // tell the transforms of f_x and f_y apart when f_x + i f_y is transformed as one: which of its
   // own planes it sends (in order, counts and offsets per rank in doubles), and which of its
@@ -100,8 +115,8 @@ class FixFluidFlow : public Fix {
   double carry_start;        // and the grid's largest velocity at the first of them
   int reversals;             // solves in a row whose fluid velocities reversed and grew (check_stable)
   double reversal_growth;    // and how much the squared velocities grew over them
-  // A point's kernel on the transform grid: per axis, its nodes as offsets into the grid's arrays
-  // ([k][j][i][c]: 3 doubles per node, wrapped onto the periodic grid) and their weights.
+  // A point's kernel on the transform grid: per axis, its nodes (global indices wrapped onto the
+  // periodic grid, then offsets into a brick's values, [k][j][i][c]: place()) and their weights.
   struct Stencil {
     long node[3][sediment::FlowKernel::max_nodes];
     double w[3][sediment::FlowKernel::max_nodes];
@@ -123,9 +138,16 @@ class FixFluidFlow : public Fix {
   void separate_xy();
   void measure_self_flow();
   Stencil stencil_at(const double *x) const;
-  void spread_point(const Stencil &at, const double *force);
-  void read_point(const Stencil &at, double *u) const;
-  void add_mirror_image();
+  void build_brick(Brick &b, const std::vector<Stencil> &at, bool subdomain) const;
+  static bool holds(const Stencil &at, const Brick &b);
+  static void place(Stencil &at, const Brick &b);
+  int owner(int q) const;
+  void routes(int q, int to, bool mirror, bool &direct, bool &mirrored) const;
+  void gather_bricks(const Brick &b);
+  void sum_into_slabs(const Brick &b, const std::vector<double> &force, bool mirror);
+  void read_from_slabs(const Brick &b, std::vector<double> &velocity);
+  void spread_point(const Stencil &at, const double *force, std::vector<double> &density) const;
+  void read_point(const Stencil &at, const std::vector<double> &velocity, double *u) const;
   void sphere_forces();
   double sphere_force(int i, double *force) const;
 };
