@@ -4,7 +4,7 @@
 D) and `every N`, in four scenes unlike one another, each answer's change set beside the change of the
 same answer from one random draw of the scene to another (its own scatter).
 
-    /usr/bin/python3 benchmarks/flow_drift.py [--schedules "drift 0.02,drift 0.1,drift 0.5,every 10"]
+    /usr/bin/python3 benchmarks/flow_drift.py [--schedules "drift 0.02,drift 0.1,drift 0.2,drift 0.5,every 10"]
         [--ranks 1] [--scenes cloud,dense,suspension,column] [--fraction 1]
 
 Scenes (one rank, a few seconds each):
@@ -50,7 +50,7 @@ def run(deck: Path, variables: dict, ranks: int, cwd: Path) -> tuple[dict[str, f
 
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--schedules", default="drift 0.02,drift 0.1,drift 0.5,every 10")
+    parser.add_argument("--schedules", default="drift 0.02,drift 0.1,drift 0.2,drift 0.5,every 10")
     parser.add_argument("--ranks", type=int, default=1)
     parser.add_argument("--scenes", default=",".join(name for name, *_ in REGIMES))
     parser.add_argument("--fraction", type=float, default=1.0, help="of each scene's steps (a quick look)")

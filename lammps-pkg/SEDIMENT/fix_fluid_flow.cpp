@@ -103,8 +103,9 @@ FixFluidFlow::FixFluidFlow(LAMMPS *lmp, int narg, char **arg) :
   }
   if (drift_given && every_given)
     error->all(FLERR, "Fix fluid/flow: give 'every N' or 'drift D', not both (drift chooses the steps between solves)");
-  // By default the fix chooses the steps between solves: the flow is then never more than a tenth of a
-  // cell behind the spheres, which changes a scene's answers by 1e-4 or less (benchmarks/flow_drift.py)
+  // By default the fix chooses the steps between solves: the flow is then never more than a fifth of a
+  // cell (of the kernel's width) behind the spheres, which changed four scenes' answers by 5e-4 or
+  // less, a twelfth or less of their scatter between random draws (benchmarks/flow_drift.py)
   if (!every_given && !drift_given) drift_limit = DEFAULT_DRIFT;
   if (domain->dimension != 3) error->all(FLERR, "Fix fluid/flow requires a 3d simulation");
   if (!domain->xperiodic || !domain->yperiodic)

@@ -66,7 +66,7 @@ class FixFluidFlow : public Fix {
   double relax;          // u <- (1 - relax) u + relax u_solved
   double drift_limit;    // > 0: solve once the spheres may have moved this many cells since the last solve,
                          // or their largest speed has changed by this fraction
-  static constexpr double DEFAULT_DRIFT = 0.1;    // without every or drift
+  static constexpr double DEFAULT_DRIFT = 0.2;    // without every or drift
   double drift;          // cells the fastest sphere of each step has moved since the last solve, summed
   double solved_speed;   // the largest speed at the last solve
   sediment::StokesOperator stokes;
