@@ -69,6 +69,8 @@ class FixFluidFlow : public Fix {
   static constexpr double DEFAULT_DRIFT = 0.2;    // without every or drift
   double drift;          // cells the fastest sphere of each step has moved since the last solve, summed
   double solved_speed;   // the largest speed at the last solve
+  bool unsettled;        // the last solve changed the spheres' fluid velocities by more than drift_limit
+  double solved_uniform[3], solved_viscosity;    // the fluid's uniform velocity and viscosity at the last solve
   sediment::StokesOperator stokes;
   sediment::FlowKernel kernel;
   double **velocity;     // per atom: the fluid velocity its drag is taken against
@@ -108,6 +110,7 @@ class FixFluidFlow : public Fix {
   // Diagnostics of the last solve (compute_vector)
   enum { FX, FY, FZ, FLUX, PEAK, LEFT_OUT, SOLVES, NDIAG };
   double diag[NDIAG];
+  static constexpr int RESTART_VALUES = 9 + NDIAG;    // count, solved, drift, speed, unsettled, viscosity, uniform, diag
 
   bigint last_solve;         // the step of the last solve (-1: none yet in this fix)
   bool warned_carry;         // the warning that the flow carries spheres a cell between solves was given
@@ -130,6 +133,7 @@ class FixFluidFlow : public Fix {
 
   void solve();
   bool left_out(int i) const;
+  bool fluid_changed() const;
   double largest_speed() const;
   void check_stable(const double *change);
   void check_carry(double peak);

@@ -8,6 +8,7 @@ import tempfile
 from pathlib import Path
 
 import numpy as np
+import pytest
 
 from harness import HERE, G, check, report, run_deck
 
@@ -278,6 +279,57 @@ print "RESULT left_out $(f_flow[6]) peak $(f_flow[5])"
     assert 0 < out.results["peak"] < 0.01
 
 
+@check
+def flow_unmoved(np_ranks: int):
+    """What changes the flow without moving the spheres, under the default schedule (drift), which
+    otherwise watches their motion:
+    - the fluid given a uniform velocity between runs: spheres at rest in still water (no gravity)
+      take it at the next run's first step (the build before: they kept 0, and the fix never solved
+      again);
+    - spheres of the flow that no integrator moves (a fixed bed) in a stream: their drags depend on
+      the fluid velocity the last solve gave them, so the fix solves again while a solve changes it
+      by more than half the drift fraction. At relax 1 the lagged iteration diverges and stops with
+      the error naming relax, as with every 1; at relax 0.3 it comes within a tenth of the
+      converged disturbance (the build before: the bed's mean fluid velocity 0.00932 m/s after its one
+      solve, against 0.01077 solved every step)."""
+    moving = quartz_deck(boundary="p p p", side=4e-3, count=20, seed=2468,
+                         drag="fix drag all fluid/drag water law stokes", flow="grid 16 16 16", integrator="",
+                         run="""fix fall all gravity 0 vector 0 0 -1
+timestep 1e-3
+run 10
+fix water all fluid density 1000 viscosity 1e-3 velocity 0.01 0 0
+run 10
+print "RESULT vx $(vcm(all,x):%.17g) solves $(f_flow[7])"
+""")
+    bed = quartz_deck(boundary="p p p", side=2e-3, count=400, seed=97, drag="fix drag all fluid/drag water law stokes",
+                      flow="grid 16 16 16 ${schedule}", integrator="", run="""fix fall all gravity 0 vector 0 0 -1
+unfix step
+fix water all fluid density 1000 viscosity 1e-3 velocity 0.01 0 0
+compute ux all reduce ave f_flow[1]
+thermo_style custom step c_ux f_flow[7]
+timestep 1e-3
+run 60
+print "RESULT ux $(c_ux:%.17g) solves $(f_flow[7])"
+""")
+    with tempfile.TemporaryDirectory() as tmp:
+        tmp = Path(tmp)
+        (tmp / "moving.lmp").write_text(moving)
+        (tmp / "bed.lmp").write_text(bed)
+        stream = run_deck(tmp / "moving.lmp", {}, np_ranks, cwd=tmp).results
+        diverged = run_deck(tmp / "bed.lmp", {"schedule": ""}, np_ranks, expect_failure=True, cwd=tmp)
+        relaxed = run_deck(tmp / "bed.lmp", {"schedule": "relax 0.3"}, np_ranks, cwd=tmp).results
+        converged = run_deck(tmp / "bed.lmp", {"schedule": "relax 0.3 every 1"}, np_ranks, cwd=tmp).results
+    disturbance = converged["ux"] - 0.01
+    report(f"spheres at rest, the fluid given 0.01 m/s between runs: their mean velocity {stream['vx']:.6g} m/s after "
+           f"10 steps ({stream['solves']:.0f} solves); a fixed bed in a stream: relax 1 stopped "
+           f"({diverged.error.strip()[:60]}...), relax 0.3 mean fluid velocity {relaxed['ux']:.7g} m/s in "
+           f"{relaxed['solves']:.0f} solves, every step {converged['ux']:.7g} ({converged['solves']:.0f} solves)")
+    assert 0.009 < stream["vx"] <= 0.01
+    assert "the lagged flow is unstable at this time step; use relax" in diverged.text
+    assert abs(disturbance) > 1e-4 and abs(relaxed["ux"] - converged["ux"]) < 0.1 * abs(disturbance)
+    assert relaxed["solves"] < converged["solves"]
+
+
 def hard_sphere_suspension(n: int, phi: float, d: float, seed: int) -> tuple[np.ndarray, float]:
     """n spheres of diameter d at solid fraction phi in a periodic cube, placed one by one at random
     where they overlap none placed before (random sequential addition): positions and the side."""
@@ -349,14 +401,20 @@ def flow_restart(np_ranks: int):
         flow_data(tmp / "cloud.data", cloud_positions(400, (0.008, 0.008, 0.008), 0.003, 3), np.ones(400),
                   (0.016, 0.016, 0.016))
         common = {"data": tmp / "cloud.data", "restart": tmp / "flow.restart"}
-        run_deck("fluid_flow.lmp", {**common, "phase": "whole", "state": tmp / "whole.txt"}, np_ranks, cwd=tmp)
+        whole_run = run_deck("fluid_flow.lmp", {**common, "phase": "whole", "state": tmp / "whole.txt"}, np_ranks,
+                             cwd=tmp)
         run_deck("fluid_flow.lmp", {**common, "phase": "first"}, np_ranks, cwd=tmp)
-        run_deck("fluid_flow.lmp", {**common, "phase": "second", "state": tmp / "split.txt"}, np_ranks, cwd=tmp)
+        split_run = run_deck("fluid_flow.lmp", {**common, "phase": "second", "state": tmp / "split.txt"}, np_ranks,
+                             cwd=tmp)
         whole, split = np.loadtxt(tmp / "whole.txt", skiprows=9), np.loadtxt(tmp / "split.txt", skiprows=9)
     scale = np.abs(whole[:, 4:10]).max()
     diff = float(np.abs(whole[:, 1:] - split[:, 1:]).max())
-    report(f"flow restart: {len(whole)} spheres, split vs whole max difference {diff:.1e} (speeds up to {scale:.1e} m/s)")
+    report(f"flow restart: {len(whole)} spheres, split vs whole max difference {diff:.1e} (speeds up to {scale:.1e} m/s); "
+           f"the last solve's diagnostics {whole_run.results} and {split_run.results}")
     assert whole.shape == split.shape and diff <= 1e-12 * max(scale, 1e-3)
+    # the diagnostics of the last solve come back too (the default schedule need not solve again soon)
+    # (the net flux is round-off, which another decomposition's sums change)
+    assert split_run.results == pytest.approx(whole_run.results, rel=1e-9, abs=1e-12 * whole_run.results["peak"])
 
 
 @check(ranks=())

@@ -234,6 +234,7 @@ BAD_INPUT = [
     (FLOW + "fix u all fluid/flow f grid 8 8 8 brinkman -1", "Fix fluid/flow: brinkman resistance must be >= 0"),
     (FLOW + "fix u all fluid/flow f grid 8 8 8 every 0", "Fix fluid/flow: every count 0 must be from 1 to 1000000"),
     (FLOW + "fix u all fluid/flow f grid 8 8 8 drift -0.1", "Fix fluid/flow: drift must be finite and > 0"),
+    (FLOW + "fix u all fluid/flow f grid 8 8 8 drift 1", "Fix fluid/flow: drift 1 must be below 1"),
     (FLOW + "fix u all fluid/flow f grid 8 8 8 drift 0.1 every 4", "Fix fluid/flow: give 'every N' or 'drift D', not both"),
     (FLOW + "fix u all fluid/flow f grid 8 8 8 every 1 drift 0.1", "Fix fluid/flow: give 'every N' or 'drift D', not both"),
     (FLOW + "fix u all fluid/flow f grid 8 8 8 column 0 1e-3", "Fix fluid/flow: keyword 'column' closes the fluid at its"),
