@@ -96,6 +96,7 @@ FixNVESphereFluid::FixNVESphereFluid(LAMMPS *lmp, int narg, char **arg) :
   while (args.more()) {
     if (args.is("floor")) {
       args.need(2, "an axis and a coordinate");
+      if (floor_axis >= 0) args.fail("one floor per fix: a second floor would replace the first, not add to it");
       floor_axis = args.axis(1, "floor axis");
       if (floor_axis == 2 && domain->dimension == 2) args.fail("a floor along z in a 2d simulation");
       floor_level = args.number(2);

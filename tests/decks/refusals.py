@@ -160,6 +160,7 @@ BAD_INPUT = [
     ("fix f all fluid density 1000 viscosity 1e-3\nfix b all fluid/buoyancy f gravity f\nrun 0", "is a fix fluid, not a fix gravity"),
     ("fix n all nve/sphere/fluid extra", "unknown keyword 'extra' (expected floor)"),
     ("fix n all nve/sphere/fluid floor z", "'floor' needs an axis and a coordinate"),
+    ("fix n all nve/sphere/fluid floor x 0 floor z 0", "one floor per fix"),
     ("fix n all nve/sphere/fluid floor w 0", "floor axis must be x, y or z, not 'w'"),
     ("fix f all fluid density 1000 viscosity 1e-3\nfix b all fluid/buoyancy f mixture c_c", "'mixture' needs c_ID and the solid density"),
     ("fix f all fluid density 1000 viscosity 1e-3\nfix b all fluid/buoyancy f mixture c_c -5", "mixture solid density must be finite and > 0"),
