@@ -19,7 +19,6 @@ Scenes (one rank, a few seconds each):
 from __future__ import annotations
 
 import argparse
-import re
 import sys
 import tempfile
 from pathlib import Path
@@ -42,10 +41,7 @@ REGIMES = [
 
 def run(deck: Path, variables: dict, ranks: int, cwd: Path) -> tuple[dict[str, float], float]:
     out = run_batch(deck, variables, ranks=ranks, cwd=cwd)
-    line = next(line for line in out.text.splitlines() if line.startswith("RESULT "))
-    words = line.split()[1:]
-    loop = sum(float(t) for t in re.findall(r"^Loop time of (\S+)", out.text, re.M))
-    return {key: float(value) for key, value in zip(words[::2], words[1::2])}, loop
+    return out.results, sum(seconds for seconds, _ in out.loops)
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -193,7 +193,7 @@ void FixFluidFlow::init()
     for (int r = 0; r <= nprocs; ++r) first_plane[r] = static_cast<int>(static_cast<long>(r) * nzt / nprocs);
     plane_lo = first_plane[me];
     plane_hi = first_plane[me + 1] - 1;
-    plan_mirror_exchange(first_plane);
+    plan_mirror_exchange();
     const long mine = static_cast<long>(grid[0]) * grid[1] * (plane_hi - plane_lo + 1);
     slab.assign(3 * mine, 0.0);
     for (auto &f : field) f.assign(2 * mine, 0.0);
@@ -225,16 +225,13 @@ void FixFluidFlow::setup(int /*vflag*/)
     if (auto integrator = static_cast<FixNVESphereFluid *>(fix); integrator->has_floor()) floors.push_back(integrator);
   if (last_solve < 0) last_solve = update->ntimestep;    // a new fix, or one read from a restart
   // A run continues the flow it has (from the last run, or a restart): a new one starts from one solve.
-  if (!solved) {
-    const double keep = relax;
-    relax = 1.0;
-    solve();
-    relax = keep;
-    if (drift_limit > 0.0) solved_speed = largest_speed();
-  } else if (fluid_changed()) {    // given another uniform velocity or viscosity since the last solve
-    solve();
-    if (drift_limit > 0.0) solved_speed = largest_speed();
-  }
+  // A run whose fluid was given another uniform velocity or viscosity since the last solve solves too.
+  if (solved && !fluid_changed()) return;
+  const double keep = relax;
+  if (!solved) relax = 1.0;
+  solve();
+  relax = keep;
+  if (drift_limit > 0.0) solved_speed = largest_speed();
 }
 
 // Whether the fluid's uniform velocity or viscosity differs from the last solve's (fix fluid given
@@ -655,14 +652,11 @@ void FixFluidFlow::measure_self_flow()
 // first_plane[r] <= q < first_plane[r + 1]. Each rank sends its planes p, in increasing order, to
 // the rank that holds nzt - p (mod nzt); a receiver lists the same planes of each sender in the
 // same order, and so knows which of its own planes each one serves.
-void FixFluidFlow::plan_mirror_exchange(const std::vector<int> &first_plane)
+void FixFluidFlow::plan_mirror_exchange()
 {
   const int nprocs = comm->nprocs, me = comm->me;
   const int plane = 2 * grid[0] * grid[1];    // complex values
   auto mirror_of = [&](int q) { return (nzt - q) % nzt; };
-  auto owner = [&](int q) {
-    return static_cast<int>(std::upper_bound(first_plane.begin(), first_plane.end(), q) - first_plane.begin()) - 1;
-  };
   mirror_sent.clear();
   mirror_serves.clear();
   mirror_send_counts.assign(nprocs, 0);
@@ -748,13 +742,18 @@ void FixFluidFlow::transform_solve()
   }
 }
 
+bool FixFluidFlow::outside_column(const double *x) const
+{
+  return column && !(x[2] >= column_lo && x[2] < column_hi);
+}
+
 // Spheres the flow leaves out: outside the column, and those stopped on a floor of fix
 // nve/sphere/fluid (the deposit, whose weight the floor carries). Held there whatever the fluid does,
 // such a sphere's drag against the flow would only resist it, and a deposit's many resist it so
 // stiffly that the lagged flow diverges within a few solves of the first landings.
 bool FixFluidFlow::left_out(int i) const
 {
-  if (column && !(atom->x[i][2] >= column_lo && atom->x[i][2] < column_hi)) return true;
+  if (outside_column(atom->x[i])) return true;
   for (const FixNVESphereFluid *floor : floors)
     if (floor->at_rest_on_floor(i)) return true;
   return false;
@@ -937,10 +936,9 @@ void FixFluidFlow::set_arrays(int i)
   const double *uniform = now ? now->velocity() : at_rest;
   double u[3] = {0.0, 0.0, 0.0};
   const double *x = atom->x[i];
-  const bool inside = !column || (x[2] >= column_lo && x[2] < column_hi);
   // The last solve's grid where this rank holds it (its subdomain's nodes: where spheres are created);
   // none yet after a restart
-  if (Stencil at = stencil_at(x); solved && inside && !flow.empty() && holds(at, brick)) {
+  if (Stencil at = stencil_at(x); solved && !outside_column(x) && !flow.empty() && holds(at, brick)) {
     place(at, brick);
     read_point(at, flow, u);
   }
@@ -974,27 +972,24 @@ void FixFluidFlow::write_restart(FILE *fp)
 
 void FixFluidFlow::restart(char *buf)
 {
-  double first;
-  memcpy(&first, buf, sizeof(double));
-  if (first >= 0.0) {    // written before the fix kept its diagnostics and the fluid of its last solve
-    double state[4];
-    memcpy(state, buf, sizeof(state));
-    solved = state[0] != 0.0;
-    drift = state[1];
-    solved_speed = state[2];
+  // Files written before the fix kept its diagnostics and the fluid of its last solve hold 4 values:
+  // solved, drift, speed, solves (the first 0 or 1); its first run then solves again.
+  double state[RESTART_VALUES];
+  memcpy(state, buf, sizeof(double));
+  const bool before = state[0] >= 0.0;
+  if (!before && state[0] != -static_cast<double>(RESTART_VALUES))
+    error->all(FLERR, "Fix fluid/flow: the restart file holds {} values of its state, not {}: written by another "
+               "release", -state[0], static_cast<int>(RESTART_VALUES));
+  memcpy(state, buf, (before ? 4 : RESTART_VALUES) * sizeof(double));
+  const double *kept = before ? state : state + 1;    // solved, drift, speed
+  solved = kept[0] != 0.0;
+  drift = kept[1];
+  solved_speed = kept[2];
+  if (before) {
     diag[SOLVES] = state[3];
-    // unknown: the first run solves again
     solved_viscosity = std::numeric_limits<double>::quiet_NaN();
     return;
   }
-  if (first != -static_cast<double>(RESTART_VALUES))
-    error->all(FLERR, "Fix fluid/flow: the restart file holds {} values of its state, not {}: written by another "
-               "release", -first, static_cast<int>(RESTART_VALUES));
-  double state[RESTART_VALUES];
-  memcpy(state, buf, sizeof(state));
-  solved = state[1] != 0.0;
-  drift = state[2];
-  solved_speed = state[3];
   unsettled = state[4] != 0.0;
   solved_viscosity = state[5];
   std::copy_n(state + 6, 3, solved_uniform);

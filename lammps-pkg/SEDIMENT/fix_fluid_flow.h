@@ -132,13 +132,14 @@ class FixFluidFlow : public Fix {
   std::vector<double> diameter, speed, voidage, per_speed;    // sphere_forces' columns for the drag law
 
   void solve();
+  bool outside_column(const double *x) const;
   bool left_out(int i) const;
   bool fluid_changed() const;
   double largest_speed() const;
   void check_stable(const double *change);
   void check_carry(double peak);
   void transform_solve();
-  void plan_mirror_exchange(const std::vector<int> &first_plane);
+  void plan_mirror_exchange();
   void separate_xy();
   void measure_self_flow();
   Stencil stencil_at(const double *x) const;

@@ -23,10 +23,7 @@ CLOUD_DECK = HERE.parents[1] / "examples" / "falling_cloud" / "in.falling_cloud"
 
 
 def cloud_result(np_ranks: int, tmp: Path, **variables) -> dict:
-    out = run_deck(CLOUD_DECK, variables, np_ranks, cwd=tmp)
-    line = next(line for line in out.text.splitlines() if line.startswith("RESULT "))
-    words = line.split()[1:]
-    return {key: float(value) for key, value in zip(words[::2], words[1::2])}
+    return run_deck(CLOUD_DECK, variables, np_ranks, cwd=tmp).results
 
 
 @check
@@ -190,6 +187,15 @@ fix flow all fluid/flow water {flow}
 fix step all nve/sphere/fluid {integrator}
 {run}"""
 
+def run_with_state(deck: str, np_ranks: int):
+    """Runs `deck`, which writes a dump to ${state}: its output and the dump's rows."""
+    with tempfile.TemporaryDirectory() as tmp:
+        path = Path(tmp) / "scene.lmp"
+        path.write_text(deck)
+        out = run_deck(path, {"state": Path(tmp) / "state.txt"}, np_ranks, cwd=Path(tmp))
+        return out, np.loadtxt(Path(tmp) / "state.txt", skiprows=9)
+
+
 @check
 def flow_runaway(np_ranks: int):
     """A dense scene (3000 spheres of 100 um at 20 % solids, Richardson & Zaki, 9 cells a side) at a
@@ -233,11 +239,7 @@ run 100
 write_dump all custom ${state} id z f_flow[1] f_flow[2] f_flow[3] modify sort id format float %.17g
 print "RESULT outside $(f_flow[6]) peak $(f_flow[5])"
 """)
-    with tempfile.TemporaryDirectory() as tmp:
-        path = Path(tmp) / "outside.lmp"
-        path.write_text(deck)
-        out = run_deck(path, {"state": Path(tmp) / "state.txt"}, np_ranks, cwd=Path(tmp))
-        rows = np.loadtxt(Path(tmp) / "state.txt", skiprows=9)
+    out, rows = run_with_state(deck, np_ranks)
     outside = rows[rows[:, 1] < 1e-3]
     inside = rows[rows[:, 1] >= 1e-3]
     report(f"{len(outside)} spheres below the column (f_flow[6] {out.results['outside']:.0f}): largest fluid velocity "
@@ -265,11 +267,7 @@ run 30
 write_dump all custom ${state} id z vz f_flow[1] f_flow[2] f_flow[3] modify sort id format float %.17g
 print "RESULT left_out $(f_flow[6]) peak $(f_flow[5])"
 """)
-    with tempfile.TemporaryDirectory() as tmp:
-        path = Path(tmp) / "deposit.lmp"
-        path.write_text(deck)
-        out = run_deck(path, {"state": Path(tmp) / "state.txt"}, np_ranks, cwd=Path(tmp))
-        rows = np.loadtxt(Path(tmp) / "state.txt", skiprows=9)
+    out, rows = run_with_state(deck, np_ranks)
     resting = (rows[:, 1] == 5e-5) & (rows[:, 2] == 0.0)
     report(f"{resting.sum()} of {len(rows)} grains at rest on the floor (f_flow[6] {out.results['left_out']:.0f}): "
            f"fluid velocity there {np.abs(rows[resting, 3:]).max():.1e} m/s; largest on the grid at the end "
