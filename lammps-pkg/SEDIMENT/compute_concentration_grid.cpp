@@ -80,9 +80,7 @@ ComputeConcentrationGrid::ComputeConcentrationGrid(LAMMPS *lmp, int narg, char *
       args.need(1, "a width");
       smooth_width = args.positive(1, "smooth width");
     } else if (args.is("weight")) {
-      if (!args.has(1) || strncmp(args.text(1), "d_", 2) != 0 || !args.text(1)[2])
-        args.fail("'weight' needs a per-atom property d_NAME (fix property/atom d_NAME)");
-      weight_name = args.text(1) + 2;
+      weight_name = args.weight(1);
     } else if (args.is("every")) {
       args.need(1, "a number of steps");
       every = args.count(1, MAXSMALLINT);
@@ -159,29 +157,7 @@ void ComputeConcentrationGrid::init()
   }
   profiled_step = -1;
 
-  if (!weight_name.empty()) {
-    int is_double = 0, cols = 0;
-    weight_index = atom->find_custom(weight_name.c_str(), is_double, cols);
-    if (weight_index < 0 || !is_double || cols != 0)
-      error->all(FLERR, "Compute concentration/grid: weight d_{} is not a per-atom floating-point vector "
-                        "(define it with fix property/atom d_{})", weight_name, weight_name);
-    // A weight of zero (a data file cut before its weights, which then read as zero) would make
-    // grains vanish from every profile without a sign.
-    const double *weight = atom->dvector[weight_index];
-    bigint bad = 0, all_bad = 0;
-    tagint first = MAXTAGINT, all_first;
-    for (int i = 0; i < atom->nlocal; ++i)
-      if ((atom->mask[i] & groupbit) && !(weight[i] > 0.0 && std::isfinite(weight[i]))) {
-        ++bad;
-        first = std::min(first, atom->tag[i]);
-      }
-    MPI_Allreduce(&bad, &all_bad, 1, MPI_LMP_BIGINT, MPI_SUM, world);
-    MPI_Allreduce(&first, &all_first, 1, MPI_LMP_TAGINT, MPI_MIN, world);
-    if (all_bad > 0)
-      error->all(FLERR, "Compute concentration/grid: {} atoms have a weight d_{} that is not > 0 (atom {} the first): "
-                 "did the data file lose its weights section, or were they never set?", all_bad, weight_name,
-                 all_first);
-  }
+  if (!weight_name.empty()) weight_index = sediment_find_weights(lmp, weight_name, groupbit, "Compute concentration/grid");
 }
 
 // Extent of the cells along an axis the grid does not resolve: the box, or the 2d slab thickness.

@@ -49,7 +49,7 @@ static inline int wrap(int i, int n)
 
 FixFluidFlow::FixFluidFlow(LAMMPS *lmp, int narg, char **arg) :
     Fix(lmp, narg, arg), fluid_id(nullptr), fluid(nullptr), nzt(0), column(false), column_lo(0.0), column_hi(0.0),
-    relax(1.0), drift_limit(0.0), drift(0.0), solved_speed(0.0), unsettled(false), solved_viscosity(0.0), velocity(nullptr), solved(false), fft(nullptr),
+    relax(1.0), weight_index(-1), drift_limit(0.0), drift(0.0), solved_speed(0.0), unsettled(false), solved_viscosity(0.0), velocity(nullptr), solved(false), fft(nullptr),
     plane_lo(0), plane_hi(-1), last_solve(-1), warned_carry(false), carries(0), carry_start(0.0), reversals(0), reversal_growth(1.0)
 {
   if (narg < 8 || strcmp(arg[4], "grid") != 0)
@@ -100,8 +100,10 @@ FixFluidFlow::FixFluidFlow(LAMMPS *lmp, int narg, char **arg) :
         args.fail("drift {} must be below 1: it is both the cells the spheres may move and the fraction their "
                   "largest speed may change between solves, and a speed that drops to zero must count", drift_limit);
       drift_given = true;
+    } else if (args.is("weight")) {
+      weight_name = args.weight(1);
     } else {
-      args.unknown("grid, column, brinkman, width, relax, every or drift");
+      args.unknown("grid, column, brinkman, width, relax, weight, every or drift");
     }
     args.next(nvalues);
   }
@@ -168,6 +170,7 @@ void FixFluidFlow::init()
     error->all(FLERR, "Fix fluid/flow: fluid '{}' is a Bingham fluid; the flow is solved for a Newtonian one",
                fluid_id);
   stokes.viscosity = fluid->properties().viscosity;
+  if (!weight_name.empty()) weight_index = sediment_find_weights(lmp, weight_name, groupbit, "Fix fluid/flow");
 
   // The grid: cubic cells over the periodic box in x and y and the box or the column in z.
   for (int d = 0; d < 3; ++d) {
@@ -304,6 +307,7 @@ void FixFluidFlow::sphere_forces()
   FixFluidDrag *drag = drags.size() == 1 && drags.front()->immersed_everywhere() ? drags.front() : nullptr;
   if (!drag) {
     for (size_t s = 0; s < count; ++s) fractions[s] = sphere_force(spheres[s], &forces[3 * s]);
+    weigh_forces();
     return;
   }
   const FixFluidDrag::Immersed immersed = drag->immersed();
@@ -334,6 +338,22 @@ void FixFluidFlow::sphere_forces()
                                     static_cast<int>(count));
   for (size_t s = 0; s < count; ++s)
     for (int c = 0; c < 3; ++c) forces[3 * s + c] *= per_speed[s];
+  weigh_forces();
+}
+
+// A parcel of w grains placed independently of the other parcels (weight d_NAME) puts sqrt(w S(0))
+// times its grain's drag on the fluid: the parcels' force density then fluctuates as the real
+// grains' does (w grains' force per parcel, and w times fewer parcels, give a variance w times too
+// large), the real grains' fluctuation being S(0) times a random placement's, with S(0) of hard
+// spheres at the local fraction (docs/physics.md section 8, "Parcels").
+void FixFluidFlow::weigh_forces()
+{
+  if (weight_index < 0) return;
+  const double *weight = atom->dvector[weight_index];
+  for (size_t s = 0; s < spheres.size(); ++s) {
+    const double scale = sqrt(weight[spheres[s]] * sediment::hard_sphere_structure_factor(fractions[s]));
+    for (int c = 0; c < 3; ++c) forces[3 * s + c] *= scale;
+  }
 }
 
 // The kernel's nodes around x on each axis, wrapped onto the periodic transform grid (their global
@@ -815,8 +835,9 @@ void FixFluidFlow::solve()
 
   // Each sphere's fluid velocity: the uniform flow of fix fluid plus what the grid gives it, less what
   // its own force and its periodic images give it, S(0) times over in a suspension (the neighbours
-  // kept clear of it: what the hindrance law already holds; docs/physics.md section 8). relax acts
-  // on the grid's part; the uniform velocity is the fluid's, whatever it was at the last solve.
+  // kept clear of it: what the hindrance law already holds; docs/physics.md section 8), once for
+  // parcels (placed independently, no neighbour is kept clear of one). relax acts on the grid's
+  // part; the uniform velocity is the fluid's, whatever it was at the last solve.
   const double *uniform = fluid->velocity();
   // sums over the spheres: new . old, new . new, old . old, and the solve's residual, (target - old)^2
   double change[4] = {0.0, 0.0, 0.0, 0.0};
@@ -827,7 +848,7 @@ void FixFluidFlow::solve()
     const bool inside = s < spheres.size() && spheres[s] == i;    // else left out: the uniform flow
     if (inside) {
       read_point(stencils[s], flow, u);
-      const double own = sediment::hard_sphere_structure_factor(fractions[s]);
+      const double own = weight_index >= 0 ? 1.0 : sediment::hard_sphere_structure_factor(fractions[s]);
       for (int c = 0; c < 3; ++c) u[c] -= own * self_flow[c] * forces[3 * s + c];
       ++s;
     }

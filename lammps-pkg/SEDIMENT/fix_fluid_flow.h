@@ -22,6 +22,7 @@ FixStyle(fluid/flow,FixFluidFlow);
 
 #include "sediment/flow.hpp"
 
+#include <string>
 #include <vector>
 
 namespace LAMMPS_NS {
@@ -64,6 +65,8 @@ class FixFluidFlow : public Fix {
   bool column;           // closed in z: free slip at column_lo and column_hi
   double column_lo, column_hi;
   double relax;          // u <- (1 - relax) u + relax u_solved
+  std::string weight_name;    // per-atom property: the real grains each sphere (a parcel) stands for
+  int weight_index;
   double drift_limit;    // > 0: solve once the spheres may have moved this many cells since the last solve,
                          // or their largest speed has changed by this fraction
   static constexpr double DEFAULT_DRIFT = 0.2;    // without every or drift
@@ -154,6 +157,7 @@ class FixFluidFlow : public Fix {
   void spread_point(const Stencil &at, const double *force, std::vector<double> &density) const;
   void read_point(const Stencil &at, const std::vector<double> &velocity, double *u) const;
   void sphere_forces();
+  void weigh_forces();
   double sphere_force(int i, double *force) const;
 };
 

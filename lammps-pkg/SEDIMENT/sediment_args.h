@@ -8,6 +8,7 @@
 #ifndef LMP_SEDIMENT_ARGS_H
 #define LMP_SEDIMENT_ARGS_H
 
+#include "atom.h"
 #include "compute.h"
 #include "error.h"
 #include "fix.h"
@@ -16,6 +17,7 @@
 #include "sediment_lammps_api.h"
 #include "utils.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <initializer_list>
@@ -104,6 +106,13 @@ class StyleArgs {
     }
     fail("{} must be {}, not '{}'", arg[iarg], listed, arg[iarg + k]);
   }
+  // NAME of the k-th value d_NAME: a per-atom weight (fix property/atom d_NAME), found by sediment_find_weights.
+  std::string weight(int k) const
+  {
+    if (!has(k) || strncmp(arg[iarg + k], "d_", 2) != 0 || !arg[iarg + k][2])
+      fail("'{}' needs a per-atom property d_NAME (fix property/atom d_NAME)", arg[iarg]);
+    return arg[iarg + k] + 2;
+  }
   // 0, 1, 2 for x, y, z; `what` names the axis in the error ("floor axis").
   int axis(int k, const char *what) const
   {
@@ -162,6 +171,33 @@ inline Compute *sediment_find_compute(LAMMPS *lmp, const char *id, const std::st
   Compute *compute = sediment_compute_by_id(lmp->modify, name);
   if (!compute) lmp->error->all(FLERR, "{}: compute '{}' does not exist", caller, name);
   return compute;
+}
+
+// The index of the per-atom weight d_`name` (real spheres each atom stands for), checked > 0 and
+// finite on every atom of `groupbit`: a weight of zero (a data file cut before its weights, which
+// then read as zero) would make spheres vanish without a sign. `caller` names the style asking.
+inline int sediment_find_weights(LAMMPS *lmp, const std::string &name, int groupbit, const std::string &caller)
+{
+  Atom *atom = lmp->atom;
+  int is_double = 0, cols = 0;
+  const int index = atom->find_custom(name.c_str(), is_double, cols);
+  if (index < 0 || !is_double || cols != 0)
+    lmp->error->all(FLERR, "{}: weight d_{} is not a per-atom floating-point vector (define it with fix "
+                    "property/atom d_{})", caller, name, name);
+  const double *weight = atom->dvector[index];
+  bigint bad = 0, all_bad = 0;
+  tagint first = MAXTAGINT, all_first = 0;
+  for (int i = 0; i < atom->nlocal; ++i)
+    if ((atom->mask[i] & groupbit) && !(weight[i] > 0.0 && std::isfinite(weight[i]))) {
+      ++bad;
+      first = std::min(first, atom->tag[i]);
+    }
+  MPI_Allreduce(&bad, &all_bad, 1, MPI_LMP_BIGINT, MPI_SUM, lmp->world);
+  MPI_Allreduce(&first, &all_first, 1, MPI_LMP_TAGINT, MPI_MIN, lmp->world);
+  if (all_bad > 0)
+    lmp->error->all(FLERR, "{}: {} atoms have a weight d_{} that is not > 0 (atom {} the first): did the data file "
+                    "lose its weights section, or were they never set?", caller, all_bad, name, all_first);
+  return index;
 }
 
 }    // namespace LAMMPS_NS
