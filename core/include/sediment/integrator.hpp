@@ -156,11 +156,14 @@ class DragBlock {
   bool full() const { return size_ == capacity; }
   void clear() { size_ = 0; }
   // The law of every sphere of the block (a nonlinear one) and the velocity u of the fluid around
-  // them; set while the block is empty.
-  void set_law(const DragModel &model, const double u[3])
+  // them; set while the block is empty. `fluid_jumps`: each sphere's fluid velocity may have jumped
+  // since its last step (a fix fluid/flow's new solve), and a step whose start lies far from its end
+  // is taken again, linearised at its end (relinearize_at_end).
+  void set_law(const DragModel &model, const double u[3], bool fluid_jumps = false)
   {
     model_ = &model;
     keeps_for_pieces_ = !model.smooth();
+    fluid_jumps_ = fluid_jumps;
     for (int k = 0; k < 3; ++k) u_[k] = u[k];
   }
   const DragModel *law() const { return model_; }
@@ -277,11 +280,13 @@ class DragBlock {
   template <bool yield> void rates(const DragModel &model, double dt, BatchMath kind);
   void split_rates(const DragModel &model, double dt, BatchMath kind);
   void advance_all(double dt);
+  void relinearize_at_end(const DragModel &model, double dt, BatchMath kind);
   template <bool yield> void find_set_valued_points(const DragModel &model, double dt);
   void step_in_pieces(const DragModel &model, double dt);
 
   const DragModel *model_ = nullptr;
   bool keeps_for_pieces_ = false;    // the law has set-valued points
+  bool fluid_jumps_ = false;         // set_law
   int size_ = 0;
   // The last step's law has set-valued points, and some sphere's step met one (meets_point_, state_):
   // keeps_for_pieces_ && any_meets_point_, kept as one flag because correction() reads it per sphere
@@ -311,7 +316,8 @@ class DragBlock {
 
 // The step of a nonlinear law for one sphere (a block of one).
 StepCorrection nonlinear_step_initial(const SphereDrag &drag, double inverse_mass, const double a[3],
-                                      const double u[3], double dt, double v[3], double dx[3]);
+                                      const double u[3], double dt, double v[3], double dx[3],
+                                      bool fluid_jumps = false);
 
 // Which step a sphere's drag takes.
 enum class StepKind { Free, Linear, Smooth, SetValued };
@@ -363,7 +369,7 @@ inline StepCorrection linear_step_initial(const Phi &p, const double a[3], const
 // the caller's a_n).
 inline StepCorrection drag_step_initial(const SphereDrag &drag, double inverse_mass, const double a[3],
                                         const double u[3], double dt, double v[3], double dx[3],
-                                        double *memo = nullptr)
+                                        double *memo = nullptr, bool fluid_jumps = false)
 {
   if (!drag_acts(drag)) {
     for (int k = 0; k < 3; ++k) {
@@ -378,7 +384,7 @@ inline StepCorrection drag_step_initial(const SphereDrag &drag, double inverse_m
   const double linear = drag.model->linear_coefficient(drag.diameter, drag.scale);
   if (!(linear > 0.0)) {
     if (at_rest_under_yield(drag, v, u)) return set_valued_step_initial(drag, 1.0 / inverse_mass, a, u, dt, v, dx);
-    return nonlinear_step_initial(drag, inverse_mass, a, u, dt, v, dx);
+    return nonlinear_step_initial(drag, inverse_mass, a, u, dt, v, dx, fluid_jumps);
   }
   const double z = linear * inverse_mass * dt;
   return linear_step_initial(memo ? phis(z, memo) : phis(z), a, u, dt, v, dx);
