@@ -388,12 +388,13 @@ template <bool yield>
 // step from the law's terminal slip, off it by a share of the jump however many relaxation times the
 // step is (after a jump of 19 mm/s, 0.46 and 27 terminal slips for quartz grains of 67 and 2.6 um
 // under the standard curve: test AfterAFluidJumpTheStepEndsAtTheTerminalSlip), and the flow, solved
-// from the drag, feeds that back (parcels of a test's column ran away). So where the end's slip
-// differs by more than RELINEARIZE of itself from the slip the step was linearised at, the step is
-// taken again from the same start, linearised at that end, up to PASSES times: a Newton iteration of
-// the linearisation point. Along the point's direction the slip advances from the start's component
+// from the drag, feeds that back (parcels of a test's column ran away). So where the share of the
+// distance from the linearisation point that the step keeps, (z_along - z_across) / z_along of it, is
+// above RELINEARIZE of the end's slip, the step is taken again from the same start, linearised at that
+// end, up to PASSES times: a Newton iteration of the linearisation point. Along the point's direction the slip advances from the start's component
 // there, and the component across it decays at the secant rate. A sphere whose end lies near its
-// start steps once, to the bit as before; each sphere's arithmetic does not depend on the others.
+// start, or whose drag is linear in its slip around it (Stokes' regime), steps once, to the bit as
+// before; each sphere's arithmetic does not depend on the others.
 [[gnu::always_inline]] inline void DragBlock::relinearize_at_end(const DragModel &model, double dt, BatchMath kind)
 {
   constexpr double RELINEARIZE = 1e-3;
@@ -414,7 +415,11 @@ template <bool yield>
         gap += (end[k] - point[k][n]) * (end[k] - point[k][n]);
         size += end[k] * end[k];
       }
-      const std::int64_t far = (gap > RELINEARIZE * RELINEARIZE * size) & (size > 0.0);
+      // The step keeps about (z_along - z_across) / z_along of the distance from its linearisation point
+      // (nothing where the drag is linear in the slip there): a share above RELINEARIZE of the end's slip
+      // is taken again.
+      const double kept = (z_[0][n] - z_[1][n]) * (z_[0][n] - z_[1][n]) * gap;
+      const std::int64_t far = (kept > RELINEARIZE * RELINEARIZE * size * z_[0][n] * z_[0][n]) & (size > 0.0);
       any_far |= far;
       moved[n] |= far;
       const double inverse = 1.0 / std::sqrt(size);

@@ -23,7 +23,7 @@ using namespace LAMMPS_NS;
 using namespace FixConst;
 
 FixFluid::FixFluid(LAMMPS *lmp, int narg, char **arg) :
-    Fix(lmp, narg, arg), atom_flow(nullptr), has_surface(0), surface_offset(0.0), surface_variable(nullptr), surface_ivar(-1),
+    Fix(lmp, narg, arg), atom_flow(nullptr), flow_fix(nullptr), has_surface(0), surface_offset(0.0), surface_variable(nullptr), surface_ivar(-1),
     centre_crossing(false), prepared_step(-1), region_id(nullptr), region(nullptr)
 {
   flow[0] = flow[1] = flow[2] = 0.0;
@@ -136,11 +136,13 @@ void FixFluid::init()
   // The fix fluid/flow that gives this fluid its velocity, if any (looked up at every init: it may
   // have been unfixed since the last run).
   atom_flow = nullptr;
+  flow_fix = nullptr;
   for (Fix *fix : sediment_fixes_of_style(lmp, "fluid/flow")) {
-    auto flow_fix = static_cast<FixFluidFlow *>(fix);
-    if (strcmp(flow_fix->fluid_name(), id) != 0) continue;
+    auto flow = static_cast<FixFluidFlow *>(fix);
+    if (strcmp(flow->fluid_name(), id) != 0) continue;
     if (atom_flow) error->all(FLERR, "Fix fluid: two fix fluid/flow give fluid '{}' its velocity", id);
-    atom_flow = flow_fix->velocity_rows();
+    atom_flow = flow->velocity_rows();
+    flow_fix = flow;
   }
   if (surface_variable) {
     surface_ivar = input->variable->find(surface_variable);
@@ -181,4 +183,9 @@ sediment::Submergence FixFluid::bounded_immersion(const double *x, double radius
 FixFluid *FixFluid::find(LAMMPS *lmp, const char *fluid_id, const std::string &caller)
 {
   return sediment_find_fix<FixFluid>(lmp, fluid_id, "fluid", caller, "fluid");
+}
+
+bool FixFluid::flow_solved_at(bigint step) const
+{
+  return flow_fix && flow_fix->solved_at(step);
 }

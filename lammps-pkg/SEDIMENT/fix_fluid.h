@@ -46,6 +46,9 @@ class FixFluid : public Fix {
   // uniform paths read velocity(), and atom_velocities() where there is a fix fluid/flow).
   const double *velocity_at(int i) const { return atom_flow ? (*atom_flow)[i] : flow; }
   bool has_atom_flow() const { return atom_flow != nullptr; }
+  // Whether the fix fluid/flow solved at `step`: the per-atom velocity then jumped, and a drag step
+  // that starts from it may start far from where it ends (fix nve/sphere/fluid).
+  bool flow_solved_at(bigint step) const;
   // The fix fluid/flow's per-atom velocity rows, or nullptr: read once for a loop over the atoms (the
   // rows move when the atom arrays grow).
   double **atom_velocities() const { return atom_flow ? *atom_flow : nullptr; }
@@ -60,6 +63,7 @@ class FixFluid : public Fix {
   sediment::Fluid fluid;
   double flow[3];
   double **const *atom_flow;    // a fix fluid/flow's per-atom velocity rows (nullptr: none), set in init()
+  const class FixFluidFlow *flow_fix;    // and the fix itself
   int has_surface;
   double surface_normal[3];    // unit normal pointing out of the fluid
   double surface_offset;       // surface is {x : x . normal = offset}

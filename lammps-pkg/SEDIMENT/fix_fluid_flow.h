@@ -54,6 +54,8 @@ class FixFluidFlow : public Fix {
   const char *fluid_name() const { return fluid_id; }
   // The per-atom fluid velocity, as the address of the fix's row pointer (rows move when they grow).
   double **const *velocity_rows() const { return &velocity; }
+  // Whether the flow was solved at `step` (its per-atom velocity then jumped).
+  bool solved_at(bigint step) const { return last_solve == step; }
 
  private:
   char *fluid_id;

@@ -396,7 +396,7 @@ void FixNVESphereFluid::first_half(Lookup lookup)
                                    : sediment::steps_in_block(sphere, block_v, block_flow)) {
         if (sphere.model != block.law()) {    // a block per law, and so per fluid/drag fix and flow
           if (block.size() > 0) state += step_block();
-          block.set_law(*sphere.model, block_flow, atom_flow);
+          block.set_law(*sphere.model, block_flow, flow_jumped);
         }
         const int n = path == HalfStep::Smooth ? block.add_smooth(sphere, per_mass, a, block_v)
                                                 : block.add(sphere, per_mass, a, block_v);
@@ -405,7 +405,7 @@ void FixNVESphereFluid::first_half(Lookup lookup)
         continue;
       }
     }
-    state += finish(i, sediment::drag_step_initial(sphere, per_mass, a, flow, dt, v[i], dx, drag_memo_rows[i], atom_flow),
+    state += finish(i, sediment::drag_step_initial(sphere, per_mass, a, flow, dt, v[i], dx, drag_memo_rows[i], flow_jumped),
                     dx, spin_rate, per_mass);
   }
   if (blocks && block.size() > 0) state += step_block();
@@ -429,7 +429,7 @@ template <bool on_floor> void FixNVESphereFluid::first_half_immersed()
   const HalfKick kick = sediment::half_kick(dt, force->ftm2v);
 
   sediment::DragBlock block;
-  block.set_law(*immersed.model, flow, flow_rows != nullptr);    // a fix fluid/flow's velocity jumps at its solves
+  block.set_law(*immersed.model, flow, flow_jumped);
   int waiting[sediment::DragBlock::capacity];
   int size = 0;
   double state = 0.0;    // as in first_half; local sums: a store into the fix would alias the atom arrays
@@ -485,7 +485,11 @@ template <bool is_uniform, class Lookup> void FixNVESphereFluid::step_first_half
 
 void FixNVESphereFluid::initial_integrate(int /*vflag*/)
 {
-  for (FixFluidDrag *drag : drags) drag->prepare_step();
+  flow_jumped = false;
+  for (FixFluidDrag *drag : drags) {
+    drag->prepare_step();
+    flow_jumped |= drag->fluid_fix()->flow_solved_at(update->ntimestep - 1);
+  }
   counts.clear();
 
   if (drags.empty()) {    // every fluid effect off: fix nve/sphere's step, no per-atom bookkeeping

@@ -92,6 +92,7 @@ class FixNVESphereFluid : public Fix {
   enum class HalfStep { General, Blocked, Smooth, LinearOnFloor, Linear };
   HalfStep half_step;
   bool atom_flow = false;    // some drag's fluid has a per-atom velocity (fix fluid/flow): setup()
+  bool flow_jumped = false;  // and its fix fluid/flow solved at the last step: initial_integrate()
   bool reported_vectors = false;    // the log names the vector copy of the block step once
   double linear_per_diameter;    // c of the Linear step
   // The first half of the step for every atom of the group, with the drag found by lookup(i, sphere,

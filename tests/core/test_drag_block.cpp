@@ -154,8 +154,8 @@ TEST(DragBlock, AfterAFluidJumpTheStepEndsAtTheTerminalSlip)
 {
   // A grain at its terminal slip whose fluid velocity jumps by 19 mm/s (a fix fluid/flow's new solve)
   // starts its step with the jump as its slip. A step of 30 Stokes relaxation times ends at the
-  // terminal slip again, within 1e-6 of it (1e-13 to 1e-9 here), where fluid_jumps takes the step
-  // again linearised at its end. Linearised at the start alone it ends a Newton step away, off by a
+  // terminal slip again, within 1e-3 of it (1e-6 to 6e-5 here: the iteration stops once it keeps
+  // less than 1e-3), where fluid_jumps takes the step again linearised at its end. Linearised at the start alone it ends a Newton step away, off by a
   // share of the jump: 0.46 and 27 terminal slips for quartz of 67 and 2.6 um under the standard
   // curve, 0.52 and 84 under Dallavalle's, which the flow solved from the drag fed back until parcels
   // of a test's column ran away. Each sphere steps bit for bit as alone, after a jump too.
@@ -180,7 +180,7 @@ TEST(DragBlock, AfterAFluidJumpTheStepEndsAtTheTerminalSlip)
         off[fluid_jumps] = std::hypot(v[0] - jump[0] - terminal[0], v[1] - jump[1] - terminal[1],
                                       v[2] - jump[2] - terminal[2]) / speed;
       }
-      EXPECT_LT(off[1], 1e-6);
+      EXPECT_LT(off[1], 1e-3);
       EXPECT_GT(off[0], 0.1);    // the defect the second linearisation mends
     }
     expect_blocks_step_as_alone(model, block_spheres(model), 1e-4, [](BatchMath, const BlockSphere &, const BlockResult &) {},
