@@ -383,18 +383,17 @@ template <bool yield>
   any_meets_point_ = any;
 }
 
-// A sphere whose fluid velocity has jumped (a fix fluid/flow's new solve) starts its step with the
-// jump as its slip, far from where the slip ends. Linearised at the start, the step ends one Newton
-// step from the law's terminal slip, off it by a share of the jump however many relaxation times the
-// step is (after a jump of 19 mm/s, 0.46 and 27 terminal slips for quartz grains of 67 and 2.6 um
-// under the standard curve: test AfterAFluidJumpTheStepEndsAtTheTerminalSlip), and the flow, solved
-// from the drag, feeds that back (parcels of a test's column ran away). So where the share of the
-// distance from the linearisation point that the step keeps, (z_along - z_across) / z_along of it, is
-// above RELINEARIZE of the end's slip, the step is taken again from the same start, linearised at that
-// end, up to PASSES times: a Newton iteration of the linearisation point. Along the point's direction the slip advances from the start's component
-// there, and the component across it decays at the secant rate. A sphere whose end lies near its
-// start, or whose drag is linear in its slip around it (Stokes' regime), steps once, to the bit as
-// before; each sphere's arithmetic does not depend on the others.
+// A sphere whose fluid velocity has jumped (a fix fluid/flow's new solve) starts its step with the jump as its slip,
+// far from where the slip ends. Linearised at the start, the step ends one Newton step from the law's terminal slip,
+// off it by a share of the jump however many relaxation times the step is (after a jump of 19 mm/s, 0.46 and 27
+// terminal slips for quartz grains of 67 and 2.6 um under the standard curve: test
+// AfterAFluidJumpTheStepEndsAtTheTerminalSlip), and the flow, solved from the drag, feeds that back (parcels of a
+// test's column ran away). So where the share of the distance from the linearisation point that the step keeps,
+// (z_along - z_across) / z_along of it, is above RELINEARIZE of the end's slip, the step is taken again from the same
+// start, linearised at that end, up to PASSES times: a Newton iteration of the linearisation point. Along the point's
+// direction the slip advances from the start's component there, and the component across it decays at the secant rate.
+// A sphere whose end lies near its start, or whose drag is linear in its slip around it (Stokes' regime), steps once,
+// to the bit as before; each sphere's arithmetic does not depend on the others.
 [[gnu::always_inline]] inline void DragBlock::relinearize_at_end(const DragModel &model, double dt, BatchMath kind)
 {
   constexpr double RELINEARIZE = 1e-3;

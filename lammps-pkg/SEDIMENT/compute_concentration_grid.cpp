@@ -157,7 +157,8 @@ void ComputeConcentrationGrid::init()
   }
   profiled_step = -1;
 
-  if (!weight_name.empty()) weight_index = sediment_find_weights(lmp, weight_name, groupbit, "Compute concentration/grid");
+  if (!weight_name.empty())
+    weight_index = sediment_find_weights(lmp, weight_name, groupbit, "Compute concentration/grid");
 }
 
 // Extent of the cells along an axis the grid does not resolve: the box, or the 2d slab thickness.

@@ -405,7 +405,8 @@ void FixNVESphereFluid::first_half(Lookup lookup)
         continue;
       }
     }
-    state += finish(i, sediment::drag_step_initial(sphere, per_mass, a, flow, dt, v[i], dx, drag_memo_rows[i], flow_jumped),
+    state += finish(i,
+                    sediment::drag_step_initial(sphere, per_mass, a, flow, dt, v[i], dx, drag_memo_rows[i], flow_jumped),
                     dx, spin_rate, per_mass);
   }
   if (blocks && block.size() > 0) state += step_block();

@@ -99,8 +99,8 @@ void expect_same_bits(const BlockResult &a, const BlockResult &b)
 // its own (wherever it sits, whoever its neighbours are), also when the step is taken again after a
 // fluid's jump (fluid_jumps); check(kind, sphere, result) then checks each sphere's result in blocks.
 template <class Check>
-void expect_blocks_step_as_alone(const DragModel &model, const std::vector<BlockSphere> &spheres, double dt, Check check,
-                                 bool fluid_jumps = false)
+void expect_blocks_step_as_alone(const DragModel &model, const std::vector<BlockSphere> &spheres, double dt,
+                                 Check check, bool fluid_jumps = false)
 {
   for (const BatchMath kind : batch_math_kinds) {
     if (!batch_math_available(kind)) continue;
@@ -152,13 +152,13 @@ TEST(DragBlock, EachSphereStepsAsAloneAndAsTheNewtonStep)
 
 TEST(DragBlock, AfterAFluidJumpTheStepEndsAtTheTerminalSlip)
 {
-  // A grain at its terminal slip whose fluid velocity jumps by 19 mm/s (a fix fluid/flow's new solve)
-  // starts its step with the jump as its slip. A step of 30 Stokes relaxation times ends at the
-  // terminal slip again, within 1e-3 of it (1e-6 to 6e-5 here: the iteration stops once it keeps
-  // less than 1e-3), where fluid_jumps takes the step again linearised at its end. Linearised at the start alone it ends a Newton step away, off by a
-  // share of the jump: 0.46 and 27 terminal slips for quartz of 67 and 2.6 um under the standard
-  // curve, 0.52 and 84 under Dallavalle's, which the flow solved from the drag fed back until parcels
-  // of a test's column ran away. Each sphere steps bit for bit as alone, after a jump too.
+  // A grain at its terminal slip whose fluid velocity jumps by 19 mm/s (a fix fluid/flow's new solve) starts its step
+  // with the jump as its slip. A step of 30 Stokes relaxation times ends at the terminal slip again, within 1e-3 of
+  // it (1e-6 to 6e-5 here: the iteration stops once it keeps less than 1e-3), where fluid_jumps takes the step again
+  // linearised at its end. Linearised at the start alone it ends a Newton step away, off by a share of the jump: 0.46
+  // and 27 terminal slips for quartz of 67 and 2.6 um under the standard curve, 0.52 and 84 under Dallavalle's, which
+  // the flow solved from the drag fed back until parcels of a test's column ran away. Each sphere steps bit for bit
+  // as alone, after a jump too.
   const Fluid fluid{998.2, 1.002e-3, 0.0};
   for (const DragLaw law : {DragLaw::Standard, DragLaw::Dallavalle}) {
     const DragModel model(law, fluid);
@@ -170,7 +170,8 @@ TEST(DragBlock, AfterAFluidJumpTheStepEndsAtTheTerminalSlip)
       const SphereDrag drag{&model, d, {}};
       // the terminal slip: steps from rest in still fluid, where the slip hardly changes from one to the next
       double terminal[3] = {0.0, 0.0, 0.0}, dx[3];
-      for (int step = 0; step < 200; ++step) drag_step_final(drag_step_initial(drag, inverse_mass, a, zero, dt, terminal, dx), a, terminal);
+      for (int step = 0; step < 200; ++step)
+        drag_step_final(drag_step_initial(drag, inverse_mass, a, zero, dt, terminal, dx), a, terminal);
       const double jump[3] = {1.2e-2, 0.0, 1.5e-2};    // the first solve's swirls in a test's column
       const double speed = std::abs(terminal[2]);
       double off[2];
@@ -183,8 +184,8 @@ TEST(DragBlock, AfterAFluidJumpTheStepEndsAtTheTerminalSlip)
       EXPECT_LT(off[1], 1e-3);
       EXPECT_GT(off[0], 0.1);    // the defect the second linearisation mends
     }
-    expect_blocks_step_as_alone(model, block_spheres(model), 1e-4, [](BatchMath, const BlockSphere &, const BlockResult &) {},
-                                true);
+    expect_blocks_step_as_alone(
+        model, block_spheres(model), 1e-4, [](BatchMath, const BlockSphere &, const BlockResult &) {}, true);
   }
 }
 
