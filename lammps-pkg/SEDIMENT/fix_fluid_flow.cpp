@@ -893,6 +893,15 @@ void FixFluidFlow::check_carry(double peak)
     carries = 0;
     return;
   }
+  // Across half the periodic box or more in one solve, the flow has lost every sphere's place: the next
+  // steps would carry spheres past their ranks' subdomains, which LAMMPS reports as lost atoms. Where
+  // the fluid velocities reverse from solve to solve, check_stable names the lag's instability instead.
+  const int across = std::min(grid[0], grid[1]);
+  if (cells > 0.5 * across && reversals == 0)
+    error->all(FLERR, "Fix fluid/flow: the flow carries spheres {:.3g} cells between solves, more than half the box "
+               "across ({} cells; largest velocity on the grid {:.3g}, step {}): the scene runs away; take a smaller "
+               "timestep, a coarser grid, or solve more often (see the doc page)", cells, across, peak,
+               update->ntimestep);
   if (carries++ == 0) carry_start = peak;
   if (carries >= 4 && peak > 10.0 * carry_start)
     error->all(FLERR, "Fix fluid/flow: the flow has carried spheres a cell or more between each of the last {} solves "
