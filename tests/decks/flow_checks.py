@@ -75,13 +75,23 @@ def flow_drift(np_ranks: int):
     assert change < 1e-4
 
 
-def flow_data(path: Path, positions: np.ndarray, types: np.ndarray, box: tuple[float, float, float]) -> None:
+def sphere_data(path: Path, title: str, positions: np.ndarray, types: np.ndarray, type_count: int,
+                box: tuple[float, float, float], diameter: float, density: float, weight: float | None = None) -> None:
+    """A data file of spheres of one diameter and density in a box from the origin; with `weight`, a
+    Weights section giving each that many grains."""
     n = len(positions)
-    atoms = np.column_stack([np.arange(1, n + 1), types, np.full(n, 2e-4), np.full(n, 1100.0), positions])
+    atoms = np.column_stack([np.arange(1, n + 1), types, np.full(n, diameter), np.full(n, density), positions])
     with open(path, "w") as f:
-        f.write(f"settling cloud\n\n{n} atoms\n2 atom types\n\n0 {box[0]} xlo xhi\n0 {box[1]} ylo yhi\n"
+        f.write(f"{title}\n\n{n} atoms\n{type_count} atom types\n\n0 {box[0]} xlo xhi\n0 {box[1]} ylo yhi\n"
                 f"0 {box[2]} zlo zhi\n\nAtoms # sphere\n\n")
         np.savetxt(f, atoms, fmt=["%d", "%d", "%.17g", "%.17g", "%.17g", "%.17g", "%.17g"])
+        if weight is not None:
+            f.write("\nWeights\n\n")
+            np.savetxt(f, np.column_stack([np.arange(1, n + 1), np.full(n, weight)]), fmt=["%d", "%.17g"])
+
+
+def flow_data(path: Path, positions: np.ndarray, types: np.ndarray, box: tuple[float, float, float]) -> None:
+    sphere_data(path, "settling cloud", positions, types, 2, box, 2e-4, 1100.0)
 
 
 def cloud_positions(n: int, centre: tuple[float, float, float], radius: float, seed: int) -> np.ndarray:
@@ -205,9 +215,10 @@ def flow_runaway(np_ranks: int):
     and 0.36, when LAMMPS loses atoms on 2 ranks: the current LAMMPS reported them at step 6, before
     the tenfold growth over four solves that the fix stopped such runs at). The fix warns at the
     first such solve and stops the run once a solve carries the spheres across half the box: at
-    step 3 (5.3 cells of 9). Not a result gone wrong, nor atoms lost. At dt 2e-3 s it runs, unwarned. (At 20 % solids this scene ran away the same way until the
-    drag step took a jump of the fluid's velocity whole, DragBlock::relinearize_at_end; it now stays
-    near 0.02 m/s, warned, until the flow's 1.7 cells a step lose atoms at step 10.)"""
+    step 3 (5.3 cells of 9). Not a result gone wrong, nor atoms lost. At dt 2e-3 s it runs, unwarned.
+    (At 20 % solids this scene ran away the same way until the drag step took a jump of the fluid's
+    velocity whole, DragBlock::relinearize_at_end; it now stays near 0.02 m/s, warned, until the
+    flow's 1.7 cells a step lose atoms at step 10.)"""
     deck = quartz_deck(boundary="p p p", side=2e-3, count=6000, seed=777,
                        drag="compute conc all concentration/grid layers z 1\n"
                             "fix drag all fluid/drag water law stokes hindrance richardson-zaki concentration c_conc",
@@ -359,14 +370,7 @@ def hard_sphere_suspension(n: int, phi: float, d: float, seed: int) -> tuple[np.
 
 def suspension_data(path: Path, positions: np.ndarray, side: float, d: float, weight: float = 1.0) -> None:
     """A data file of quartz spheres of diameter d in a periodic cube, each standing for `weight` grains."""
-    n = len(positions)
-    atoms = np.column_stack([np.arange(1, n + 1), np.ones(n), np.full(n, d), np.full(n, 2650.0), positions])
-    with open(path, "w") as f:
-        f.write(f"suspension\n\n{n} atoms\n1 atom types\n\n0 {side} xlo xhi\n0 {side} ylo yhi\n"
-                f"0 {side} zlo zhi\n\nAtoms # sphere\n\n")
-        np.savetxt(f, atoms, fmt=["%d", "%d", "%.17g", "%.17g", "%.17g", "%.17g", "%.17g"])
-        f.write("\nWeights\n\n")
-        np.savetxt(f, np.column_stack([np.arange(1, n + 1), np.full(n, weight)]), fmt=["%d", "%.17g"])
+    sphere_data(path, "suspension", positions, np.ones(len(positions)), 1, (side, side, side), d, 2650.0, weight)
 
 
 @check
