@@ -350,9 +350,10 @@ void FixFluidFlow::weigh_forces()
 {
   if (weight_index < 0) return;
   const double *weight = atom->dvector[weight_index];
+  scales.resize(spheres.size());
   for (size_t s = 0; s < spheres.size(); ++s) {
-    const double scale = sqrt(weight[spheres[s]] * sediment::hard_sphere_structure_factor(fractions[s]));
-    for (int c = 0; c < 3; ++c) forces[3 * s + c] *= scale;
+    scales[s] = sqrt(weight[spheres[s]] * sediment::hard_sphere_structure_factor(fractions[s]));
+    for (int c = 0; c < 3; ++c) forces[3 * s + c] *= scales[s];
   }
 }
 
@@ -647,12 +648,28 @@ void FixFluidFlow::read_point(const Stencil &at, const std::vector<double> &velo
 // width outgrows on coarse grids.
 void FixFluidFlow::measure_self_flow()
 {
+  // A unit force at a node, alone on the transform grid (no mirror image): read where it is, its own
+  // flow with its periodic images; read along z from it, in a closed column, the flow its mirror image
+  // gives a sphere at each distance from the bottom or top (the image of a sphere at height z lies
+  // 2 (z - zlo) below it, and modulo the transform's height, 2 (zhi - z) above: one image).
   const double at[3] = {origin[0] + 0.5 * spacing[0], origin[1] + 0.5 * spacing[1], origin[2] + 0.5 * spacing[2]};
-  std::vector<Stencil> unit(comm->me == 0 ? 1 : 0, stencil_at(at));    // spread and read on rank 0
+  const int reads = column ? IMAGE_STEPS * grid[2] + 1 : 1;
+  std::vector<Stencil> unit, read;
+  if (comm->me == 0) {    // spread and read on rank 0
+    unit.push_back(stencil_at(at));
+    for (int j = 0; j < reads; ++j) {
+      const double point[3] = {at[0], at[1], at[2] + spacing[2] * j / IMAGE_STEPS};
+      read.push_back(stencil_at(point));
+    }
+  }
+  std::vector<Stencil> both(unit);
+  both.insert(both.end(), read.begin(), read.end());
   Brick b;
-  build_brick(b, unit, false);
+  build_brick(b, both, false);
   gather_bricks(b);
   for (Stencil &s : unit) place(s, b);
+  for (Stencil &s : read) place(s, b);
+  image_flow.assign(3 * reads, 0.0);
   std::vector<double> force, velocity;
   for (int c = 0; c < 3; ++c) {
     force.assign(3 * b.size(), 0.0);
@@ -662,10 +679,28 @@ void FixFluidFlow::measure_self_flow()
     sum_into_slabs(b, force, false);
     transform_solve();
     read_from_slabs(b, velocity);
-    for (const Stencil &s : unit) read_point(s, velocity, u);
-    self_flow[c] = u[c];
+    for (size_t j = 0; j < read.size(); ++j) {
+      read_point(read[j], velocity, u);
+      // the image's force: the same along x and y, reversed along z (free slip)
+      image_flow[3 * j + c] = (c == 2 ? -1.0 : 1.0) * u[c];
+    }
+    if (comm->me == 0) self_flow[c] = image_flow[c] * (c == 2 ? -1.0 : 1.0);
   }
   MPI_Bcast(self_flow, 3, MPI_DOUBLE, 0, world);
+  MPI_Bcast(image_flow.data(), 3 * reads, MPI_DOUBLE, 0, world);
+}
+
+// The flow per unit force that the mirror image of a sphere at height z gives it back, per axis (a
+// closed column only): interpolated in the table of measure_self_flow by the separation of the two.
+void FixFluidFlow::image_flow_at(double z, double *u) const
+{
+  const double steps = 2.0 * (z - origin[2]) / spacing[2], period = nzt;
+  double s = steps - period * std::floor(steps / period);
+  s = IMAGE_STEPS * std::min(s, period - s);
+  const int last = IMAGE_STEPS * grid[2];
+  const int j = std::min(static_cast<int>(s), last - 1);
+  const double t = std::min(s - j, 1.0);
+  for (int c = 0; c < 3; ++c) u[c] = (1.0 - t) * image_flow[3 * j + c] + t * image_flow[3 * (j + 1) + c];
 }
 
 // Which planes go where for separate_xy: plane q of the transform lies on the rank r with
@@ -850,6 +885,13 @@ void FixFluidFlow::solve()
       read_point(stencils[s], flow, u);
       const double own = weight_index >= 0 ? 1.0 : sediment::hard_sphere_structure_factor(fractions[s]);
       for (int c = 0; c < 3; ++c) u[c] -= own * self_flow[c] * forces[3 * s + c];
+      // A parcel's mirror image, like the parcel, stirs the fluid with sqrt(w S(0)) grains' force; the
+      // parcel moves as one grain and meets one grain's image (docs/physics.md section 8, Parcels).
+      if (column && weight_index >= 0 && scales[s] > 1.0) {
+        double image[3];
+        image_flow_at(x[i][2], image);
+        for (int c = 0; c < 3; ++c) u[c] -= (1.0 - 1.0 / scales[s]) * image[c] * forces[3 * s + c];
+      }
       ++s;
     }
     for (int c = 0; c < 3; ++c) {

@@ -112,6 +112,10 @@ class FixFluidFlow : public Fix {
   std::vector<double> mirror_out, mirror_in;
   double origin[3], spacing[3], length[3];
   double self_flow[3];    // per axis: the flow a unit force gives back where it is spread (images too)
+  // A closed column: per axis, the flow a unit force's mirror image gives back at its source, by their
+  // separation along z in steps of 1 / IMAGE_STEPS cell, 0 to the column's height ([separation][axis])
+  std::vector<double> image_flow;
+  static constexpr int IMAGE_STEPS = 8;
   // Diagnostics of the last solve (compute_vector)
   enum { FX, FY, FZ, FLUX, PEAK, LEFT_OUT, SOLVES, NDIAG };
   double diag[NDIAG];
@@ -134,6 +138,7 @@ class FixFluidFlow : public Fix {
   std::vector<int> spheres;
   std::vector<Stencil> stencils;
   std::vector<double> forces, fractions;
+  std::vector<double> scales;    // with weight: each force's factor sqrt(w S(0)) (weigh_forces)
   std::vector<double> diameter, speed, voidage, per_speed;    // sphere_forces' columns for the drag law
 
   void solve();
@@ -147,6 +152,7 @@ class FixFluidFlow : public Fix {
   void plan_mirror_exchange();
   void separate_xy();
   void measure_self_flow();
+  void image_flow_at(double z, double *u) const;
   Stencil stencil_at(const double *x) const;
   void build_brick(Brick &b, const std::vector<Stencil> &at, bool subdomain) const;
   static bool holds(const Stencil &at, const Brick &b);
