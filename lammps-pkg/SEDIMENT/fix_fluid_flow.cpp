@@ -802,15 +802,20 @@ bool FixFluidFlow::outside_column(const double *x) const
   return column && !(x[2] >= column_lo && x[2] < column_hi);
 }
 
-// Spheres the flow leaves out: outside the column, and those stopped on a floor of fix
-// nve/sphere/fluid (the deposit, whose weight the floor carries). Held there whatever the fluid does,
-// such a sphere's drag against the flow would only resist it, and a deposit's many resist it so
-// stiffly that the lagged flow diverges within a few solves of the first landings.
+// Spheres the flow leaves out: outside the column, those stopped on a floor of fix nve/sphere/fluid
+// (the deposit, whose weight the floor carries), and those whose local fraction is past their
+// hindrance's cap (max_fraction, random close packing by default): a bed, which grains without
+// contacts only reach piled on the floor. Held there whatever the fluid does, such a sphere's drag
+// against the flow would only resist it, and a deposit's many resist it so stiffly that the lagged
+// flow diverges within a few solves of the first landings; a bed's, capped, hold its spheres to the
+// fluid, which they then stir as a suspension far denser than the bed (docs/physics.md section 8).
 bool FixFluidFlow::left_out(int i) const
 {
   if (outside_column(atom->x[i])) return true;
   for (const FixNVESphereFluid *floor : floors)
     if (floor->at_rest_on_floor(i)) return true;
+  for (const FixFluidDrag *drag : drags)
+    if (drag->fraction_capped(i)) return true;
   return false;
 }
 
