@@ -35,6 +35,12 @@ def drag_laws() -> list:
 def explicit_step_limit(law: str, density: float, viscosity: float, yield_stress: float, d: float, particle_density: float, speed: float = ...) -> float:
     """Largest step [s] at which explicit drag is stable at a slip speed (2 tau for Stokes)."""
 
+def fft_friendly(n: int) -> bool:
+    """Whether n is a grid size the FFTs of fix fluid/flow take (no prime factor but 2, 3 and 5)."""
+
+def hard_sphere_structure_factor(phi: float) -> float:
+    """The long-wave structure factor S(0) of hard spheres at solid fraction phi (Carnahan & Starling)."""
+
 def hertz_contact_frequency(impact: str, diameter: float, density: float, youngs_modulus: float, poisson_ratio: float, overlap: float) -> float:
     """Angular frequency [1/s] of a Hertz contact linearised at `overlap` ('wall' or 'pair')."""
 

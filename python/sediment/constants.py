@@ -63,3 +63,10 @@ def __getattr__(name: str):
         from . import _core
         return getattr(_core, name)
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+# The swirls settling grains drive (Segre, Herbolzheimer & Chaikin 1997, PRL 79 2574, dilute spheres,
+# phi <= 0.05): vertical velocity fluctuations of SWIRL_SPEED phi^1/3 times the mean settling speed,
+# correlated over 2 xi = SWIRL_LENGTH a phi^-1/3 (a the radius). The planner's screening estimates
+# what they change from these; `sediment sample --two-way` makes its column some swirls wide.
+SWIRL_SPEED = 2.0      # times phi^1/3, of the mean settling speed
+SWIRL_LENGTH = 40.0    # times a phi^-1/3

@@ -3,6 +3,7 @@
 // into a Python LAMMPS through the styles library (sediment.sim.styles).
 
 #include "sediment/drag.hpp"
+#include "sediment/flow.hpp"
 #include "sediment/geometry.hpp"
 #include "sediment/integrator.hpp"
 #include "sediment/terminal.hpp"
@@ -258,6 +259,11 @@ PYBIND11_MODULE(_core, m)
 
   m.def("rayleigh_time", &rayleigh_time, py::arg("radius"), py::arg("density"), py::arg("youngs_modulus"),
         py::arg("poisson_ratio"), "Rayleigh time [s].");
+
+  m.def("hard_sphere_structure_factor", &hard_sphere_structure_factor, py::arg("phi"),
+        "The long-wave structure factor S(0) of hard spheres at solid fraction phi (Carnahan & Starling).");
+  m.def("fft_friendly", &fft_friendly, py::arg("n"),
+        "Whether n is a grid size the FFTs of fix fluid/flow take (no prime factor but 2, 3 and 5).");
 
   const auto impact_of = [](const std::string &name) {
     if (name == "wall") return Impact::Wall;

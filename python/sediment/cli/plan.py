@@ -70,6 +70,11 @@ def add_parser(commands) -> argparse.ArgumentParser:
     test.add_argument("--contact-cut", type=quantity("contact_cut"), metavar="UM",
                       help="smallest grain of the reduced scene [um] (default a third of the largest: smaller "
                       "grains meet larger ones with an interception efficiency below 9 %%)")
+    test.add_argument("--measure-flow", action="store_true",
+                      help="also measure what two-way coupling changes: the test's column of parcels three swirls "
+                      "wide under fix fluid/flow and its one-way twin, --flow-seeds draws, written to OUT/flow.csv "
+                      "and flow.json (minutes to an hour per draw on one core; docs/effects.md section 3)")
+    test.add_argument("--flow-seeds", type=count, default=3, help="draws of --measure-flow (default 3)")
     deck = parser.add_argument_group("deck")
     deck.add_argument("--observe", nargs="+", metavar="NAME", help="RESULT or SERIES names the deck prints")
     deck.add_argument("--ladder", type=_ladder, action="append", metavar="NAME=V1,V2",
@@ -129,6 +134,8 @@ def run(args: argparse.Namespace) -> int:
             _print_screens(scene.screens)
             if args.measure_contacts:
                 _measure_contacts(test, args, tolerance)
+            if args.measure_flow:
+                _measure_flow(test, args, tolerance, options)
             return 0
     pin(scene, dict(args.set or []))
     plan = plan_effects(scene, args.out, tolerance, args.jobs, args.seed if args.deck is None else 1,
@@ -137,7 +144,58 @@ def run(args: argparse.Namespace) -> int:
     print(f"the chosen scene: {args.final_out / 'decision'}")
     if args.deck is None and args.measure_contacts:
         _measure_contacts(test, args, tolerance)
+    if args.deck is None and args.measure_flow:
+        _measure_flow(test, args, tolerance, options)
     return 0
+
+
+def _measure_flow(test, args: argparse.Namespace, tolerance: float, options: dict) -> None:
+    """Runs --flow-seeds draws of the two-way column and its twin, --jobs at once, one bar each."""
+    import json
+    import sys
+
+    from ..planner.flow import flow_scene, measure_draw, measure_flow
+    from ..planner.scenes import prepare
+    from ..results import write_text
+    from ..sim.process import Runs
+
+    seeds = [args.seed + k for k in range(args.flow_seeds)]
+    options = {k: v for k, v in options.items() if k != "width"}    # the column's width is the swirls'
+    first = flow_scene(test, seeds[0], **options)
+    across, tall = first.flow_grid()
+    print(f"measuring two-way coupling: a column {first.width * 1e3:.3g} mm wide ({across} x {across} x {tall} cells), "
+          f"{len(first.diameter)} parcels, {sum(n for _, n in first.stages())} steps, and its one-way twin, "
+          f"{len(seeds)} draws ({min(args.jobs, len(seeds))} at once) ...", flush=True)
+    running = Runs()
+    folder = prepare(args.out / "flow")
+    bars = {seed: progress_bar(total=1, desc=f"two-way seed {seed}", unit="step", position=k, file=sys.stderr,
+                               dynamic_ncols=True, mininterval=0.5) for k, seed in enumerate(seeds)}
+
+    def draw(test, scene, where):
+        bar = bars[scene.seed]
+
+        def update(done: int, total: int) -> None:
+            bar.total = total
+            bar.update(done - bar.n)
+        return measure_draw(test, scene, where, running=running, on_progress=update)
+
+    try:
+        measured = measure_flow(test, seeds, folder, jobs=args.jobs, running=running, draw=draw, **options)
+    finally:
+        for bar in bars.values():
+            bar.close()
+    table = measured.table()
+    print(table.text(), end="")
+    name, at, change, error = measured.largest()
+    verdict = measured.verdict(tolerance)
+    print(f"two-way coupling moves the {name} reading at {at / 60:.3g} min by {change:+.3g} +- {error:.2g} pp "
+          f"(tolerance {tolerance:g}): the one-way assumption {verdict}")
+    write_text(args.out / "flow.csv", table.csv())
+    write_text(args.out / "flow.json", json.dumps({
+        "seeds": seeds, "width_m": first.width, "grid": [across, across, tall], "parcels": len(first.diameter),
+        "loop_seconds": measured.loop_seconds, "largest": {"instrument": name, "time_s": at, "change_pp": change,
+                                                            "standard_error_pp": error},
+        "tolerance_pp": tolerance, "verdict": verdict}, indent=2) + "\n")
 
 
 def _measure_contacts(test, args: argparse.Namespace, tolerance: float) -> None:

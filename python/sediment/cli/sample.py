@@ -36,6 +36,9 @@ def add_parser(commands) -> argparse.ArgumentParser:
                         "5.1), difelice, none (drag difelice carries its own)")
     parser.add_argument("--contacts", action="store_true", help="Hertz contacts between grains and with the floor")
     parser.add_argument("--lubrication", action="store_true", help="squeeze-film lubrication (with contacts)")
+    parser.add_argument("--two-way", action="store_true",
+                        help="two-way coupling: the flow the grains drive (fix fluid/flow), in a column three swirls "
+                        "wide with parcels placed independently; the deck's `-var flow no` runs its one-way twin")
     parser.add_argument("--courant", type=positive, default=4.0,
                         help="layers the fastest grain in suspension may cross per step (default 4: within 0.25 "
                         "points of percent finer of Courant 1 for the five samples of docs/effects.md)")
@@ -89,7 +92,7 @@ def effects_of(args: argparse.Namespace, contacts: bool = False, lubrication: bo
         raise ValueError("--drag difelice is Dallavalle's curve with Di Felice's hindrance (Bravo et al.): it takes no "
                          f"--hindrance {args.hindrance}; for that hindrance choose --drag dallavalle or standard")
     hindrance = args.hindrance or ("difelice" if args.drag == "difelice" else "richardson-zaki")
-    return Effects(args.drag, contacts, lubrication, hindrance)
+    return Effects(args.drag, contacts, lubrication, hindrance, flow=args.two_way)
 
 
 def cylinder_of(args: argparse.Namespace):

@@ -18,7 +18,7 @@ from typing import Callable
 import numpy as np
 
 from .. import _core
-from ..constants import BOLTZMANN, INSTRUMENTS, LAB_TEMPERATURE, PIPETTE_DEPTH, SPECIMEN_MASS
+from ..constants import BOLTZMANN, INSTRUMENTS, LAB_TEMPERATURE, PIPETTE_DEPTH, SPECIMEN_MASS, SWIRL_LENGTH, SWIRL_SPEED
 from ..lab.granulometry import read_all
 from ..lab.instruments import instrument
 from ..lab.psd import PSD, log_classes
@@ -31,12 +31,6 @@ BED_PACKING = 0.6             # solid fraction of a settled silt bed (random loo
 FILM_REBOUND_STOKES = 10.0    # approach Stokes number below which a squeeze film stops a rebound (Gondret et al. 2002)
 
 INCLUDE, OMIT, MEASURE, REPORT = "include", "omit", "measure", "report only"
-
-# The swirls the grains drive (Segre, Herbolzheimer & Chaikin 1997, PRL 79 2574, dilute spheres,
-# phi <= 0.05): vertical velocity fluctuations of 2.0 phi^1/3 times the mean settling speed, correlated
-# over 2 xi = 40 a phi^-1/3. A grain crossing them diffuses vertically by about D = dV 2 xi.
-SWIRL_SPEED = 2.0      # times phi^1/3, of the mean settling speed
-SWIRL_LENGTH = 40.0    # times a phi^-1/3
 
 # Estimated changes at most OMIT_BELOW x tolerance are dropped without a run; at least INCLUDE_ABOVE x
 # tolerance are kept without one: a margin of four either way on estimates that came within 10 % of
@@ -290,8 +284,9 @@ def screen(test: SedimentationTest, tolerance: float = 0.5) -> list[Screen]:
                           f"1997), which spread each class's arrival at {100 * PIPETTE_DEPTH:g} cm by up to "
                           f"{100 * widest:.2g} % of its fall and move a reading by up to {change:.3g} pp "
                           "(an upper estimate)"
-                          + ("; not simulated: the planner's sub-volume is two grains across, too narrow for the "
-                             "swirls (fix fluid/flow resolves them in a column of real grains)" if coupled else "")))
+                          + ("; not simulated in the planner's sub-volume, two grains across and too narrow for the "
+                             "swirls: --measure-flow measures it in a column of parcels three swirls wide under fix "
+                             "fluid/flow, against its one-way twin" if coupled else "")))
 
     screens.append(Screen("yield", "yield stress (Bingham)", "yield number tau_y / (drho g d)", 0.0, 0.0, OMIT,
                           "water is Newtonian: the yield machinery is never needed"))

@@ -17,7 +17,7 @@ import numpy as np
 
 from .. import _core
 from ..constants import (BRAVO_CYLINDER_HEIGHT, BRAVO_CYLINDER_WIDTH, D422_CYLINDER_AREA, D422_CYLINDER_HEIGHT,
-                         DRAGS, HINDRANCES, SPECIMEN_MASS)
+                         DRAGS, HINDRANCES, SPECIMEN_MASS, SWIRL_LENGTH)
 from ..lab.psd import PSD, SizeClasses, discretise
 from ..lab.readout import Suspension
 from ..lab.settling import terminal_speed
@@ -57,6 +57,8 @@ class Effects:
     # "mixture": buoyancy from the local suspension density on top of the hindrance's plain-buoyancy form,
     # as some models take a measured exponent (the error budget's row; docs/physics.md 3)
     buoyancy: str = "plain"
+    # two-way coupling: the flow the grains drive (fix fluid/flow), in a column FLOW_SWIRLS swirls wide
+    flow: bool = False
 
     def __post_init__(self) -> None:
         if self.buoyancy not in ("plain", "mixture"):
@@ -77,9 +79,10 @@ class Effects:
 
     def describe(self) -> str:
         """The drag in words, as decks and reports name it."""
+        coupled = ", two-way (fix fluid/flow)" if self.flow else ""
         if self.drag == "difelice":
-            return "difelice (Dallavalle's curve hindered by Di Felice, Bravo et al.)"
-        return self.drag + (f", hindered ({self.hindrance})" if self.hindered else ", unhindered")
+            return "difelice (Dallavalle's curve hindered by Di Felice, Bravo et al.)" + coupled
+        return self.drag + (f", hindered ({self.hindrance})" if self.hindered else ", unhindered") + coupled
 
     def fix_arguments(self) -> str:
         """The law, hindrance and concentration keywords of fix fluid/drag."""
@@ -160,6 +163,11 @@ class Scene:
         if self.effects.interacting:                  # contacts set the step everywhere
             dt = self.contact_time_step()
             return [(dt, math.ceil(self.t_end / dt))]
+        if self.effects.flow:
+            return self._flow_stages(self._settling_stages())
+        return self._settling_stages()
+
+    def _settling_stages(self) -> list[tuple[float, int]]:
         every = self.frame_steps()
         steps = FRAMES_PER_STAGE * every
         v_max = self.largest_terminal_speed()
@@ -173,6 +181,61 @@ class Scene:
             if time >= self.height / v_max * (1 - 1e-12):
                 dt = time / steps
         return result
+
+    def _flow_stages(self, stages: list[tuple[float, int]]) -> list[tuple[float, int]]:
+        """Each stage of the settling steps again, in as many steps as keep the flow the grains still
+        falling at its start drive to FLOW_COURANT cells a step (flow_time_step), at most twice the last
+        stage's step: the same stage ends, a whole number of frames."""
+        out, time, every, last = [], 0.0, self.frame_steps(), math.inf
+        for dt, steps in stages:
+            limit = min(self.flow_time_step(time), 2 * last)
+            n = steps if dt <= limit else every * math.ceil(steps * dt / limit / every)
+            last = dt * steps / n
+            out.append((dt * steps / n, n))
+            time += dt * steps
+        return out
+
+    def flow_grid(self) -> tuple[int, int]:
+        """Cells of fix fluid/flow's grid across the column and along its height: cubic cells,
+        FLOW_CELLS_ACROSS across (a width `plan` makes a whole number of them up the height)."""
+        return FLOW_CELLS_ACROSS, round(self.height * FLOW_CELLS_ACROSS / self.width)
+
+    def flow_speed(self, time: float = 0.0) -> float:
+        """Root mean square of the fluid velocity [m/s] that the grains placed independently drive on the
+        flow's grid, from those still falling at `time` (each class's share of the column its terminal
+        speed has not yet cleared): each parcel stirs the fluid with sqrt(w S(0)) grains' buoyant weight,
+        so the force density's fluctuation has the spectrum n <F^2> on every wave k, and the Stokes flow
+        of a wave is (I - k k / k^2) f / (mu k^2), read through the kernel (a Gaussian of one cell) on
+        both sides. The column is taken periodic in z (its mirror image changes the sum little)."""
+        f, c = self.suspension, self.classes
+        across, up = self.flow_grid()
+        cell = self.width / across
+        speed = np.array([terminal_speed(f, d, self.effects.drag) for d in c.diameter])
+        falling = c.count * np.clip(1 - speed * time / self.height, 0, 1)
+        if not falling.any():
+            return 0.0
+        structure = _core.hard_sphere_structure_factor(self.volume_fraction_of_solids)
+        noise = np.sum(falling * c.weight * structure * f.buoyant_weight(c.diameter) ** 2) / self.volume
+        k = [2 * np.pi * np.fft.fftfreq(n, cell) for n in (across, across, up)]
+        kx, ky, kz = np.meshgrid(*k, indexing="ij")
+        k2 = kx ** 2 + ky ** 2 + kz ** 2
+        k2[0, 0, 0] = np.inf
+        kernel = np.exp(-k2 * cell ** 2)              # exp(-k^2 sigma^2 / 2) on each side
+        variance = noise * np.sum((1 - kz ** 2 / k2) * kernel ** 2 / (f.viscosity ** 2 * k2 ** 2)) / self.volume
+        return float(math.sqrt(variance))
+
+    def flow_time_step(self, time: float = 0.0) -> float:
+        """The longest step [s] at which the grid's largest velocity (FLOW_PEAK times flow_speed) carries
+        a parcel FLOW_COURANT cells: past a cell a step the flow cannot follow the density it is solved
+        from (fix fluid/flow's doc page, Stability)."""
+        speed = self.flow_speed(time)
+        cell = self.width / self.flow_grid()[0]
+        return math.inf if speed == 0 else FLOW_COURANT * cell / (FLOW_PEAK * speed)
+
+    @property
+    def volume_fraction_of_solids(self) -> float:
+        """The suspension's initial solid fraction."""
+        return self.initial_concentration / self.suspension.particle_density
 
     def frame_steps(self) -> int:
         """Steps between layer frames: FRAMES_PER_STAGE frames per stage."""
@@ -212,6 +275,19 @@ class Scene:
 
 
 FRAMES_PER_STAGE = 20
+# Two-way coupling (`--two-way`): the column is FLOW_SWIRLS swirls wide (Segre et al.'s 40 a phi^-1/3 at
+# the start, a the mass-mean radius), the flow's grid FLOW_CELLS_ACROSS cubic cells across it (the
+# FFT's size, 2^4), and each step carries a parcel at most FLOW_COURANT cells at the grid's largest
+# velocity, taken as FLOW_PEAK times the root mean square that the independent start drives: the
+# largest of some 1e5 nodes of a Gaussian field. Sample 2 (docs/effects.md): 12.8 mm, 16 x 16 x 450.
+FLOW_SWIRLS = 3
+FLOW_CELLS_ACROSS = 16
+FLOW_COURANT = 0.5
+FLOW_PEAK = 4.5
+# The swirls outlast the grains that drive them: no stage's step is more than twice the last's, as the
+# settling schedule's. Sample 2 without that limit: the step went from 0.052 to 0.47 s at 185 s while
+# the grid's largest velocity was still 1.6 mm/s (0.8 allowed), and the next steps carried the parcels
+# 19 cells.
 MAX_PARTICLES = 10_000_000
 POISSON_RATIO = 0.3
 OVERLAP_TOLERANCE = 0.01    # largest contact overlap / diameter the soft contacts are made for
@@ -266,6 +342,17 @@ def meeting_modulus(suspension: Suspension, diameter: np.ndarray, speed: np.ndar
 
 
 COLUMN_DIAMETERS = 20    # a column is at least this many of its largest grains tall
+
+
+def swirl_length(psd: PSD, solids: float) -> float:
+    """Segre et al.'s correlation length of the swirls, SWIRL_LENGTH a phi^-1/3 [m], for the mass-mean
+    radius a of the sample and its solid fraction."""
+    from ..lab.psd import log_classes
+
+    lo, hi = psd.span()
+    diameter, share = log_classes(psd, lo, hi, 120)
+    radius = 0.5 * float(share @ diameter / share.sum())
+    return SWIRL_LENGTH * radius * solids ** (-1 / 3)
 
 
 def plan(psd: PSD, *, geometry: str = "column", cylinder: Cylinder = Cylinder(), mass: float = SPECIMEN_MASS,
@@ -327,6 +414,17 @@ def plan(psd: PSD, *, geometry: str = "column", cylinder: Cylinder = Cylinder(),
         raise ValueError(f"{mass:g} kg of solids would fill {solids:.0%} of the {cylinder.area * cylinder.height * 1e3:.3g} L "
                          "suspension: a sedimentation test holds a few percent (50-60 g in 1 L)")
     d_max = psd.span()[1]
+    if effects.flow:
+        if geometry != "column" or effects.interacting:
+            raise ValueError("two-way coupling is simulated in a column of parcels or grains without contacts (--geometry "
+                             "column, no --contacts or --lubrication)")
+        swirl = FLOW_SWIRLS * swirl_length(psd, solids)
+        width = swirl if width is None else width
+        # cubic cells, FLOW_CELLS_ACROSS across, a whole number up the height that the FFTs take
+        up = math.ceil(cylinder.height * FLOW_CELLS_ACROSS / width)
+        while not _core.fft_friendly(up):
+            up += 1
+        width = cylinder.height * FLOW_CELLS_ACROSS / up
     if geometry == "slab":
         width = cylinder.diameter if width is None else width
         thickness = d_max

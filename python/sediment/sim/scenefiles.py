@@ -154,6 +154,11 @@ def _deck(scene: Scene, data: str, layer_file: str) -> str:
         "variable        resume index no     # yes: start from ${restart_file} (sediment run --resume)",
         "variable        restart_file index restart.a.bin",
         "variable        timing index no     # yes: LAMMPS's timing breakdown after each stage (where the time goes)",
+    ]
+    if e.flow:
+        lines.append("variable        flow index yes      # no: the one-way twin of this scene (the same grains, steps and "
+                     "frames; the fluid at rest)")
+    lines += [
         "",
     ]
     if not e.interacting:    # set before the box (and before read_restart), so in both branches below
@@ -184,6 +189,14 @@ def _deck(scene: Scene, data: str, layer_file: str) -> str:
         + (f" mixture c_conc {f.particle_density:.12g}" if e.buoyancy == "mixture" else ""),
     ]
     lines.append(f"fix             drag all fluid/drag water {e.fix_arguments()}")
+    if e.flow:
+        across, tall = scene.flow_grid()
+        parcels = "" if np.all(scene.weight == 1) else " weight d_weight"
+        lines += [f"# the flow the grains drive (two-way coupling): {across} x {across} x {tall} cells over the column, "
+                  "closed by free slip at the floor and the surface",
+                  f'if "${{flow}} == yes" then "fix             flow all fluid/flow water grid {across} {across} {tall} '
+                  f'column 0 {scene.height:.12g}{parcels}"',
+                  "fix             surface all wall/reflect zhi EDGE    # the swirls lift fine grains to the surface"]
     if e.interacting:
         lines += pair_lines(scene)
         lines += [f"fix             floor all wall/gran granular {contact_model(scene)} {up}plane 0 NULL",

@@ -1,0 +1,160 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
+"""What two-way coupling changes in a sedimentation test, measured (docs/effects.md section 3, "The
+papers' one-way assumption").
+
+The screening bounds the swirls from above with Segre et al.'s measurements. This measures them: the
+test's column of parcels FLOW_SWIRLS swirls wide and the cylinder's height, placed independently,
+under `fix fluid/flow` (each parcel stirring the fluid as its real grains do), and its one-way twin:
+the same data file, deck, steps and frames, with the fluid at rest (`-var flow no`). A draw is the
+pair; the readings' changes are paired per draw, so the parcels' sampling error, which both share,
+drops out of the change. Draws with independent seeds give its standard error.
+"""
+from __future__ import annotations
+
+import math
+import re
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Callable
+
+import numpy as np
+
+from ..results import Table
+from ..sim.process import Runs
+from ..sim.run import run_batch
+from ..sim.scene import Effects, Scene, plan
+from ..sim.scenefiles import write
+from .screening import SedimentationTest
+
+
+@dataclass
+class FlowMeasurement:
+    """The readings of every draw, two-way and one-way, per instrument."""
+
+    scene: Scene                        # the first draw's (its width, grid, parcels and steps)
+    seeds: list[int]
+    times: dict[str, np.ndarray] = field(default_factory=dict)       # reading times [s] per instrument
+    two_way: dict[str, np.ndarray] = field(default_factory=dict)     # [draw, reading] percent finer
+    one_way: dict[str, np.ndarray] = field(default_factory=dict)
+    loop_seconds: list[tuple[float, float]] = field(default_factory=list)    # per draw: two-way, one-way
+
+    def changes(self) -> dict[str, tuple[np.ndarray, np.ndarray, np.ndarray]]:
+        """Per instrument: reading times, the mean change two-way minus one-way [pp] and its standard
+        error (the spread of the draws' changes over sqrt(draws); nan for one draw)."""
+        out = {}
+        for name, times in self.times.items():
+            change = self.two_way[name] - self.one_way[name]
+            error = (change.std(axis=0, ddof=1) / math.sqrt(len(change)) if len(change) > 1
+                     else np.full(len(times), np.nan))
+            out[name] = (times, change.mean(axis=0), error)
+        return out
+
+    def largest(self) -> tuple[str, float, float, float]:
+        """The reading whose mean change is largest: instrument, time [s], change and standard error [pp]."""
+        best = ("", math.nan, 0.0, math.nan)
+        for name, (times, change, error) in self.changes().items():
+            k = int(np.argmax(np.abs(change)))
+            if abs(change[k]) >= abs(best[2]):
+                best = (name, float(times[k]), float(change[k]), float(error[k]))
+        return best
+
+    def verdict(self, tolerance: float) -> str:
+        """Whether the one-way assumption holds at `tolerance` [pp]: the largest mean change with two
+        standard errors either way, within or beyond it, or not resolved by these draws."""
+        _, _, change, error = self.largest()
+        margin = 2 * error if math.isfinite(error) else math.inf
+        if abs(change) + margin <= tolerance:
+            return "holds: two-way coupling moves no reading beyond the tolerance"
+        if abs(change) - margin > tolerance:
+            return "fails: two-way coupling moves a reading beyond the tolerance (simulate it: sediment sample --two-way)"
+        return "not resolved: the change is within two standard errors of the tolerance (more draws: --flow-seeds)"
+
+    def table(self) -> Table:
+        """Every reading: instrument, time, mean one-way and two-way percent finer, change, standard error."""
+        table = Table(["instrument", "time_min", "one_way", "two_way", "change_pp", "standard_error_pp"],
+                      notes=[f"{len(self.seeds)} draws (seeds {', '.join(map(str, self.seeds))}), each two-way and "
+                             "its one-way twin; changes paired per draw"])
+        for name, (times, change, error) in self.changes().items():
+            for k, t in enumerate(times):
+                table.add(name, f"{t / 60:.4g}", f"{self.one_way[name][:, k].mean():.3f}",
+                          f"{self.two_way[name][:, k].mean():.3f}", f"{change[k]:+.3f}", f"{error[k]:.3f}")
+        return table
+
+
+def flow_scene(test: SedimentationTest, seed: int, **options) -> Scene:
+    """The two-way column of the test (`sediment sample --two-way` with these `plan` options)."""
+    return plan(test.psd, cylinder=test.cylinder, mass=test.mass, suspension=test.suspension, seed=seed,
+                effects=Effects(flow=True), **options)
+
+
+def measure_draw(test: SedimentationTest, scene: Scene, folder: Path, running: Runs | None = None,
+                 on_progress: Callable[[int, int], None] | None = None) -> tuple[dict, dict, tuple[float, float]]:
+    """Runs one draw in `folder` (its one-way twin in one/, the column in two/, one rank each) and reads
+    both: (two-way readings, one-way readings, their loop seconds), readings as {instrument: (times,
+    percent finer)}. `on_progress(done, total)` follows the two-way run's steps."""
+    readings, seconds = {}, {}
+    for kind, flow in (("one", "no"), ("two", "yes")):
+        where = Path(folder) / kind
+        write(scene, where)
+        reader = _step_counter(on_progress) if kind == "two" and on_progress is not None else None
+        out = run_batch(where / "in.sedimentation", {"flow": flow, "overwrite": "yes"}, running=running,
+                        on_line=reader)
+        seconds[kind] = sum(s for s, _ in out.loops)
+        readings[kind] = _readings(test, where / "layers.h5")
+    return readings["two"], readings["one"], (seconds["two"], seconds["one"])
+
+
+def measure_flow(test: SedimentationTest, seeds: list[int], folder: Path, jobs: int = 1, running: Runs | None = None,
+                 draw: Callable | None = None, **options) -> FlowMeasurement:
+    """The draws of `seeds` in folder/seed_N, `jobs` at once (`draw(test, scene, folder)` runs one:
+    measure_draw by default), gathered into a FlowMeasurement. A draw that fails stops the others
+    (through `running`) and raises."""
+    from concurrent.futures import ThreadPoolExecutor
+
+    draw = draw or (lambda test, scene, where: measure_draw(test, scene, where, running=running))
+    scenes = [flow_scene(test, seed, **options) for seed in seeds]
+    with ThreadPoolExecutor(max_workers=max(1, min(jobs, len(seeds)))) as pool:
+        futures = [pool.submit(draw, test, scene, Path(folder) / f"seed_{seed}") for seed, scene in zip(seeds, scenes)]
+        try:
+            results = [f.result() for f in futures]
+        except BaseException:    # Ctrl-C or a failed draw: stop the others too
+            if running is not None:
+                running.stop()
+            raise
+    measured = FlowMeasurement(scenes[0], list(seeds))
+    for two, one, seconds in results:
+        measured.loop_seconds.append(seconds)
+        for name, (times, finer) in two.items():
+            measured.times[name] = times
+            for kind, value in (("two_way", finer), ("one_way", one[name][1])):
+                rows = getattr(measured, kind)
+                rows[name] = np.vstack([rows[name], value]) if name in rows else np.atleast_2d(value)
+    return measured
+
+
+def _readings(test: SedimentationTest, layers_file: Path) -> dict[str, tuple[np.ndarray, np.ndarray]]:
+    from ..lab.granulometry import read_all
+    from ..lab.readout import Column
+    from ..sim.layers import read_layers
+
+    layers = read_layers(layers_file)
+    if not layers.complete:
+        raise RuntimeError(f"{layers_file}: the run's frames stop before the end of the test")
+    found, _ = read_all(Column.from_layers(layers), list(test.instruments), cylinder_area=test.cylinder.area)
+    return {r.instrument: (np.asarray(r.time, float), np.asarray(r.percent_finer, float)) for r in found}
+
+
+def _step_counter(report: Callable[[int, int], None]) -> Callable[[str], None]:
+    """A reader of a `sediment sample` deck's output reporting (step, steps) at each thermo row."""
+    total = [0]
+
+    def read(line: str) -> None:
+        planned = re.match(r"SEDIMENT plan steps (\d+)", line)
+        if planned:
+            total[0] = int(planned.group(1))
+            return
+        words = line.split()
+        if total[0] and len(words) >= 3 and words[0].isdigit():
+            report(min(int(words[0]), total[0]), total[0])
+
+    return read

@@ -1,0 +1,162 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
+"""The test's column under two-way coupling: `sediment sample --two-way` (sediment.sim.scene, Effects.flow)
+and `sediment plan --measure-flow` (sediment.planner.flow)."""
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from sediment import _core, cli
+from sediment.constants import SWIRL_LENGTH
+from sediment.lab.psd import read_psd
+from sediment.planner.flow import FlowMeasurement, measure_flow
+from sediment.planner.screening import SedimentationTest
+from sediment.sim import scene as sc
+from sediment.sim.scenefiles import write
+
+REPO = Path(__file__).resolve().parents[2]
+SAMPLE2 = REPO / "examples" / "granulometry" / "psd" / "sample2.csv"
+
+
+@pytest.fixture(scope="module")
+def column():
+    return sc.plan(read_psd(SAMPLE2), effects=sc.Effects(flow=True))
+
+
+def test_the_column_is_three_swirls_wide_in_cubic_cells_the_ffts_take(column):
+    across, tall = column.flow_grid()
+    swirl = sc.swirl_length(column.psd, column.volume_fraction_of_solids)
+    assert swirl == pytest.approx(SWIRL_LENGTH * 29.5e-6 * 0.0226 ** (-1 / 3), rel=0.05)    # a = 29.5 um: 4.2 mm
+    # the fewest cubic cells up the height that the FFTs take, at most three swirls' width each 16
+    fewest = math.ceil(column.height * 16 / (3 * swirl))
+    assert _core.fft_friendly(tall) and not any(_core.fft_friendly(n) for n in range(fewest, tall))
+    assert (across, column.width / across) == (16, pytest.approx(column.height / tall, rel=1e-12))
+    assert 2.85 * swirl < column.width <= 3 * swirl
+
+
+def test_the_parcels_start_independent_so_their_counts_fluctuate_as_the_grains(column):
+    """The flow is driven by the fluctuation of the grains' density: the counts of parcels in the
+    cells of a quarter of the width are Poisson (dispersion 1), not the stratified start's (a half)."""
+    cells = np.floor(column.position / (column.width / 4)).astype(int)
+    _, counts = np.unique(cells[:, 0] + 4 * cells[:, 1] + 16 * cells[:, 2], return_counts=True)
+    assert counts.var() / counts.mean() == pytest.approx(1.0, abs=0.15)
+    stratified = sc.plan(read_psd(SAMPLE2), width=column.width)
+    cells = np.floor(stratified.position / (column.width / 4)).astype(int)
+    _, counts = np.unique(cells[:, 0] + 4 * cells[:, 1] + 16 * cells[:, 2], return_counts=True)
+    assert counts.var() / counts.mean() < 0.6    # 0.51
+
+
+def test_each_stage_keeps_the_flow_within_its_courant_number_and_ends_where_the_settling_stage_does(column):
+    flow_stages, settling = column.stages(), column._settling_stages()
+    assert len(flow_stages) == len(settling)
+    time, last, every = 0.0, math.inf, column.frame_steps()
+    for (dt, n), (dt_settle, n_settle) in zip(flow_stages, settling):
+        assert dt * n == pytest.approx(dt_settle * n_settle, rel=1e-12) and n % every == 0
+        assert dt <= min(dt_settle, column.flow_time_step(time), 2 * last) * (1 + 1e-12)
+        time, last = time + dt * n, dt
+    assert time == pytest.approx(column.t_end, rel=1e-12)
+    # the first step: the grid's largest velocity (4.5 rms) carries a parcel half a cell (less the
+    # rounding of the stage to whole frames)
+    carried = flow_stages[0][0] * sc.FLOW_PEAK * column.flow_speed(0.0) / (column.width / 16)
+    assert 0.49 < carried <= 0.5
+
+
+def test_the_start_drives_the_flow_the_schedule_estimates(column, tmp_path):
+    """The parcels at their terminal slip after two steps of the first stage: the fluid velocity they
+    read (fix fluid/flow, the column's mirror images included) has the root mean square flow_speed
+    estimates on the periodic grid (4.55 against 4.30 mm/s), and the grid's largest velocity is
+    FLOW_PEAK = 4.5 times that estimate within a fifth (4.33)."""
+    from sediment.sim.run import run_batch
+    from sediment.sim.scenefiles import write_data
+
+    write_data(column, tmp_path / "column.data")
+    across, tall = column.flow_grid()
+    f = column.suspension
+    (tmp_path / "in.start").write_text(f"""units si
+atom_style sphere
+boundary p p f
+fix weights all property/atom d_weight
+read_data column.data fix weights NULL Weights
+comm_modify cutoff 1e-9
+fix grav all gravity {f.gravity!r} vector 0 0 -1
+fix water all fluid density {f.fluid_density!r} viscosity {f.viscosity!r}
+fix buoy all fluid/buoyancy water
+fix drag all fluid/drag water law standard
+fix flow all fluid/flow water grid {across} {across} {tall} column 0 {column.height!r} weight d_weight every 1
+fix step all nve/sphere/fluid
+timestep {column.stages()[0][0]!r}
+run 2
+write_dump all custom u.txt id f_flow[1] f_flow[2] f_flow[3] modify format float %.10g
+print "RESULT peak $(f_flow[5])"
+""")
+    out = run_batch(tmp_path / "in.start")
+    u = np.loadtxt(tmp_path / "u.txt", skiprows=9)[:, 1:]
+    estimate = column.flow_speed(0.0)
+    assert np.sqrt((u ** 2).sum(axis=1).mean()) == pytest.approx(estimate, rel=0.12)
+    assert out.results["peak"] == pytest.approx(sc.FLOW_PEAK * estimate, rel=0.2)
+
+
+def test_the_deck_runs_the_flow_or_its_one_way_twin(column, tmp_path):
+    write(column, tmp_path)
+    deck = (tmp_path / "in.sedimentation").read_text()
+    across, tall = column.flow_grid()
+    assert "variable        flow index yes" in deck
+    assert (f'if "${{flow}} == yes" then "fix             flow all fluid/flow water grid {across} {across} {tall} '
+            f'column 0 {column.height:.12g} weight d_weight"') in deck
+    assert "fix             surface all wall/reflect zhi EDGE" in deck
+    assert "fluid/flow" not in (write(sc.plan(read_psd(SAMPLE2)), tmp_path / "one") and
+                                (tmp_path / "one" / "in.sedimentation").read_text())
+
+
+@pytest.mark.parametrize("options, message", [
+    ({"geometry": "slab"}, "two-way coupling is simulated in a column"),
+    ({"particles": None, "effects": sc.Effects(flow=True, contacts=True)}, "two-way coupling is simulated in a column"),
+])
+def test_a_two_way_scene_it_cannot_simulate_is_refused(options, message):
+    options.setdefault("effects", sc.Effects(flow=True))
+    with pytest.raises(ValueError, match=message):
+        sc.plan(read_psd(SAMPLE2), **options)
+
+
+def test_the_changes_are_paired_per_draw_and_their_verdict_holds_two_standard_errors(column):
+    """measure_flow with draws that return known readings: the change is two-way minus one-way per draw,
+    its standard error the draws' spread over sqrt(draws); a verdict only beyond two of them."""
+    times = np.array([60.0, 120.0])
+    offsets = {1: 0.0, 2: 2.0, 3: 4.0}    # a draw's own sampling error: the same in both runs of it
+
+    def draw(test, scene, folder):
+        base = np.array([80.0, 60.0]) + offsets[scene.seed]
+        change = np.array([1.0 + 0.1 * scene.seed, -0.2])
+        return {"pipette": (times, base + change)}, {"pipette": (times, base)}, (2.0, 1.0)
+
+    test = SedimentationTest(read_psd(SAMPLE2), instruments=("pipette",))
+    measured = measure_flow(test, [1, 2, 3], Path("unused"), draw=draw, t_end=600.0)
+    _, change, error = measured.changes()["pipette"]
+    assert change == pytest.approx([1.2, -0.2]) and error == pytest.approx([0.1 / math.sqrt(3), 0.0], abs=1e-12)
+    assert measured.largest() == ("pipette", 60.0, pytest.approx(1.2), pytest.approx(0.1 / math.sqrt(3)))
+    assert measured.verdict(0.5).startswith("fails") and measured.verdict(2.0).startswith("holds")
+    assert measured.verdict(1.2).startswith("not resolved")
+    one = FlowMeasurement(measured.scene, [1], {"pipette": times}, {"pipette": measured.two_way["pipette"][:1]},
+                          {"pipette": measured.one_way["pipette"][:1]})
+    assert one.verdict(5.0).startswith("not resolved")    # one draw: no standard error
+
+
+def test_plan_measures_a_short_column_two_ways_and_its_twin(tmp_path):
+    """`sediment plan --measure-flow` end to end on a short column (12 cm, 2000 parcels, the pipette's
+    first reading): both runs of each draw finish, and flow.csv and flow.json hold the paired change."""
+    out = tmp_path / "plan"
+    assert cli.main(["plan", str(SAMPLE2), "--screen-only", "--measure-flow", "--flow-seeds", "2", "--height", "0.12",
+                     "--t-end", "60", "--instruments", "pipette", "--particles", "2000", "--jobs", "2",
+                     "--out", str(out)]) == 0
+    summary = json.loads((out / "flow.json").read_text())
+    assert summary["seeds"] == [1, 2] and summary["grid"][:2] == [16, 16]
+    assert summary["largest"]["instrument"] == "pipette" and math.isfinite(summary["largest"]["change_pp"])
+    rows = (out / "flow.csv").read_text().splitlines()
+    assert rows[0].startswith("instrument,time_min,one_way,two_way,change_pp") and len(rows) == 2
+    for seed in (1, 2):
+        for kind in ("one", "two"):
+            assert (out / "flow" / f"seed_{seed}" / kind / "layers.h5").is_file()
