@@ -160,3 +160,31 @@ def test_plan_measures_a_short_column_two_ways_and_its_twin(tmp_path):
     for seed in (1, 2):
         for kind in ("one", "two"):
             assert (out / "flow" / f"seed_{seed}" / kind / "layers.h5").is_file()
+
+
+def test_a_measurement_that_fails_puts_the_flow_into_the_plan(tmp_path):
+    """Where two-way coupling moves a reading beyond the tolerance it is on in the plan: switch_on sets
+    the decision's two_way, rewrites its deck under the flow, records the measurement, and `sediment
+    sample --plan` then writes the two-way column."""
+    from sediment.planner.flow import switch_on
+    from sediment.planner.scenes import SampleScene, decided_options
+
+    test = SedimentationTest(read_psd(SAMPLE2))
+    scene = SampleScene(test, {"geometry": "column", "width": None, "classes": 40, "layers": 400, "t_end": 86400.0},
+                        [2000], [4.0], 0.5)
+    settings = {"drag": "standard", "hindrance": "richardson-zaki", "particles": 2000, "courant": 4.0}
+    scene.write(settings, tmp_path / "decision", 1)
+    (tmp_path / "report.json").write_text(json.dumps({"decision": {"settings": settings, "seed": 1},
+                                                      "scene_options": scene.options_record()}))
+    assert decided_options(tmp_path / "report.json")[0]["two_way"] is False
+    times = np.array([44.5])
+    failing = FlowMeasurement(None, [1, 2], {"pipette": times}, {"pipette": np.array([[60.0], [61.0]])},
+                              {"pipette": np.array([[50.0], [50.5]])})
+    switch_on(tmp_path, scene, failing, 0.5)
+    report = json.loads((tmp_path / "report.json").read_text())
+    assert report["two_way"]["change_pp"] == pytest.approx(10.25) and report["two_way"]["verdict"].startswith("fails")
+    assert decided_options(tmp_path / "report.json")[0]["two_way"] is True
+    assert "fluid/flow" in (tmp_path / "decision" / "in.sedimentation").read_text()
+    assert cli.main(["sample", str(SAMPLE2), "--plan", str(tmp_path / "report.json"), "--out",
+                     str(tmp_path / "sample")]) == 0
+    assert "fluid/flow" in (tmp_path / "sample" / "in.sedimentation").read_text()

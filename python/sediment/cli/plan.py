@@ -145,11 +145,16 @@ def run(args: argparse.Namespace) -> int:
     if args.deck is None and args.measure_contacts:
         _measure_contacts(test, args, tolerance)
     if args.deck is None and args.measure_flow:
-        _measure_flow(test, args, tolerance, options)
+        measured = _measure_flow(test, args, tolerance, options)
+        if measured.verdict(tolerance).startswith("fails"):
+            from ..planner.flow import switch_on
+
+            switch_on(args.out, scene, measured, tolerance)
+            print(f"two-way coupling is on in the decision: {scene.describe(dict(plan.decision.settings, two_way=True))}")
     return 0
 
 
-def _measure_flow(test, args: argparse.Namespace, tolerance: float, options: dict) -> None:
+def _measure_flow(test, args: argparse.Namespace, tolerance: float, options: dict):
     """Runs --flow-seeds draws of the two-way column and its twin, --jobs at once, one bar each."""
     import json
     import sys
@@ -196,6 +201,7 @@ def _measure_flow(test, args: argparse.Namespace, tolerance: float, options: dic
         "loop_seconds": measured.loop_seconds, "largest": {"instrument": name, "time_s": at, "change_pp": change,
                                                             "standard_error_pp": error},
         "tolerance_pp": tolerance, "verdict": verdict}, indent=2) + "\n")
+    return measured
 
 
 def _measure_contacts(test, args: argparse.Namespace, tolerance: float) -> None:

@@ -140,7 +140,7 @@ def run(args: argparse.Namespace) -> int:
             raise ValueError(f"{args.plan} was made for another test: " + ", ".join(differ) +
                              "; plan this one (sediment plan) or sample without --plan")
         print(f"the plan's decision ({args.plan}): --drag {args.drag} --hindrance {args.hindrance} "
-              f"--particles {args.particles} --courant {args.courant:g}")
+              f"--particles {args.particles} --courant {args.courant:g}" + (" --two-way" if args.two_way else ""))
 
     suspension = suspension_of(args)
     if record:

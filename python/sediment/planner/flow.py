@@ -81,6 +81,25 @@ class FlowMeasurement:
         return table
 
 
+def switch_on(plan_folder: Path, scene, measured: FlowMeasurement, tolerance: float) -> None:
+    """Puts two-way coupling into a plan whose measurement found it moves a reading beyond the
+    tolerance: the decision's settings get two_way (`sediment sample --plan` then writes the column
+    under the flow), its deck in decision/ is rewritten so, and report.json records the measurement."""
+    import json
+
+    from ..results import write_text
+
+    report_path = Path(plan_folder) / "report.json"
+    report = json.loads(report_path.read_text())
+    decision = report["decision"]
+    decision["settings"]["two_way"] = True
+    name, at, change, error = measured.largest()
+    report["two_way"] = {"seeds": measured.seeds, "instrument": name, "time_s": at, "change_pp": change,
+                         "standard_error_pp": error, "tolerance_pp": tolerance, "verdict": measured.verdict(tolerance)}
+    scene.write(decision["settings"], Path(plan_folder) / "decision", decision["seed"])
+    write_text(report_path, json.dumps(report, indent=1, default=str) + "\n")
+
+
 def flow_scene(test: SedimentationTest, seed: int, **options) -> Scene:
     """The two-way column of the test (`sediment sample --two-way` with these `plan` options)."""
     return plan(test.psd, cylinder=test.cylinder, mass=test.mass, suspension=test.suspension, seed=seed,

@@ -87,8 +87,11 @@ def decided_options(report: Path) -> tuple[dict, dict]:
             raise ValueError(f"courant {courant!r}")
         if not isinstance(content.get("scene_options"), dict):
             raise ValueError("test options (scene_options): a plan of an earlier version, or damaged")
-        return ({"drag": decision["drag"], "hindrance": hindrance, "particles": particles, "courant": float(courant)},
-                content["scene_options"])
+        two_way = decision.get("two_way", False)    # switched on by a measurement (--measure-flow) that needed it
+        if not isinstance(two_way, bool):
+            raise ValueError(f"two_way {two_way!r}")
+        return ({"drag": decision["drag"], "hindrance": hindrance, "particles": particles, "courant": float(courant),
+                 "two_way": two_way}, content["scene_options"])
     except (json.JSONDecodeError, UnicodeDecodeError) as exc:
         raise ValueError(f"{report} is not a plan's report.json: {exc}") from None
     except (KeyError, TypeError, ValueError) as exc:
@@ -133,7 +136,7 @@ class SampleScene:
     def describe(self, settings: dict) -> str:
         """The `sediment sample` options of a setting."""
         return (f"--drag {settings['drag']} --hindrance {settings['hindrance']} --particles {settings['particles']} "
-                f"--courant {settings['courant']:g}")
+                f"--courant {settings['courant']:g}" + (" --two-way" if settings.get("two_way") else ""))
 
     def options_record(self) -> dict:
         """The test besides the knobs, as `sediment sample --plan` checks it."""
@@ -148,7 +151,8 @@ class SampleScene:
         t = self.test
         scene = plan(t.psd, cylinder=t.cylinder, mass=t.mass, suspension=t.suspension, seed=seed,
                      particles=int(settings["particles"]), courant=float(settings["courant"]),
-                     effects=Effects(settings["drag"], hindrance=settings["hindrance"]), **self.options)
+                     effects=Effects(settings["drag"], hindrance=settings["hindrance"],
+                                     flow=settings.get("two_way", False)), **self.options)
         scene.water_record = self.water_record
         return scene
 
