@@ -31,7 +31,7 @@ from .screening import SedimentationTest
 class FlowMeasurement:
     """The readings of every draw, two-way and one-way, per instrument."""
 
-    scene: Scene                        # the first draw's (its width, grid, parcels and steps)
+    scene: Scene | None                 # the first draw's (its width, grid, parcels and steps)
     seeds: list[int]
     times: dict[str, np.ndarray] = field(default_factory=dict)       # reading times [s] per instrument
     two_way: dict[str, np.ndarray] = field(default_factory=dict)     # [draw, reading] percent finer
@@ -111,7 +111,7 @@ def measure_draw(test: SedimentationTest, scene: Scene, folder: Path, running: R
     """Runs one draw in `folder` (its one-way twin in one/, the column in two/, one rank each) and reads
     both: (two-way readings, one-way readings, their loop seconds), readings as {instrument: (times,
     percent finer)}. `on_progress(done, total)` follows the two-way run's steps."""
-    readings, seconds = {}, {}
+    seconds = {}
     for kind, flow in (("one", "no"), ("two", "yes")):
         where = Path(folder) / kind
         write(scene, where)
@@ -119,8 +119,7 @@ def measure_draw(test: SedimentationTest, scene: Scene, folder: Path, running: R
         out = run_batch(where / "in.sedimentation", {"flow": flow, "overwrite": "yes"}, running=running,
                         on_line=reader)
         seconds[kind] = sum(s for s, _ in out.loops)
-        readings[kind] = _readings(test, where / "layers.h5")
-    return readings["two"], readings["one"], (seconds["two"], seconds["one"])
+    return (*read_draw(test, folder), (seconds["two"], seconds["one"]))
 
 
 def measure_flow(test: SedimentationTest, seeds: list[int], folder: Path, jobs: int = 1, running: Runs | None = None,
@@ -140,7 +139,12 @@ def measure_flow(test: SedimentationTest, seeds: list[int], folder: Path, jobs: 
             if running is not None:
                 running.stop()
             raise
-    measured = FlowMeasurement(scenes[0], list(seeds))
+    return gather(scenes[0], seeds, results)
+
+
+def gather(scene: Scene | None, seeds: list[int], results: list[tuple[dict, dict, tuple[float, float]]]) -> FlowMeasurement:
+    """The draws' (two-way readings, one-way readings, loop seconds) as one FlowMeasurement."""
+    measured = FlowMeasurement(scene, list(seeds))
     for two, one, seconds in results:
         measured.loop_seconds.append(seconds)
         for name, (times, finer) in two.items():
@@ -149,6 +153,11 @@ def measure_flow(test: SedimentationTest, seeds: list[int], folder: Path, jobs: 
                 rows = getattr(measured, kind)
                 rows[name] = np.vstack([rows[name], value]) if name in rows else np.atleast_2d(value)
     return measured
+
+
+def read_draw(test: SedimentationTest, folder: Path) -> tuple[dict, dict]:
+    """The readings of a draw that has run: (two-way, one-way) from folder/two and folder/one."""
+    return _readings(test, Path(folder) / "two" / "layers.h5"), _readings(test, Path(folder) / "one" / "layers.h5")
 
 
 def _readings(test: SedimentationTest, layers_file: Path) -> dict[str, tuple[np.ndarray, np.ndarray]]:

@@ -306,6 +306,11 @@ def describe(scene: Scene) -> str:
              f"simulated PSD vs input at the class edges: max difference {worst:.2f} percentage points",
              f"time: {len(stages)} stages, {sum(n for _, n in stages)} steps to {scene.t_end:g} s "
              f"(dt {stages[0][0]:.3g} .. {stages[-1][0]:.3g} s)"]
+    if scene.effects.flow:
+        across, tall = scene.flow_grid()
+        lines.append(f"two-way: fix fluid/flow on {across} x {across} x {tall} cells of {scene.width / across * 1e3:.3g} mm; "
+                     f"the start's flow, {scene.flow_speed() * 1e3:.3g} mm/s rms, sets the first step "
+                     f"({scene.flow_time_step():.3g} s); `-var flow no` runs the one-way twin")
     first, last = scene.psd.percent_finer[0], scene.psd.percent_finer[-1]
     if first > 0 or last < 100:
         lines.append(f"note: the PSD table runs from {first:g} to {last:g} % finer; the {first + 100 - last:g} % of the "
