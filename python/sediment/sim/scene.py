@@ -18,7 +18,7 @@ import numpy as np
 from .. import _core
 from ..constants import (BRAVO_CYLINDER_HEIGHT, BRAVO_CYLINDER_WIDTH, D422_CYLINDER_AREA, D422_CYLINDER_HEIGHT,
                          DRAGS, HINDRANCES, SPECIMEN_MASS, SWIRL_LENGTH)
-from ..lab.psd import PSD, SizeClasses, discretise
+from ..lab.psd import PSD, SizeClasses, discretise, log_classes
 from ..lab.readout import Suspension
 from ..lab.settling import terminal_speed
 from .placement import place
@@ -191,7 +191,7 @@ class Scene:
             limit = min(self.flow_time_step(time), 2 * last)
             n = steps if dt <= limit else every * math.ceil(steps * dt / limit / every)
             last = dt * steps / n
-            out.append((dt * steps / n, n))
+            out.append((last, n))
             time += dt * steps
         return out
 
@@ -206,7 +206,8 @@ class Scene:
         speed has not yet cleared): each parcel stirs the fluid with sqrt(w S(0)) grains' buoyant weight,
         so the force density's fluctuation has the spectrum n <F^2> on every wave k, and the Stokes flow
         of a wave is (I - k k / k^2) f / (mu k^2), read through the kernel (a Gaussian of one cell) on
-        both sides. The column is taken periodic in z (its mirror image changes the sum little)."""
+        both sides. The column is taken periodic in z: in sample 2's column the parcels read 1.06 times
+        this after two steps, in a column of 12 cm, whose mirror images weigh more, 1.4 times."""
         f, c = self.suspension, self.classes
         across, up = self.flow_grid()
         cell = self.width / across
@@ -279,7 +280,7 @@ FRAMES_PER_STAGE = 20
 # the start, a the mass-mean radius), the flow's grid FLOW_CELLS_ACROSS cubic cells across it (the
 # FFT's size, 2^4), and each step carries a parcel at most FLOW_COURANT cells at the grid's largest
 # velocity, taken as FLOW_PEAK times the root mean square that the independent start drives: the
-# largest of some 1e5 nodes of a Gaussian field. Sample 2 (docs/effects.md): 12.8 mm, 16 x 16 x 450.
+# largest of some 1e5 nodes of a Gaussian field. Sample 2 (docs/effects.md): 12 mm, 16 x 16 x 480.
 FLOW_SWIRLS = 3
 FLOW_CELLS_ACROSS = 16
 FLOW_COURANT = 0.5
@@ -347,8 +348,6 @@ COLUMN_DIAMETERS = 20    # a column is at least this many of its largest grains 
 def swirl_length(psd: PSD, solids: float) -> float:
     """Segre et al.'s correlation length of the swirls, SWIRL_LENGTH a phi^-1/3 [m], for the mass-mean
     radius a of the sample and its solid fraction."""
-    from ..lab.psd import log_classes
-
     lo, hi = psd.span()
     diameter, share = log_classes(psd, lo, hi, 120)
     radius = 0.5 * float(share @ diameter / share.sum())
