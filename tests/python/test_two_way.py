@@ -101,6 +101,8 @@ print "RESULT peak $(f_flow[5])"
 
 
 def test_the_deck_runs_the_flow_or_its_one_way_twin(column, tmp_path):
+    from sediment.sim.run import run_batch
+
     write(column, tmp_path)
     deck = (tmp_path / "in.sedimentation").read_text()
     across, tall = column.flow_grid()
@@ -108,6 +110,8 @@ def test_the_deck_runs_the_flow_or_its_one_way_twin(column, tmp_path):
     assert (f'if "${{flow}} == yes" then "fix             flow all fluid/flow water grid {across} {across} {tall} '
             f'column 0 {column.height:.12g} weight d_weight"') in deck
     assert "fix             surface all wall/reflect zhi EDGE" in deck
+    typo = run_batch(tmp_path / "in.sedimentation", {"flow": "yse"}, check=False)
+    assert typo.returncode == 2 and "variable flow must be yes or no, not yse" in typo.text
     assert "fluid/flow" not in (write(sc.plan(read_psd(SAMPLE2)), tmp_path / "one") and
                                 (tmp_path / "one" / "in.sedimentation").read_text())
 

@@ -156,8 +156,10 @@ def _deck(scene: Scene, data: str, layer_file: str) -> str:
         "variable        timing index no     # yes: LAMMPS's timing breakdown after each stage (where the time goes)",
     ]
     if e.flow:
-        lines.append("variable        flow index yes      # no: the one-way twin of this scene (the same grains, steps and "
-                     "frames; the fluid at rest)")
+        lines += ["variable        flow index yes      # no: the one-way twin of this scene (the same grains, steps and "
+                  "frames; the fluid at rest)",
+                  'if "${flow} != yes && ${flow} != no" then &',
+                  '  "print \'ERROR: variable flow must be yes or no, not ${flow}\'" "quit 2"']
     lines += [
         "",
     ]
