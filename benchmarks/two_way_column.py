@@ -45,7 +45,7 @@ def main() -> int:
     name, at, change, error = measured.largest()
     estimate = next(s.change for s in screen(test) if s.effect == "two-way")
     print(f"sample {args.sample}, {len(results)} draws: the largest mean change {change:+.3g} +- {error:.2g} pp "
-          f"({name} at {at / 60:.3g} min); the screen's upper estimate {estimate:.3g} pp; at 0.5 pp the one-way "
+          f"({name} at {at / 60:.3g} min); the screen's estimate {estimate:.3g} pp; at 0.5 pp the one-way "
           f"assumption {measured.verdict(0.5)}")
     plt = pyplot()
     fig, ax = plt.subplots(figsize=(6.4, 3.8))
@@ -59,7 +59,7 @@ def main() -> int:
     ax.set_xlabel("time [min]")
     ax.set_ylabel("two-way minus one-way [points]")
     ax.set_title(f"sample {args.sample} at 60 g/L: {len(results)} draws, two standard errors "
-                 f"(dotted: the screen's upper estimate)", fontsize=9)
+                 f"(dotted: the screen's estimate)", fontsize=9)
     ax.legend(fontsize=8)
     out = args.out or HERE.parent / "docs" / "effects" / f"two_way_column_sample{args.sample}.png"
     save(fig, out)
