@@ -8,7 +8,7 @@ A draw is a folder holding `two/` (the column of `sediment sample --two-way --se
 (the same files run with `--var flow no`), as `sediment plan --measure-flow` leaves them in
 OUT/flow/seed_K. Per instrument and reading, the change two-way minus one-way is paired per draw, and
 its standard error is the draws' spread over sqrt(draws) (sediment.planner.flow). Prints each reading's
-mean change and the screen's upper estimate beside the largest; draws each instrument's changes against
+mean change and the screen's estimate beside the largest; draws each instrument's changes against
 time with two standard errors.
 """
 from __future__ import annotations
