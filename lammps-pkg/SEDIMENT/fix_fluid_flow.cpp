@@ -1103,11 +1103,11 @@ double FixFluidFlow::memory_usage()
 {
   const double grids = static_cast<double>(spread.capacity() + flow.capacity() + slab.size() + 3 * field[0].size() +
                                            mirror_out.size() + mirror_in.size() + sent.capacity() +
-                                           received.capacity()) +
+                                           received.capacity() + image_flow.capacity()) +
       static_cast<double>(bricks.nodes.capacity()) * sizeof(int) / sizeof(double);
   const double per_sphere = static_cast<double>(stencils.capacity()) * sizeof(Stencil) +
-      static_cast<double>(forces.capacity() + fractions.capacity() + diameter.capacity() + speed.capacity() +
-                          voidage.capacity() + per_speed.capacity()) * sizeof(double) +
+      static_cast<double>(forces.capacity() + fractions.capacity() + scales.capacity() + diameter.capacity() +
+                          speed.capacity() + voidage.capacity() + per_speed.capacity()) * sizeof(double) +
       static_cast<double>(spheres.capacity()) * sizeof(int);
   return (3.0 * atom->nmax + grids) * sizeof(double) + per_sphere;
 }
