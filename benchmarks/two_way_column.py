@@ -2,7 +2,7 @@
 """The papers' one-way assumption, measured: docs/effects.md's table and figure of the test's column under
 two-way coupling against its one-way twin, for draws that have run.
 
-    /usr/bin/python3 benchmarks/two_way_column.py --sample 2 DRAW [DRAW ...] [--out docs/effects/two_way_column_sample2.png]
+    /usr/bin/python3 benchmarks/two_way_column.py --sample 2 DRAW [DRAW ...] [--out FIGURE]
 
 A draw is a folder holding `two/` (the column of `sediment sample --two-way --seed K`, run) and `one/`
 (the same files run with `--var flow no`), as `sediment plan --measure-flow` leaves them in

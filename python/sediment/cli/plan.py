@@ -73,7 +73,8 @@ def add_parser(commands) -> argparse.ArgumentParser:
     test.add_argument("--measure-flow", action="store_true",
                       help="also measure what two-way coupling changes: the test's column of parcels three swirls "
                       "wide under fix fluid/flow and its one-way twin, --flow-seeds draws, written to OUT/flow.csv "
-                      "and flow.json (15-50 min per draw on one core for Bravo et al.'s samples; docs/effects.md section 3)")
+                      "and flow.json (15-50 min per draw on one core for Bravo et al.'s samples; docs/effects.md "
+                      "section 3)")
     test.add_argument("--flow-seeds", type=count, default=3, help="draws of --measure-flow (default 3)")
     deck = parser.add_argument_group("deck")
     deck.add_argument("--observe", nargs="+", metavar="NAME", help="RESULT or SERIES names the deck prints")

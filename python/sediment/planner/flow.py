@@ -66,7 +66,8 @@ class FlowMeasurement:
         if abs(change) + margin <= tolerance:
             return "holds: two-way coupling moves no reading beyond the tolerance"
         if abs(change) - margin > tolerance:
-            return "fails: two-way coupling moves a reading beyond the tolerance (simulate it: sediment sample --two-way)"
+            return ("fails: two-way coupling moves a reading beyond the tolerance (simulate it: sediment sample "
+                    "--two-way)")
         return "not resolved: the change is within two standard errors of the tolerance (more draws: --flow-seeds)"
 
     def table(self) -> Table:
@@ -142,7 +143,8 @@ def measure_flow(test: SedimentationTest, seeds: list[int], folder: Path, jobs: 
     return gather(scenes[0], seeds, results)
 
 
-def gather(scene: Scene | None, seeds: list[int], results: list[tuple[dict, dict, tuple[float, float]]]) -> FlowMeasurement:
+def gather(scene: Scene | None, seeds: list[int],
+           results: list[tuple[dict, dict, tuple[float, float]]]) -> FlowMeasurement:
     """The draws' (two-way readings, one-way readings, loop seconds) as one FlowMeasurement."""
     measured = FlowMeasurement(scene, list(seeds))
     for two, one, seconds in results:

@@ -415,8 +415,8 @@ def plan(psd: PSD, *, geometry: str = "column", cylinder: Cylinder = Cylinder(),
     d_max = psd.span()[1]
     if effects.flow:
         if geometry != "column" or effects.interacting:
-            raise ValueError("two-way coupling is simulated in a column of parcels or grains without contacts (--geometry "
-                             "column, no --contacts or --lubrication)")
+            raise ValueError("two-way coupling is simulated in a column of parcels or grains without contacts "
+                             "(--geometry column, no --contacts or --lubrication)")
         swirl = FLOW_SWIRLS * swirl_length(psd, solids)
         width = swirl if width is None else width
         # cubic cells, FLOW_CELLS_ACROSS across, a whole number up the height that the FFTs take

@@ -310,7 +310,8 @@ def describe(scene: Scene) -> str:
              f"(dt {stages[0][0]:.3g} .. {stages[-1][0]:.3g} s)"]
     if scene.effects.flow:
         across, tall = scene.flow_grid()
-        lines.append(f"two-way: fix fluid/flow on {across} x {across} x {tall} cells of {scene.width / across * 1e3:.3g} mm; "
+        lines.append(f"two-way: fix fluid/flow on {across} x {across} x {tall} cells of "
+                     f"{scene.width / across * 1e3:.3g} mm; "
                      f"the start's flow, {scene.flow_speed() * 1e3:.3g} mm/s rms, sets the first step "
                      f"({scene.flow_time_step():.3g} s); `-var flow no` runs the one-way twin")
     first, last = scene.psd.percent_finer[0], scene.psd.percent_finer[-1]
