@@ -150,17 +150,18 @@ def test_the_changes_are_paired_per_draw_and_their_verdict_holds_two_standard_er
 
 
 def test_plan_measures_a_short_column_two_ways_and_its_twin(tmp_path):
-    """`sediment plan --measure-flow` end to end on a short column (12 cm, 2000 parcels, the pipette's
-    first reading): both runs of each draw finish, and flow.csv and flow.json hold the paired change."""
+    """`sediment plan --measure-flow` end to end on a short column (5 cm, 2000 parcels, the buoyancy
+    sphere's readings in the first minute; the machinery, not the physics of a test): both runs of each
+    draw finish, and flow.csv and flow.json hold the paired changes."""
     out = tmp_path / "plan"
-    assert cli.main(["plan", str(SAMPLE2), "--screen-only", "--measure-flow", "--flow-seeds", "2", "--height", "0.12",
-                     "--t-end", "60", "--instruments", "pipette", "--particles", "2000", "--jobs", "2",
+    assert cli.main(["plan", str(SAMPLE2), "--screen-only", "--measure-flow", "--flow-seeds", "2", "--height", "0.05",
+                     "--t-end", "60", "--instruments", "buoyancy", "--particles", "2000", "--jobs", "2",
                      "--out", str(out)]) == 0
     summary = json.loads((out / "flow.json").read_text())
     assert summary["seeds"] == [1, 2] and summary["grid"][:2] == [16, 16]
-    assert summary["largest"]["instrument"] == "pipette" and math.isfinite(summary["largest"]["change_pp"])
+    assert summary["largest"]["instrument"] == "buoyancy" and math.isfinite(summary["largest"]["change_pp"])
     rows = (out / "flow.csv").read_text().splitlines()
-    assert rows[0].startswith("instrument,time_min,one_way,two_way,change_pp") and len(rows) == 2
+    assert rows[0].startswith("instrument,time_min,one_way,two_way,change_pp") and len(rows) == 3
     for seed in (1, 2):
         for kind in ("one", "two"):
             assert (out / "flow" / f"seed_{seed}" / kind / "layers.h5").is_file()
