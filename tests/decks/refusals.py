@@ -305,8 +305,10 @@ def fuzz_input(np_ranks: int):
         case, folder = case_and_dir
         deck = folder / "deck.lmp"
         deck.write_text(case.deck)
+        # A hang is a run that never ends: 300 s, not 60, so that a deck which ends in under a second
+        # alone is not called one on a loaded machine (a fresh clone's, load average above 11).
         try:
-            out = run_batch(deck, {}, np_ranks, cwd=folder, timeout=60, check=False)
+            out = run_batch(deck, {}, np_ranks, cwd=folder, timeout=300, check=False)
         except subprocess.TimeoutExpired:
             return case, "hang"
         refused = out.returncode != 0 and out.error is not None and out.error.startswith("ERROR")
