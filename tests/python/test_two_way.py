@@ -126,6 +126,23 @@ def test_a_two_way_scene_it_cannot_simulate_is_refused(options, message):
         sc.plan(read_psd(SAMPLE2), **options)
 
 
+@pytest.mark.parametrize("arguments, message", [
+    (["--screen-only", "--flow-seeds", "2"], "--flow-seeds sets the draws of --measure-flow: give both"),
+    (["--screen-only", "--measure-flow", "--flow-seeds", "0"], "--flow-seeds: must be >= 1, got 0"),
+    (["--screen-only", "--measure-flow", "--geometry", "slab"], "two-way coupling is simulated in a column"),
+])
+def test_plan_refuses_a_flow_measurement_it_cannot_make_before_running_anything(arguments, message, tmp_path,
+                                                                                 capsys):
+    out = tmp_path / "plan"
+    try:
+        code = cli.main(["plan", str(SAMPLE2), *arguments, "--out", str(out)])
+    except SystemExit as stop:    # argparse's own refusals
+        code = stop.code
+    assert code == 2
+    assert message in capsys.readouterr().err
+    assert not out.exists()
+
+
 def test_the_changes_are_paired_per_draw_and_their_verdict_holds_two_standard_errors(column):
     """measure_flow with draws that return known readings: the change is two-way minus one-way per draw,
     its standard error the draws' spread over sqrt(draws); a verdict only beyond two of them."""

@@ -128,6 +128,8 @@ def run(args: argparse.Namespace) -> int:
         name = args.psd.stem
         if args.contact_cut is not None and not args.measure_contacts:
             raise ValueError("--contact-cut sets the reduced scene of --measure-contacts: give both")
+        if args.flow_seeds != args.kinds["test"]["flow_seeds"] and not args.measure_flow:
+            raise ValueError("--flow-seeds sets the draws of --measure-flow: give both")
         if args.screen_only:
             if args.set:
                 pin(scene, dict(args.set))    # a wrong setting named first
