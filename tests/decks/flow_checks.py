@@ -175,22 +175,28 @@ print "RESULT peak $(f_flow[5])"
 
 
 
+def quartz_box(boundary: str, box: tuple[float, float, float], atoms: str) -> str:
+    """The opening of a deck of quartz spheres of 100 um in a box from the origin to `box` with `boundary`,
+    created by the `atoms` lines (regions, create_atoms)."""
+    return f"""units si
+atom_style sphere
+atom_modify map array
+boundary {boundary}
+region box block 0 {box[0]} 0 {box[1]} 0 {box[2]}
+create_box 1 box
+{atoms}
+set group all diameter 1e-4
+set group all density 2650
+comm_modify cutoff 1e-4
+"""
+
+
 def quartz_deck(boundary: str, side: float, count: int, seed: int, drag: str, flow: str, integrator: str,
                 run: str) -> str:
     """A deck of `count` quartz spheres of 100 um at random (seed) in a cubic box of `side` with
     `boundary`, falling in water under gravity and buoyancy, with the `drag` lines, fix fluid/flow's
     arguments after the fluid (`flow`), fix nve/sphere/fluid's keywords (`integrator`), then `run`."""
-    return f"""units si
-atom_style sphere
-atom_modify map array
-boundary {boundary}
-region box block 0 {side} 0 {side} 0 {side}
-create_box 1 box
-create_atoms 1 random {count} {seed} NULL
-set group all diameter 1e-4
-set group all density 2650
-comm_modify cutoff 1e-4
-fix fall all gravity 9.81 vector 0 0 -1
+    return quartz_box(boundary, (side, side, side), f"create_atoms 1 random {count} {seed} NULL") + f"""fix fall all gravity 9.81 vector 0 0 -1
 fix water all fluid density 1000 viscosity 1e-3
 fix buoy all fluid/buoyancy water
 {drag}
@@ -452,20 +458,10 @@ def flow_bed(np_ranks: int):
     100 um piled in the bottom layer and 200 above: f_flow[6] counts those whose fraction is past the
     cap (1292 of the pile), whose fluid velocity is the uniform one (at rest) exactly, and only they
     (the build before: none)."""
-    deck = """units si
-atom_style sphere
-atom_modify map array
-boundary p p f
-region box block 0 2e-3 0 2e-3 0 4e-3
-create_box 1 box
-region bed block 0 2e-3 0 2e-3 0.06e-3 0.19e-3
+    deck = quartz_box("p p f", (2e-3, 2e-3, 4e-3), """region bed block 0 2e-3 0 2e-3 0.06e-3 0.19e-3
 region above block 0 2e-3 0 2e-3 1e-3 3.9e-3
 create_atoms 1 random 1500 2468 bed
-create_atoms 1 random 200 1357 above
-set group all diameter 1e-4
-set group all density 2650
-comm_modify cutoff 1e-4
-fix fall all gravity 9.81 vector 0 0 -1
+create_atoms 1 random 200 1357 above""") + """fix fall all gravity 9.81 vector 0 0 -1
 fix water all fluid density 1000 viscosity 1e-3
 fix buoy all fluid/buoyancy water
 compute conc all concentration/grid layers z 16 bounds 0 4e-3
@@ -487,18 +483,8 @@ print "RESULT left_out $(f_flow[6])"
     assert np.all(rows[capped, 2:5] == 0.0) and np.all(np.abs(rows[~capped, 2:5]).max(axis=1) > 0)
 
 
-PARCEL_IMAGE_DECK = """units si
-atom_style sphere
-atom_modify map array
-boundary p p f
-region box block 0 4e-3 0 4e-3 0 8e-3
-create_box 1 box
-create_atoms 1 single 2.125e-3 2.125e-3 ${z}
-set group all diameter 1e-4
-set group all density 2650
-fix weights all property/atom d_weight
+PARCEL_IMAGE_DECK = quartz_box("p p f", (4e-3, 4e-3, 8e-3), "create_atoms 1 single 2.125e-3 2.125e-3 ${z}") + """fix weights all property/atom d_weight
 set group all d_weight ${weight}
-comm_modify cutoff 1e-4
 fix water all fluid density 1000 viscosity 1e-3
 fix drag all fluid/drag water law stokes
 fix flow all fluid/flow water grid 16 16 32 column 0 8e-3 weight d_weight
