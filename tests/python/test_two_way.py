@@ -3,6 +3,7 @@
 and `sediment plan --measure-flow` (sediment.planner.flow)."""
 from __future__ import annotations
 
+import dataclasses
 import json
 import math
 from pathlib import Path
@@ -13,7 +14,7 @@ import pytest
 from sediment import _core, cli
 from sediment.constants import SWIRL_LENGTH
 from sediment.lab.psd import read_psd
-from sediment.planner.flow import FlowMeasurement, measure_flow
+from sediment.planner.flow import FlowMeasurement, coarser_cells, measure_flow
 from sediment.planner.screening import SedimentationTest
 from sediment.sim import scene as sc
 from sediment.sim.scenefiles import write
@@ -36,6 +37,20 @@ def test_the_column_is_three_swirls_wide_in_cubic_cells_the_ffts_take(column):
     assert _core.fft_friendly(tall) and not any(_core.fft_friendly(n) for n in range(fewest, tall))
     assert (across, column.width / across) == (16, pytest.approx(column.height / tall, rel=1e-12))
     assert 2.85 * swirl < column.width <= 3 * swirl
+
+
+def test_another_grid_keeps_cubic_cells_and_a_check_grid_keeps_the_parcels(column):
+    """--flow-cells 12 plans the same width on 12 x 12 x 360 cubic cells; the grid check of a
+    measurement (coarser_cells: 12 for 16) reruns the first draw's very parcels on its grid, with the
+    steps that grid's larger cells allow."""
+    twelve = sc.plan(read_psd(SAMPLE2), effects=sc.Effects(flow=True), flow_cells=12)
+    assert twelve.flow_grid() == (12, 360) and twelve.width == pytest.approx(column.width)
+    # over 480 cells up a check grid's must be whole and a size the FFTs take: 12 x 12 x 360
+    assert [coarser_cells(dataclasses.replace(column, flow_cells=n, width=column.height * n / up))
+            for n, up in ((16, 480), (24, 480), (8, 480), (16, 125), (4, 480))] == [12, 18, 6, None, None]
+    check = dataclasses.replace(column, flow_cells=coarser_cells(column))
+    assert check.flow_grid() == (12, 360) and check.position is column.position
+    assert sum(n for _, n in check.stages()) < sum(n for _, n in column.stages())
 
 
 def test_the_parcels_start_independent_so_their_counts_fluctuate_as_the_grains(column):
@@ -118,6 +133,8 @@ def test_the_deck_runs_the_flow_or_its_one_way_twin(column, tmp_path):
 
 @pytest.mark.parametrize("options, message", [
     ({"geometry": "slab"}, "two-way coupling is simulated in a column"),
+    ({"flow_cells": 14}, "a product of 2, 3 and 5"),
+    ({"flow_cells": 3}, "4 or more cells across"),
     ({"particles": None, "effects": sc.Effects(flow=True, contacts=True)}, "two-way coupling is simulated in a column"),
 ])
 def test_a_two_way_scene_it_cannot_simulate_is_refused(options, message):
@@ -128,6 +145,8 @@ def test_a_two_way_scene_it_cannot_simulate_is_refused(options, message):
 
 @pytest.mark.parametrize("arguments, message", [
     (["--screen-only", "--flow-seeds", "2"], "--flow-seeds sets the draws of --measure-flow: give both"),
+    (["--screen-only", "--flow-cells", "12"], "--flow-cells sets the draws of --measure-flow: give both"),
+    (["--screen-only", "--measure-flow", "--flow-cells", "14"], "a product of 2, 3 and 5 (the sizes LAMMPS's FFTs"),
     (["--screen-only", "--measure-flow", "--flow-seeds", "0"], "--flow-seeds: must be >= 1, got 0"),
     (["--screen-only", "--measure-flow", "--geometry", "slab"], "two-way coupling is simulated in a column"),
 ])
@@ -167,16 +186,20 @@ def test_the_changes_are_paired_per_draw_and_their_verdict_holds_two_standard_er
 
 
 def test_plan_measures_a_short_column_two_ways_and_its_twin(tmp_path):
-    """`sediment plan --measure-flow` end to end on a short column (5 cm, 2000 parcels, the buoyancy
+    """`sediment plan --measure-flow` end to end on a short column (6 cm, 2000 parcels, the buoyancy
     sphere's readings in the first minute; the machinery, not the physics of a test): both runs of each
-    draw finish, and flow.csv and flow.json hold the paired changes."""
+    draw and of the grid check finish, and flow.csv and flow.json hold the paired changes."""
     out = tmp_path / "plan"
-    assert cli.main(["plan", str(SAMPLE2), "--screen-only", "--measure-flow", "--flow-seeds", "2", "--height", "0.05",
+    assert cli.main(["plan", str(SAMPLE2), "--screen-only", "--measure-flow", "--flow-seeds", "2", "--height", "0.06",
                      "--t-end", "60", "--instruments", "buoyancy", "--particles", "2000", "--jobs", "2",
                      "--out", str(out)]) == 0
     summary = json.loads((out / "flow.json").read_text())
     assert summary["seeds"] == [1, 2] and summary["grid"][:2] == [16, 16]
     assert summary["largest"]["instrument"] == "buoyancy" and math.isfinite(summary["largest"]["change_pp"])
+    # the grid check: seed 1 again on 12 cells across, with its own twin
+    check = summary["grid_check"]
+    assert check["cells"] == 16 and check["check_cells"] == 12 and math.isfinite(check["check_change_pp"])
+    assert "grid 12 12 " in (out / "flow" / "seed_1_cells_12" / "two" / "in.sedimentation").read_text()
     rows = (out / "flow.csv").read_text().splitlines()
     assert rows[0].startswith("instrument,time_min,one_way,two_way,change_pp") and len(rows) == 3
     for seed in (1, 2):
@@ -184,7 +207,7 @@ def test_plan_measures_a_short_column_two_ways_and_its_twin(tmp_path):
             assert (out / "flow" / f"seed_{seed}" / kind / "layers.h5").is_file()
 
 
-def test_a_measurement_that_fails_puts_the_flow_into_the_plan(tmp_path):
+def test_a_measurement_that_fails_puts_the_flow_into_the_plan(column, tmp_path):
     """Where two-way coupling moves a reading beyond the tolerance it is on in the plan: switch_on sets
     the decision's two_way, rewrites its deck under the flow, records the measurement, and `sediment
     sample --plan` then writes the two-way column."""
@@ -200,13 +223,14 @@ def test_a_measurement_that_fails_puts_the_flow_into_the_plan(tmp_path):
                                                       "scene_options": scene.options_record()}))
     assert decided_options(tmp_path / "report.json")[0]["two_way"] is False
     times = np.array([44.5])
-    failing = FlowMeasurement(None, [1, 2], {"pipette": times}, {"pipette": np.array([[60.0], [61.0]])},
+    failing = FlowMeasurement(dataclasses.replace(column, flow_cells=12), [1, 2], {"pipette": times}, {"pipette": np.array([[60.0], [61.0]])},
                               {"pipette": np.array([[50.0], [50.5]])})
     switch_on(tmp_path, scene, failing, 0.5)
     report = json.loads((tmp_path / "report.json").read_text())
     assert report["two_way"]["change_pp"] == pytest.approx(10.25) and report["two_way"]["verdict"].startswith("fails")
     assert decided_options(tmp_path / "report.json")[0]["two_way"] is True
-    assert "fluid/flow" in (tmp_path / "decision" / "in.sedimentation").read_text()
+    assert decided_options(tmp_path / "report.json")[0]["flow_cells"] == 12    # the grid it was measured on
+    assert "fluid/flow water grid 12 12 " in (tmp_path / "decision" / "in.sedimentation").read_text()
     assert cli.main(["sample", str(SAMPLE2), "--plan", str(tmp_path / "report.json"), "--out",
                      str(tmp_path / "sample")]) == 0
-    assert "fluid/flow" in (tmp_path / "sample" / "in.sedimentation").read_text()
+    assert "fluid/flow water grid 12 12 " in (tmp_path / "sample" / "in.sedimentation").read_text()

@@ -76,6 +76,9 @@ def add_parser(commands) -> argparse.ArgumentParser:
                       "and flow.json (15-50 min per draw on one core for Bravo et al.'s samples; docs/effects.md "
                       "section 3)")
     test.add_argument("--flow-seeds", type=count, default=3, help="draws of --measure-flow (default 3)")
+    test.add_argument("--flow-cells", type=count, default=None, metavar="N",
+                      help="fix fluid/flow's cells across the column of --measure-flow (default 16; docs/effects.md "
+                      "section 3 shows what the grid changes)")
     deck = parser.add_argument_group("deck")
     deck.add_argument("--observe", nargs="+", metavar="NAME", help="RESULT or SERIES names the deck prints")
     deck.add_argument("--ladder", type=_ladder, action="append", metavar="NAME=V1,V2",
@@ -128,8 +131,9 @@ def run(args: argparse.Namespace) -> int:
         name = args.psd.stem
         if args.contact_cut is not None and not args.measure_contacts:
             raise ValueError("--contact-cut sets the reduced scene of --measure-contacts: give both")
-        if args.flow_seeds != args.kinds["test"]["flow_seeds"] and not args.measure_flow:
-            raise ValueError("--flow-seeds sets the draws of --measure-flow: give both")
+        for name in ("flow_seeds", "flow_cells"):
+            if getattr(args, name) != args.kinds["test"][name] and not args.measure_flow:
+                raise ValueError(f"--{name.replace('_', '-')} sets the draws of --measure-flow: give both")
         if args.screen_only:
             if args.set:
                 pin(scene, dict(args.set))    # a wrong setting named first
@@ -162,25 +166,30 @@ def _measure_flow(test, args: argparse.Namespace, tolerance: float, options: dic
     import json
     import sys
 
-    from ..planner.flow import flow_scene, measure_draw, measure_flow
+    from ..planner.flow import coarser_cells, flow_scene, measure_draw, measure_flow
     from ..planner.scenes import prepare
     from ..results import write_text
     from ..sim.process import Runs
 
     seeds = [args.seed + k for k in range(args.flow_seeds)]
     options = {k: v for k, v in options.items() if k != "width"}    # the column's width is the swirls'
+    if args.flow_cells is not None:
+        options["flow_cells"] = args.flow_cells
     first = flow_scene(test, seeds[0], **options)
     across, tall = first.flow_grid()
+    check = coarser_cells(first)
     print(f"measuring two-way coupling: a column {first.width * 1e3:.3g} mm wide ({across} x {across} x {tall} cells), "
           f"{len(first.diameter)} parcels, {sum(n for _, n in first.stages())} steps, and its one-way twin, "
-          f"{len(seeds)} draws ({min(args.jobs, len(seeds))} at once) ...", flush=True)
+          f"{len(seeds)} draws" + (f", and seed {seeds[0]}'s on {check} cells across (the grid check)" if check else "")
+          + f" ({min(args.jobs, len(seeds) + bool(check))} at once) ...", flush=True)
     running = Runs()
     folder = prepare(args.out / "flow")
-    bars = {seed: progress_bar(total=1, desc=f"two-way seed {seed}", unit="step", position=k, file=sys.stderr,
-                               dynamic_ncols=True, mininterval=0.5) for k, seed in enumerate(seeds)}
+    names = [f"seed {seed}" for seed in seeds] + ([f"seed {seeds[0]}, {check} across"] if check else [])
+    bars = {name: progress_bar(total=1, desc=f"two-way {name}", unit="step", position=k, file=sys.stderr,
+                               dynamic_ncols=True, mininterval=0.5) for k, name in enumerate(names)}
 
     def draw(test, scene, where):
-        bar = bars[scene.seed]
+        bar = bars[f"seed {scene.seed}" + (f", {scene.flow_cells} across" if scene.flow_cells != across else "")]
 
         def update(done: int, total: int) -> None:
             bar.total = total
@@ -188,7 +197,8 @@ def _measure_flow(test, args: argparse.Namespace, tolerance: float, options: dic
         return measure_draw(test, scene, where, running=running, on_progress=update)
 
     try:
-        measured = measure_flow(test, seeds, folder, jobs=args.jobs, running=running, draw=draw, **options)
+        measured = measure_flow(test, seeds, folder, jobs=args.jobs, running=running, draw=draw, check_cells=check,
+                                **options)
     finally:
         for bar in bars.values():
             bar.close()
@@ -198,12 +208,18 @@ def _measure_flow(test, args: argparse.Namespace, tolerance: float, options: dic
     verdict = measured.verdict(tolerance)
     print(f"two-way coupling moves the {name} reading at {at / 60:.3g} min by {change:+.3g} +- {error:.2g} pp "
           f"(tolerance {tolerance:g}): the one-way assumption {verdict}")
+    grid = measured.grid_check()
+    if grid is not None:
+        print(f"grid check: seed {seeds[0]}'s change there is {grid[2]:+.3g} pp on {grid[0]} cells across, "
+              f"{grid[3]:+.3g} on {grid[1]} (the grid's effect on this measurement)")
     write_text(args.out / "flow.csv", table.csv())
     write_text(args.out / "flow.json", json.dumps({
         "seeds": seeds, "width_m": first.width, "grid": [across, across, tall], "parcels": len(first.diameter),
         "loop_seconds": measured.loop_seconds, "largest": {"instrument": name, "time_s": at, "change_pp": change,
                                                             "standard_error_pp": error},
-        "tolerance_pp": tolerance, "verdict": verdict}, indent=2) + "\n")
+        "tolerance_pp": tolerance, "verdict": verdict,
+        "grid_check": None if grid is None else {"cells": grid[0], "change_pp": grid[2], "check_cells": grid[1],
+                                                 "check_change_pp": grid[3]}}, indent=2) + "\n")
     return measured
 
 

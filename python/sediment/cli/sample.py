@@ -39,6 +39,9 @@ def add_parser(commands) -> argparse.ArgumentParser:
     parser.add_argument("--two-way", action="store_true",
                         help="two-way coupling: the flow the grains drive (fix fluid/flow), in a column three swirls "
                         "wide with parcels placed independently; the deck's `-var flow no` runs its one-way twin")
+    parser.add_argument("--flow-cells", type=count, metavar="N",
+                        help="with --two-way: fix fluid/flow's cubic cells across the column (default 16; a size "
+                        "the FFTs take; docs/effects.md section 3 shows what the grid changes)")
     parser.add_argument("--courant", type=positive, default=4.0,
                         help="layers the fastest grain in suspension may cross per step (default 4: within 0.25 "
                         "points of percent finer of Courant 1 for the five samples of docs/effects.md)")
@@ -47,7 +50,8 @@ def add_parser(commands) -> argparse.ArgumentParser:
                         "file, restart files, logs) instead of refusing")
     parser.add_argument("--plan", type=Path, metavar="REPORT",
                         help="take the drag, hindrance, parcels and Courant number that `sediment plan` decided "
-                        "(its report.json) instead of --drag, --hindrance, --particles and --courant")
+                        "(its report.json) instead of --drag, --hindrance, --particles and --courant (and whether "
+                        "to couple two ways, on which grid)")
     return parser
 
 
@@ -106,9 +110,11 @@ def cylinder_of(args: argparse.Namespace):
 def run(args: argparse.Namespace) -> int:
     """Plans the scene, prints it and writes its data file, deck and PSD tables."""
     from ..lab.psd import read_psd
-    from ..sim.scene import plan
+    from ..sim.scene import FLOW_CELLS_ACROSS, plan
     from ..sim.scenefiles import describe, runs_replaced, write
 
+    if args.flow_cells is not None and not args.two_way:
+        raise ValueError("--flow-cells sets the grid of --two-way's flow: give both")
     psd = read_psd(args.psd)
     record = ()
     if args.temperature_record is not None:
@@ -140,7 +146,8 @@ def run(args: argparse.Namespace) -> int:
             raise ValueError(f"{args.plan} was made for another test: " + ", ".join(differ) +
                              "; plan this one (sediment plan) or sample without --plan")
         print(f"the plan's decision ({args.plan}): --drag {args.drag} --hindrance {args.hindrance} "
-              f"--particles {args.particles} --courant {args.courant:g}" + (" --two-way" if args.two_way else ""))
+              f"--particles {args.particles} --courant {args.courant:g}"
+              + (f" --two-way --flow-cells {args.flow_cells}" if args.two_way else ""))
 
     suspension = suspension_of(args)
     if record:
@@ -152,7 +159,8 @@ def run(args: argparse.Namespace) -> int:
                  suspension=suspension, width=args.width,
                  classes=args.classes, particles=None if args.real_grains else args.particles,
                  effects=effects_of(args, args.contacts, args.lubrication),
-                 layers=args.layers, t_end=args.t_end, courant=args.courant, seed=args.seed)
+                 layers=args.layers, t_end=args.t_end, courant=args.courant, seed=args.seed,
+                 flow_cells=args.flow_cells or FLOW_CELLS_ACROSS)
     scene.water_record = record
     print(describe(scene))
     write(scene, args.out)

@@ -7,18 +7,20 @@ test's column of parcels FLOW_SWIRLS swirls wide and the cylinder's height, plac
 under `fix fluid/flow` (each parcel stirring the fluid as its real grains do), and its one-way twin:
 the same data file, deck, steps and frames, with the fluid at rest (`-var flow no`). A draw is the
 pair; the readings' changes are paired per draw, so the parcels' sampling error, which both share,
-drops out of the change. Draws with independent seeds give its standard error.
+drops out of the change. Draws with independent seeds give its standard error, and the first draw
+run again on a coarser grid (its own twin beside it) shows what the grid changes.
 """
 from __future__ import annotations
 
 import math
 import re
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Callable
 
 import numpy as np
 
+from .. import _core
 from ..results import Table
 from ..sim.process import Runs
 from ..sim.run import run_batch
@@ -37,6 +39,7 @@ class FlowMeasurement:
     two_way: dict[str, np.ndarray] = field(default_factory=dict)     # [draw, reading] percent finer
     one_way: dict[str, np.ndarray] = field(default_factory=dict)
     loop_seconds: list[tuple[float, float]] = field(default_factory=list)    # per draw: two-way, one-way
+    check: FlowMeasurement | None = None    # the first draw on a coarser grid (measure_flow's check_cells)
 
     def changes(self) -> dict[str, tuple[np.ndarray, np.ndarray, np.ndarray]]:
         """Per instrument: reading times, the mean change two-way minus one-way [pp] and its standard
@@ -57,6 +60,17 @@ class FlowMeasurement:
             if abs(change[k]) >= abs(best[2]):
                 best = (name, float(times[k]), float(change[k]), float(error[k]))
         return best
+
+    def grid_check(self) -> tuple[int, int, float, float] | None:
+        """The first draw's change at the largest reading on its grid and on the check's: (cells across,
+        the check's, change, the check's change) [pp]; None without a check."""
+        if self.check is None or self.scene is None or self.check.scene is None:
+            return None
+        name, at, _, _ = self.largest()
+        k = int(np.flatnonzero(self.times[name] == at)[0])
+        change = self.two_way[name][0, k] - self.one_way[name][0, k]
+        coarse = self.check.two_way[name][0, k] - self.check.one_way[name][0, k]
+        return self.scene.flow_cells, self.check.scene.flow_cells, float(change), float(coarse)
 
     def verdict(self, tolerance: float) -> str:
         """Whether the one-way assumption holds at `tolerance` [pp]: the largest mean change with two
@@ -94,6 +108,8 @@ def switch_on(plan_folder: Path, scene, measured: FlowMeasurement, tolerance: fl
     report = json.loads(report_path.read_text())
     decision = report["decision"]
     decision["settings"]["two_way"] = True
+    if measured.scene is not None:    # the grid it was measured on
+        decision["settings"]["flow_cells"] = measured.scene.flow_cells
     name, at, change, error = measured.largest()
     report["two_way"] = {"seeds": measured.seeds, "instrument": name, "time_s": at, "change_pp": change,
                          "standard_error_pp": error, "tolerance_pp": tolerance, "verdict": measured.verdict(tolerance)}
@@ -123,24 +139,44 @@ def measure_draw(test: SedimentationTest, scene: Scene, folder: Path, running: R
     return (*read_draw(test, folder), (seconds["two"], seconds["one"]))
 
 
+def coarser_cells(scene: Scene) -> int | None:
+    """The grid check's cells across for a two-way column: of the coarser grids of cubic cells over the
+    same width and height whose sizes the FFTs take (fix fluid/flow's cells are cubes), the one nearest
+    three quarters of the scene's cells (16 x 16 x 480: 12 x 12 x 360); at least 4 across, None if
+    there is none."""
+    cells, up = scene.flow_grid()
+    sizes = [n for n in range(4, cells) if (up * n) % cells == 0 and _core.fft_friendly(n)
+             and _core.fft_friendly(up * n // cells)]
+    return min(sizes, key=lambda n: abs(n - 0.75 * cells)) if sizes else None
+
+
 def measure_flow(test: SedimentationTest, seeds: list[int], folder: Path, jobs: int = 1, running: Runs | None = None,
-                 draw: Callable | None = None, **options) -> FlowMeasurement:
+                 draw: Callable | None = None, check_cells: int | None = None, **options) -> FlowMeasurement:
     """The draws of `seeds` in folder/seed_N, `jobs` at once (`draw(test, scene, folder)` runs one:
-    measure_draw by default), gathered into a FlowMeasurement. A draw that fails stops the others
-    (through `running`) and raises."""
+    measure_draw by default), gathered into a FlowMeasurement. With `check_cells`, the first draw's
+    parcels also run (and their twin, at that grid's steps) with that many cells across, in
+    folder/seed_N_cells_M: the measurement's `check`. A draw that fails stops the others (through
+    `running`) and raises."""
     from concurrent.futures import ThreadPoolExecutor
 
     draw = draw or (lambda test, scene, where: measure_draw(test, scene, where, running=running))
     scenes = [flow_scene(test, seed, **options) for seed in seeds]
-    with ThreadPoolExecutor(max_workers=max(1, min(jobs, len(seeds)))) as pool:
-        futures = [pool.submit(draw, test, scene, Path(folder) / f"seed_{seed}") for seed, scene in zip(seeds, scenes)]
+    folders = [Path(folder) / f"seed_{seed}" for seed in seeds]
+    if check_cells is not None:
+        scenes.append(replace(scenes[0], flow_cells=check_cells))    # the same parcels, width and frames
+        folders.append(Path(folder) / f"seed_{seeds[0]}_cells_{check_cells}")
+    with ThreadPoolExecutor(max_workers=max(1, min(jobs, len(scenes)))) as pool:
+        futures = [pool.submit(draw, test, scene, where) for scene, where in zip(scenes, folders)]
         try:
             results = [f.result() for f in futures]
         except BaseException:    # Ctrl-C or a failed draw: stop the others too
             if running is not None:
                 running.stop()
             raise
-    return gather(scenes[0], seeds, results)
+    measured = gather(scenes[0], seeds, results[:len(seeds)])
+    if check_cells is not None:
+        measured.check = gather(scenes[-1], seeds[:1], results[len(seeds):])
+    return measured
 
 
 def gather(scene: Scene | None, seeds: list[int],

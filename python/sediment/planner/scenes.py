@@ -26,6 +26,7 @@ from ..sim.printed import parse_printed
 from ..sim.process import Runs
 from ..sim.run import run_batch
 from ..constants import DRAGS, HINDRANCES
+from ..sim.scene import FLOW_CELLS_ACROSS
 from .screening import INCLUDE, MEASURE, OMIT, Screen, SedimentationTest, screen, verdict_of
 
 
@@ -90,8 +91,11 @@ def decided_options(report: Path) -> tuple[dict, dict]:
         two_way = decision.get("two_way", False)    # switched on by a measurement (--measure-flow) that needed it
         if not isinstance(two_way, bool):
             raise ValueError(f"two_way {two_way!r}")
+        flow_cells = decision.get("flow_cells", FLOW_CELLS_ACROSS)    # the grid it was measured on
+        if not (isinstance(flow_cells, int) and flow_cells >= 4):
+            raise ValueError(f"flow_cells {flow_cells!r}")
         return ({"drag": decision["drag"], "hindrance": hindrance, "particles": particles, "courant": float(courant),
-                 "two_way": two_way}, content["scene_options"])
+                 "two_way": two_way, "flow_cells": flow_cells}, content["scene_options"])
     except (json.JSONDecodeError, UnicodeDecodeError) as exc:
         raise ValueError(f"{report} is not a plan's report.json: {exc}") from None
     except (KeyError, TypeError, ValueError) as exc:
@@ -136,7 +140,9 @@ class SampleScene:
     def describe(self, settings: dict) -> str:
         """The `sediment sample` options of a setting."""
         return (f"--drag {settings['drag']} --hindrance {settings['hindrance']} --particles {settings['particles']} "
-                f"--courant {settings['courant']:g}" + (" --two-way" if settings.get("two_way") else ""))
+                f"--courant {settings['courant']:g}" + (" --two-way" if settings.get("two_way") else "")
+                + (f" --flow-cells {settings['flow_cells']}" if settings.get("two_way") and "flow_cells" in settings
+                   else ""))
 
     def options_record(self) -> dict:
         """The test besides the knobs, as `sediment sample --plan` checks it."""
@@ -152,7 +158,8 @@ class SampleScene:
         scene = plan(t.psd, cylinder=t.cylinder, mass=t.mass, suspension=t.suspension, seed=seed,
                      particles=int(settings["particles"]), courant=float(settings["courant"]),
                      effects=Effects(settings["drag"], hindrance=settings["hindrance"],
-                                     flow=settings.get("two_way", False)), **self.options)
+                                     flow=settings.get("two_way", False)),
+                     flow_cells=settings.get("flow_cells", FLOW_CELLS_ACROSS), **self.options)
         scene.water_record = self.water_record
         return scene
 

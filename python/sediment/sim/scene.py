@@ -98,6 +98,21 @@ class Effects:
         return self.contacts or self.lubrication
 
 
+# Two-way coupling (`--two-way`): the column is FLOW_SWIRLS swirls wide (Segre et al.'s 40 a phi^-1/3 at
+# the start, a the mass-mean radius), the flow's grid FLOW_CELLS_ACROSS cubic cells across it by
+# default (Scene.flow_cells), and each step carries a parcel at most FLOW_COURANT cells at the grid's largest
+# velocity, taken as FLOW_PEAK times the root mean square that the independent start drives: the
+# largest of some 1e5 nodes of a Gaussian field. Sample 2 (docs/effects.md): 12 mm, 16 x 16 x 480.
+FLOW_SWIRLS = 3
+FLOW_CELLS_ACROSS = 16
+FLOW_COURANT = 0.5
+FLOW_PEAK = 4.5
+# The swirls outlast the grains that drive them: no stage's step is more than twice the last's, as the
+# settling schedule's. Sample 2 without that limit: the step went from 0.052 to 0.47 s at 185 s while
+# the grid's largest velocity was still 1.6 mm/s (0.8 allowed), and the next steps carried the parcels
+# 19 cells.
+
+
 @dataclass
 class Scene:
     """Everything `write` needs; built by `plan`."""
@@ -125,6 +140,8 @@ class Scene:
     # the run re-issues the fluid at each frame where it has moved by more than DRIFT_STEP since the
     # last (a laboratory's day); empty: the suspension's water throughout
     water_record: tuple[tuple[float, float], ...] = ()
+    # two-way coupling: fix fluid/flow's cells across the column (flow_grid)
+    flow_cells: int = FLOW_CELLS_ACROSS
     diameter: np.ndarray = field(default_factory=lambda: np.empty(0))    # per atom [m]
     weight: np.ndarray = field(default_factory=lambda: np.empty(0))
     position: np.ndarray = field(default_factory=lambda: np.empty((0, 3)))
@@ -197,8 +214,8 @@ class Scene:
 
     def flow_grid(self) -> tuple[int, int]:
         """Cells of fix fluid/flow's grid across the column and along its height: cubic cells,
-        FLOW_CELLS_ACROSS across (a width `plan` makes a whole number of them up the height)."""
-        return FLOW_CELLS_ACROSS, round(self.height * FLOW_CELLS_ACROSS / self.width)
+        flow_cells across (a width `plan` makes a whole number of them up the height)."""
+        return self.flow_cells, round(self.height * self.flow_cells / self.width)
 
     def flow_speed(self, time: float = 0.0) -> float:
         """Root mean square of the fluid velocity [m/s] that the grains placed independently drive on the
@@ -230,7 +247,7 @@ class Scene:
         a parcel FLOW_COURANT cells: past a cell a step the flow cannot follow the density it is solved
         from (fix fluid/flow's doc page, Stability)."""
         speed = self.flow_speed(time)
-        cell = self.width / self.flow_grid()[0]
+        cell = self.width / self.flow_cells
         return math.inf if speed == 0 else FLOW_COURANT * cell / (FLOW_PEAK * speed)
 
     @property
@@ -276,19 +293,6 @@ class Scene:
 
 
 FRAMES_PER_STAGE = 20
-# Two-way coupling (`--two-way`): the column is FLOW_SWIRLS swirls wide (Segre et al.'s 40 a phi^-1/3 at
-# the start, a the mass-mean radius), the flow's grid FLOW_CELLS_ACROSS cubic cells across it (the
-# FFT's size, 2^4), and each step carries a parcel at most FLOW_COURANT cells at the grid's largest
-# velocity, taken as FLOW_PEAK times the root mean square that the independent start drives: the
-# largest of some 1e5 nodes of a Gaussian field. Sample 2 (docs/effects.md): 12 mm, 16 x 16 x 480.
-FLOW_SWIRLS = 3
-FLOW_CELLS_ACROSS = 16
-FLOW_COURANT = 0.5
-FLOW_PEAK = 4.5
-# The swirls outlast the grains that drive them: no stage's step is more than twice the last's, as the
-# settling schedule's. Sample 2 without that limit: the step went from 0.052 to 0.47 s at 185 s while
-# the grid's largest velocity was still 1.6 mm/s (0.8 allowed), and the next steps carried the parcels
-# 19 cells.
 MAX_PARTICLES = 10_000_000
 POISSON_RATIO = 0.3
 OVERLAP_TOLERANCE = 0.01    # largest contact overlap / diameter the soft contacts are made for
@@ -357,7 +361,7 @@ def swirl_length(psd: PSD, solids: float) -> float:
 def plan(psd: PSD, *, geometry: str = "column", cylinder: Cylinder = Cylinder(), mass: float = SPECIMEN_MASS,
          suspension: Suspension = Suspension(), width: float | None = None, classes: int | np.ndarray = 40,
          particles: int | None = 20000, effects: Effects = Effects(), layers: int = 400, t_end: float = 86400.0,
-         courant: float = 4.0, seed: int = 1) -> Scene:
+         courant: float = 4.0, seed: int = 1, flow_cells: int = FLOW_CELLS_ACROSS) -> Scene:
     """The scene of a test: sub-volume, classes, particles and their placement.
 
     Parameters
@@ -390,6 +394,9 @@ def plan(psd: PSD, *, geometry: str = "column", cylinder: Cylinder = Cylinder(),
         finer of 1 for the five samples of docs/effects.md).
     seed : int
         Placement seed.
+    flow_cells : int
+        With effects.flow: fix fluid/flow's cubic cells across the column, a size the FFTs take (16: the
+        grid check of docs/effects.md section 3).
 
     Returns
     -------
@@ -419,11 +426,14 @@ def plan(psd: PSD, *, geometry: str = "column", cylinder: Cylinder = Cylinder(),
                              "(--geometry column, no --contacts or --lubrication)")
         swirl = FLOW_SWIRLS * swirl_length(psd, solids)
         width = swirl if width is None else width
-        # cubic cells, FLOW_CELLS_ACROSS across, a whole number up the height that the FFTs take
-        up = math.ceil(cylinder.height * FLOW_CELLS_ACROSS / width)
+        if not (flow_cells >= 4 and _core.fft_friendly(flow_cells)):
+            raise ValueError(f"the flow's grid needs 4 or more cells across, a product of 2, 3 and 5 (the sizes "
+                             f"LAMMPS's FFTs take), not {flow_cells}")
+        # cubic cells, flow_cells across, a whole number up the height that the FFTs take
+        up = math.ceil(cylinder.height * flow_cells / width)
         while not _core.fft_friendly(up):
             up += 1
-        width = cylinder.height * FLOW_CELLS_ACROSS / up
+        width = cylinder.height * flow_cells / up
     if geometry == "slab":
         width = cylinder.diameter if width is None else width
         thickness = d_max
@@ -438,7 +448,7 @@ def plan(psd: PSD, *, geometry: str = "column", cylinder: Cylinder = Cylinder(),
         raise ValueError(f"{size_classes.count.sum():.3g} real grains in this sub-volume (more than {MAX_PARTICLES:.0e}): "
                          "simulate parcels (--particles) or a smaller sub-volume (--width, --height)")
     scene = Scene(psd, size_classes, suspension, cylinder, geometry, width, thickness, mass, effects, layers, t_end,
-                  courant, seed)
+                  courant, seed, flow_cells=flow_cells)
     _check_runnable(scene)
     place(scene)
     return scene
