@@ -235,6 +235,21 @@ def test_run_reports_the_lammps_error(tmp_path, capsys):
     assert "in.bad failed" in err and "Fix fluid" in err
 
 
+def test_any_time_step_scale_ends_on_a_frame_and_an_unread_variable_is_refused(tmp_path, capsys):
+    """A stage is a whole number of frames at every dt_scale (`sediment sweep --dt`): sample 2's 6 cm
+    minute has a frame every 5 steps, every 3 at dt_scale 2 (LAMMPS rounds 2.5 up), and ended two
+    steps short of its last frame, before t_end, which fix layers/hdf5 refused. A --var the deck never
+    reads would run it as if not given: refused, naming it."""
+    out = tmp_path / "s"
+    assert cli.main(["sample", str(PSDS / "sample2.csv"), "--height", "0.06", "--t-end", "60", "--particles", "2000",
+                     "--out", str(out)]) == 0
+    for scale in ("2", "3"):
+        assert cli.main(["run", str(out / "in.sedimentation"), "--var", "dt_scale", scale, "--force", "--quiet"]) == 0
+        assert "60.9239 s simulated" in capsys.readouterr().out    # to the stage's last frame past 60 s
+    assert cli.main(["run", str(out / "in.sedimentation"), "--var", "flow", "yes", "--quiet"]) == 2
+    assert "never reads a variable 'flow'" in capsys.readouterr().err
+
+
 def test_end_to_end_sample5_hydrometer_follows_the_simulated_psd(tmp_path, capsys):
     """sample -> run (2 MPI ranks) -> readout on sample 5: 3000 parcels, the full 0.36 m column, to
     250 min (the D422 readings that cover 5-50 um). The hydrometer must read the simulated PSD within

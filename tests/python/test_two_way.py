@@ -41,16 +41,17 @@ def test_the_column_is_three_swirls_wide_in_cubic_cells_the_ffts_take(column):
 
 def test_another_grid_keeps_cubic_cells_and_a_check_grid_keeps_the_parcels(column):
     """--flow-cells 12 plans the same width on 12 x 12 x 360 cubic cells; the grid check of a
-    measurement (coarser_cells: 12 for 16) reruns the first draw's very parcels on its grid, with the
-    steps that grid's larger cells allow."""
+    measurement (coarser_cells: 12 for 16) reruns the first draw's very parcels on its grid at the first
+    draw's steps, so that its one-way twin is the first draw's and the grid is all that differs."""
     twelve = sc.plan(read_psd(SAMPLE2), effects=sc.Effects(flow=True), flow_cells=12)
     assert twelve.flow_grid() == (12, 360) and twelve.width == pytest.approx(column.width)
     # over 480 cells up a check grid's must be whole and a size the FFTs take: 12 x 12 x 360
     assert [coarser_cells(dataclasses.replace(column, flow_cells=n, width=column.height * n / up))
             for n, up in ((16, 480), (24, 480), (8, 480), (16, 125), (4, 480))] == [12, 18, 6, None, None]
-    check = dataclasses.replace(column, flow_cells=coarser_cells(column))
+    check = dataclasses.replace(column, flow_cells=coarser_cells(column), flow_step_cells=16)
     assert check.flow_grid() == (12, 360) and check.position is column.position
-    assert sum(n for _, n in check.stages()) < sum(n for _, n in column.stages())
+    assert check.stages() == column.stages()
+    assert sum(n for _, n in twelve.stages()) < sum(n for _, n in column.stages())    # its own, larger steps
 
 
 def test_the_parcels_start_independent_so_their_counts_fluctuate_as_the_grains(column):
@@ -135,6 +136,7 @@ def test_the_deck_runs_the_flow_or_its_one_way_twin(column, tmp_path):
     ({"geometry": "slab"}, "two-way coupling is simulated in a column"),
     ({"flow_cells": 14}, "a product of 2, 3 and 5"),
     ({"flow_cells": 3}, "4 or more cells across"),
+    ({"flow_cells": 64}, r"grid would be 64 x 64 x 1850 cells \(7.58e\+06, about 2.3 GB\), beyond 4.19e\+06"),
     ({"particles": None, "effects": sc.Effects(flow=True, contacts=True)}, "two-way coupling is simulated in a column"),
 ])
 def test_a_two_way_scene_it_cannot_simulate_is_refused(options, message):
@@ -147,6 +149,8 @@ def test_a_two_way_scene_it_cannot_simulate_is_refused(options, message):
     (["--screen-only", "--flow-seeds", "2"], "--flow-seeds sets the draws of --measure-flow: give both"),
     (["--screen-only", "--flow-cells", "12"], "--flow-cells sets the draws of --measure-flow: give both"),
     (["--screen-only", "--measure-flow", "--flow-cells", "14"], "a product of 2, 3 and 5 (the sizes LAMMPS's FFTs"),
+    (["--screen-only", "--measure-flow", "--flow-cells", "1000"], "grid would be 1000 x 1000 x 28906 cells"),
+    (["--screen-only", "--measure-flow", "--flow-seeds", "1000000000"], "at most 100 draws"),
     (["--screen-only", "--measure-flow", "--flow-seeds", "0"], "--flow-seeds: must be >= 1, got 0"),
     (["--screen-only", "--measure-flow", "--geometry", "slab"], "two-way coupling is simulated in a column"),
 ])
@@ -170,11 +174,13 @@ def test_the_changes_are_paired_per_draw_and_their_verdict_holds_two_standard_er
 
     def draw(test, scene, folder):
         base = np.array([80.0, 60.0]) + offsets[scene.seed]
-        change = np.array([1.0 + 0.1 * scene.seed, -0.2])
+        change = np.array([1.0 + 0.1 * scene.seed, -0.2]) * (0.5 if scene.flow_cells == 12 else 1.0)
         return {"pipette": (times, base + change)}, {"pipette": (times, base)}, (2.0, 1.0)
 
     test = SedimentationTest(read_psd(SAMPLE2), instruments=("pipette",))
-    measured = measure_flow(test, [1, 2, 3], Path("unused"), draw=draw, t_end=600.0)
+    measured = measure_flow(test, [1, 2, 3], Path("unused"), draw=draw, check_cells=12, t_end=600.0)
+    # the grid check: the first draw's change at the largest reading, on 16 and on 12 cells across
+    assert measured.grid_check() == (16, 12, pytest.approx(1.1), pytest.approx(0.55))
     _, change, error = measured.changes()["pipette"]
     assert change == pytest.approx([1.2, -0.2]) and error == pytest.approx([0.1 / math.sqrt(3), 0.0], abs=1e-12)
     assert measured.largest() == ("pipette", 60.0, pytest.approx(1.2), pytest.approx(0.1 / math.sqrt(3)))
@@ -182,7 +188,8 @@ def test_the_changes_are_paired_per_draw_and_their_verdict_holds_two_standard_er
     assert measured.verdict(1.2).startswith("not resolved")
     one = FlowMeasurement(measured.scene, [1], {"pipette": times}, {"pipette": measured.two_way["pipette"][:1]},
                           {"pipette": measured.one_way["pipette"][:1]})
-    assert one.verdict(5.0).startswith("not resolved")    # one draw: no standard error
+    assert one.verdict(5.0) == "not resolved: one draw gives no standard error (--flow-seeds 2 or more)"
+    assert one.grid_check() is None
 
 
 def test_plan_measures_a_short_column_two_ways_and_its_twin(tmp_path):
@@ -194,7 +201,7 @@ def test_plan_measures_a_short_column_two_ways_and_its_twin(tmp_path):
                      "--t-end", "60", "--instruments", "buoyancy", "--particles", "2000", "--jobs", "2",
                      "--out", str(out)]) == 0
     summary = json.loads((out / "flow.json").read_text())
-    assert summary["seeds"] == [1, 2] and summary["grid"][:2] == [16, 16]
+    assert summary["seeds"] == [1, 2] and summary["grid"][:2] == [16, 16] and 1900 < summary["parcels"] < 2100
     assert summary["largest"]["instrument"] == "buoyancy" and math.isfinite(summary["largest"]["change_pp"])
     # the grid check: seed 1 again on 12 cells across, with its own twin
     check = summary["grid_check"]
@@ -207,7 +214,7 @@ def test_plan_measures_a_short_column_two_ways_and_its_twin(tmp_path):
             assert (out / "flow" / f"seed_{seed}" / kind / "layers.h5").is_file()
 
 
-def test_a_measurement_that_fails_puts_the_flow_into_the_plan(column, tmp_path):
+def test_a_measurement_that_fails_puts_the_flow_into_the_plan(column, tmp_path, capsys):
     """Where two-way coupling moves a reading beyond the tolerance it is on in the plan: switch_on sets
     the decision's two_way, rewrites its deck under the flow, records the measurement, and `sediment
     sample --plan` then writes the two-way column."""
@@ -234,3 +241,12 @@ def test_a_measurement_that_fails_puts_the_flow_into_the_plan(column, tmp_path):
     assert cli.main(["sample", str(SAMPLE2), "--plan", str(tmp_path / "report.json"), "--out",
                      str(tmp_path / "sample")]) == 0
     assert "fluid/flow water grid 12 12 " in (tmp_path / "sample" / "in.sedimentation").read_text()
+    # the plan decides the coupling and its grid: another wish is refused, not dropped
+    for wish in (["--flow-cells", "16"], ["--two-way", "--flow-cells", "8"]):
+        assert cli.main(["sample", str(SAMPLE2), "--plan", str(tmp_path / "report.json"), *wish, "--out",
+                         str(tmp_path / "other")]) == 2
+        assert "decided two-way coupling on 12 cells across: --flow-cells would change that" in capsys.readouterr().err
+    report["decision"]["settings"]["flow_cells"] = 10**9
+    (tmp_path / "report.json").write_text(json.dumps(report))
+    with pytest.raises(ValueError, match="no decided flow_cells 1000000000"):
+        decided_options(tmp_path / "report.json")

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import math
 from pathlib import Path
 
 from ..constants import INSTRUMENTS
@@ -20,6 +21,7 @@ def _ladder(text: str) -> tuple[str, list[str]]:
     return name, [v.strip() for v in values.split(",")]
 
 
+MAX_FLOW_SEEDS = 100
 EXAMPLES = [
     'sediment plan examples/granulometry/psd/sample5.csv --out out/plan',
     'sediment plan --deck examples/planner/in.suspension --observe speed --out out/plan-deck',
@@ -72,7 +74,8 @@ def add_parser(commands) -> argparse.ArgumentParser:
                       "grains meet larger ones with an interception efficiency below 9 %%)")
     test.add_argument("--measure-flow", action="store_true",
                       help="also measure what two-way coupling changes: the test's column of parcels three swirls "
-                      "wide under fix fluid/flow and its one-way twin, --flow-seeds draws, written to OUT/flow.csv "
+                      "wide (20 000 parcels, or the largest of --particles) under fix fluid/flow and its one-way twin, "
+                      "--flow-seeds draws, written to OUT/flow.csv "
                       "and flow.json (15-50 min per draw on one core for Bravo et al.'s samples; docs/effects.md "
                       "section 3)")
     test.add_argument("--flow-seeds", type=count, default=3, help="draws of --measure-flow (default 3)")
@@ -131,6 +134,9 @@ def run(args: argparse.Namespace) -> int:
         name = args.psd.stem
         if args.contact_cut is not None and not args.measure_contacts:
             raise ValueError("--contact-cut sets the reduced scene of --measure-contacts: give both")
+        if args.flow_seeds > MAX_FLOW_SEEDS:
+            raise ValueError(f"--flow-seeds {args.flow_seeds}: at most {MAX_FLOW_SEEDS} draws (each takes minutes to an "
+                             "hour)")
         for name in ("flow_seeds", "flow_cells"):
             if getattr(args, name) != args.kinds["test"][name] and not args.measure_flow:
                 raise ValueError(f"--{name.replace('_', '-')} sets the draws of --measure-flow: give both")
@@ -175,6 +181,8 @@ def _measure_flow(test, args: argparse.Namespace, tolerance: float, options: dic
     options = {k: v for k, v in options.items() if k != "width"}    # the column's width is the swirls'
     if args.flow_cells is not None:
         options["flow_cells"] = args.flow_cells
+    if args.particles != args.kinds["test"]["particles"]:    # else `sediment sample --two-way`'s 20 000
+        options["particles"] = max(args.particles)
     first = flow_scene(test, seeds[0], **options)
     across, tall = first.flow_grid()
     check = coarser_cells(first)
@@ -216,7 +224,7 @@ def _measure_flow(test, args: argparse.Namespace, tolerance: float, options: dic
     write_text(args.out / "flow.json", json.dumps({
         "seeds": seeds, "width_m": first.width, "grid": [across, across, tall], "parcels": len(first.diameter),
         "loop_seconds": measured.loop_seconds, "largest": {"instrument": name, "time_s": at, "change_pp": change,
-                                                            "standard_error_pp": error},
+                                                            "standard_error_pp": error if math.isfinite(error) else None},
         "tolerance_pp": tolerance, "verdict": verdict,
         "grid_check": None if grid is None else {"cells": grid[0], "change_pp": grid[2], "check_cells": grid[1],
                                                  "check_change_pp": grid[3]}}, indent=2) + "\n")

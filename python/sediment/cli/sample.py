@@ -113,8 +113,6 @@ def run(args: argparse.Namespace) -> int:
     from ..sim.scene import FLOW_CELLS_ACROSS, plan
     from ..sim.scenefiles import describe, runs_replaced, write
 
-    if args.flow_cells is not None and not args.two_way:
-        raise ValueError("--flow-cells sets the grid of --two-way's flow: give both")
     psd = read_psd(args.psd)
     record = ()
     if args.temperature_record is not None:
@@ -127,6 +125,17 @@ def run(args: argparse.Namespace) -> int:
         if args.real_grains:
             raise ValueError("--plan decides a number of parcels: it does not go with --real-grains")
         decided, planned = decided_options(args.plan)
+        if not decided["two_way"]:
+            decided["flow_cells"] = None
+        # the plan decides whether to couple two ways and on which grid: a different wish is refused
+        asked = [f"--{name.replace('_', '-')}" for name, given in (("two_way", args.two_way),
+                                                                  ("flow_cells", args.flow_cells))
+                 if given not in (None, False) and given != decided[name]]
+        if asked:
+            coupling = (f"two-way coupling on {decided['flow_cells']} cells across" if decided["two_way"]
+                        else "one-way coupling")
+            raise ValueError(f"{args.plan} decided {coupling}: {' and '.join(asked)} would change that; sample "
+                             "without --plan to choose it")
         for name, value in decided.items():
             setattr(args, name, value)
         cylinder = cylinder_of(args)
@@ -149,6 +158,8 @@ def run(args: argparse.Namespace) -> int:
               f"--particles {args.particles} --courant {args.courant:g}"
               + (f" --two-way --flow-cells {args.flow_cells}" if args.two_way else ""))
 
+    if args.flow_cells is not None and not args.two_way:
+        raise ValueError("--flow-cells sets the grid of --two-way's flow: give both")
     suspension = suspension_of(args)
     if record:
         from ..lab.readout import Suspension

@@ -76,6 +76,8 @@ class FlowMeasurement:
         """Whether the one-way assumption holds at `tolerance` [pp]: the largest mean change with two
         standard errors either way, within or beyond it, or not resolved by these draws."""
         _, _, change, error = self.largest()
+        if len(self.seeds) < 2:
+            return "not resolved: one draw gives no standard error (--flow-seeds 2 or more)"
         margin = 2 * error if math.isfinite(error) else math.inf
         if abs(change) + margin <= tolerance:
             return "holds: two-way coupling moves no reading beyond the tolerance"
@@ -112,7 +114,7 @@ def switch_on(plan_folder: Path, scene, measured: FlowMeasurement, tolerance: fl
         decision["settings"]["flow_cells"] = measured.scene.flow_cells
     name, at, change, error = measured.largest()
     report["two_way"] = {"seeds": measured.seeds, "instrument": name, "time_s": at, "change_pp": change,
-                         "standard_error_pp": error, "tolerance_pp": tolerance, "verdict": measured.verdict(tolerance)}
+                         "standard_error_pp": error if math.isfinite(error) else None, "tolerance_pp": tolerance, "verdict": measured.verdict(tolerance)}
     scene.write(decision["settings"], Path(plan_folder) / "decision", decision["seed"])
     write_text(report_path, json.dumps(report, indent=1, default=str) + "\n")
 
@@ -163,7 +165,8 @@ def measure_flow(test: SedimentationTest, seeds: list[int], folder: Path, jobs: 
     scenes = [flow_scene(test, seed, **options) for seed in seeds]
     folders = [Path(folder) / f"seed_{seed}" for seed in seeds]
     if check_cells is not None:
-        scenes.append(replace(scenes[0], flow_cells=check_cells))    # the same parcels, width and frames
+        # the same parcels, width, frames and steps: its twin is the first draw's, run again
+        scenes.append(replace(scenes[0], flow_cells=check_cells, flow_step_cells=scenes[0].flow_cells))
         folders.append(Path(folder) / f"seed_{seeds[0]}_cells_{check_cells}")
     with ThreadPoolExecutor(max_workers=max(1, min(jobs, len(scenes)))) as pool:
         futures = [pool.submit(draw, test, scene, where) for scene, where in zip(scenes, folders)]

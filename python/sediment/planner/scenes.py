@@ -19,6 +19,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .. import _core
 from ..results import write_text
 from ..sim.deck import deck_text, index_variables
 from ..sim.observe import observe, relative_error
@@ -26,7 +27,7 @@ from ..sim.printed import parse_printed
 from ..sim.process import Runs
 from ..sim.run import run_batch
 from ..constants import DRAGS, HINDRANCES
-from ..sim.scene import FLOW_CELLS_ACROSS
+from ..sim.scene import FLOW_CELLS_ACROSS, MAX_FLOW_CELLS
 from .screening import INCLUDE, MEASURE, OMIT, Screen, SedimentationTest, screen, verdict_of
 
 
@@ -92,7 +93,7 @@ def decided_options(report: Path) -> tuple[dict, dict]:
         if not isinstance(two_way, bool):
             raise ValueError(f"two_way {two_way!r}")
         flow_cells = decision.get("flow_cells", FLOW_CELLS_ACROSS)    # the grid it was measured on
-        if not (isinstance(flow_cells, int) and flow_cells >= 4):
+        if not (isinstance(flow_cells, int) and 4 <= flow_cells <= MAX_FLOW_CELLS and _core.fft_friendly(flow_cells)):
             raise ValueError(f"flow_cells {flow_cells!r}")
         return ({"drag": decision["drag"], "hindrance": hindrance, "particles": particles, "courant": float(courant),
                  "two_way": two_way, "flow_cells": flow_cells}, content["scene_options"])

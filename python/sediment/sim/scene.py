@@ -105,6 +105,11 @@ class Effects:
 # largest of some 1e5 nodes of a Gaussian field. Sample 2 (docs/effects.md): 12 mm, 16 x 16 x 480.
 FLOW_SWIRLS = 3
 FLOW_CELLS_ACROSS = 16
+# The largest grid `plan` writes: fix fluid/flow holds about FLOW_BYTES_PER_CELL a cell (the column and
+# its mirror image, three fields; sample 2's 16 x 16 x 480 took 47 MB with its 20 000 parcels), so
+# 2^22 cells take some 1.3 GB, and sample 3's 16 x 16 x 3072 is a fifth of it.
+MAX_FLOW_CELLS = 2**22
+FLOW_BYTES_PER_CELL = 300
 FLOW_COURANT = 0.5
 FLOW_PEAK = 4.5
 # The swirls outlast the grains that drive them: no stage's step is more than twice the last's, as the
@@ -140,8 +145,10 @@ class Scene:
     # the run re-issues the fluid at each frame where it has moved by more than DRIFT_STEP since the
     # last (a laboratory's day); empty: the suspension's water throughout
     water_record: tuple[tuple[float, float], ...] = ()
-    # two-way coupling: fix fluid/flow's cells across the column (flow_grid)
+    # two-way coupling: fix fluid/flow's cells across the column (flow_grid), and those whose flow sets the
+    # steps (None: the same; a grid check runs on its measurement's steps, as the one-way twin it shares)
     flow_cells: int = FLOW_CELLS_ACROSS
+    flow_step_cells: int | None = None
     diameter: np.ndarray = field(default_factory=lambda: np.empty(0))    # per atom [m]
     weight: np.ndarray = field(default_factory=lambda: np.empty(0))
     position: np.ndarray = field(default_factory=lambda: np.empty((0, 3)))
@@ -217,16 +224,18 @@ class Scene:
         flow_cells across (a width `plan` makes a whole number of them up the height)."""
         return self.flow_cells, round(self.height * self.flow_cells / self.width)
 
-    def flow_speed(self, time: float = 0.0) -> float:
+    def flow_speed(self, time: float = 0.0, cells: int | None = None) -> float:
         """Root mean square of the fluid velocity [m/s] that the grains placed independently drive on the
         flow's grid, from those still falling at `time` (each class's share of the column its terminal
         speed has not yet cleared): each parcel stirs the fluid with sqrt(w S(0)) grains' buoyant weight,
         so the force density's fluctuation has the spectrum n <F^2> on every wave k, and the Stokes flow
         of a wave is (I - k k / k^2) f / (mu k^2), read through the kernel (a Gaussian of one cell) on
         both sides. The column is taken periodic in z: in sample 2's column the parcels read 1.06 times
-        this after two steps, in a column of 12 cm, whose mirror images weigh more, 1.4 times."""
+        this after two steps, in a column of 12 cm, whose mirror images weigh more, 1.4 times. On a grid
+        of `cells` across if given."""
         f, c = self.suspension, self.classes
-        across, up = self.flow_grid()
+        across = cells or self.flow_cells
+        up = round(self.height * across / self.width)
         cell = self.width / across
         speed = np.array([terminal_speed(f, d, self.effects.drag) for d in c.diameter])
         falling = c.count * np.clip(1 - speed * time / self.height, 0, 1)
@@ -245,9 +254,10 @@ class Scene:
     def flow_time_step(self, time: float = 0.0) -> float:
         """The longest step [s] at which the grid's largest velocity (FLOW_PEAK times flow_speed) carries
         a parcel FLOW_COURANT cells: past a cell a step the flow cannot follow the density it is solved
-        from (fix fluid/flow's doc page, Stability)."""
-        speed = self.flow_speed(time)
-        cell = self.width / self.flow_cells
+        from (fix fluid/flow's doc page, Stability); on the grid of flow_step_cells if set."""
+        cells = self.flow_step_cells or self.flow_cells
+        speed = self.flow_speed(time, cells)
+        cell = self.width / cells
         return math.inf if speed == 0 else FLOW_COURANT * cell / (FLOW_PEAK * speed)
 
     @property
@@ -426,11 +436,17 @@ def plan(psd: PSD, *, geometry: str = "column", cylinder: Cylinder = Cylinder(),
                              "(--geometry column, no --contacts or --lubrication)")
         swirl = FLOW_SWIRLS * swirl_length(psd, solids)
         width = swirl if width is None else width
-        if not (flow_cells >= 4 and _core.fft_friendly(flow_cells)):
+        if not (flow_cells >= 4 and (flow_cells > MAX_FLOW_CELLS or _core.fft_friendly(flow_cells))):
             raise ValueError(f"the flow's grid needs 4 or more cells across, a product of 2, 3 and 5 (the sizes "
                              f"LAMMPS's FFTs take), not {flow_cells}")
         # cubic cells, flow_cells across, a whole number up the height that the FFTs take
         up = math.ceil(cylinder.height * flow_cells / width)
+        if flow_cells ** 2 * up > MAX_FLOW_CELLS:
+            cells = flow_cells ** 2 * up
+            raise ValueError(f"fix fluid/flow's grid would be {flow_cells} x {flow_cells} x {up} cells ({cells:.3g}, "
+                             f"about {cells * FLOW_BYTES_PER_CELL / 1e9:.2g} GB), beyond {MAX_FLOW_CELLS:.3g}: this "
+                             f"PSD's swirls make a column {width * 1e3:.3g} mm wide, {cylinder.height / width:.3g} "
+                             "times as tall; take fewer --flow-cells or a shorter --height")
         while not _core.fft_friendly(up):
             up += 1
         width = cylinder.height * flow_cells / up

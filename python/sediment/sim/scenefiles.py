@@ -211,7 +211,10 @@ def _deck(scene: Scene, data: str, layer_file: str) -> str:
     else:
         lines.append(f"fix             step all nve/sphere/fluid floor {up} 0.0")
     lines += [
-        f"fix             layers all layers/hdf5 $(round({frames_every}/v_dt_scale)+(round({frames_every}/v_dt_scale)<1)) "
+        "# a frame every frame_every steps, and each stage a whole number of them at any dt_scale: the last",
+        "# frame is then the run's last step, at t_end or up to a frame past it",
+        f"variable        frame_every equal $(round({frames_every}/v_dt_scale)+(round({frames_every}/v_dt_scale)<1))",
+        f"fix             layers all layers/hdf5 ${{frame_every}} "
         f"${{layers_file}} c_conc fluid water particle_density {f.particle_density:.12g} overwrite ${{overwrite}} &",
         "                end_time ${t_end}    # complete only when the frames reach the end of the test",
         "",
@@ -233,7 +236,7 @@ def _deck(scene: Scene, data: str, layer_file: str) -> str:
         # stage then end on the same times as the whole stage would
         commands = ([f'"{_fluid_line(water)}"'] if water is not None else []) \
             + ([f'"timestep $({dt:.17g}*v_dt_scale)"'] if first else []) + ['"run ${stage_end} upto post ${timing}"']
-        lines += [f"variable        stage_end equal $(v_stage_end+ceil({steps}/v_dt_scale))",
+        lines += [f"variable        stage_end equal $(v_stage_end+ceil(ceil({steps}/v_dt_scale)/v_frame_every)*v_frame_every)",
                   f'if "$(step) < ${{stage_end}}" then {" ".join(commands)}']
     return "\n".join(lines) + "\n"
 
