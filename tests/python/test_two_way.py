@@ -192,6 +192,24 @@ def test_the_changes_are_paired_per_draw_and_their_verdict_holds_two_standard_er
     assert one.grid_check() is None
 
 
+def test_a_column_whose_swirls_outgrow_its_steps_says_so(column, tmp_path, monkeypatch):
+    """fix fluid/flow stops a run the flow carries across the box between solves; the measurement then
+    says what that means for the column (its steps were planned from the start's flow), not LAMMPS's
+    advice alone (a timestep or a grid a --measure-flow user cannot set)."""
+    import sediment.planner.flow as flow
+
+    def runaway(deck, variables, **_):
+        if variables["flow"] == "yes":
+            raise RuntimeError("in.sedimentation failed (exit 1): ERROR: Fix fluid/flow: the flow carries spheres "
+                               "6.25 cells between solves, more than half the box across: the scene runs away")
+        return type("Out", (), {"loops": [(1.0, 1)]})()
+
+    monkeypatch.setattr(flow, "run_batch", runaway)
+    with pytest.raises(RuntimeError, match=r"seed 1's column: the swirls outgrew the steps planned from the start's "
+                                           r"flow \(4.3 mm/s rms\)(.|\n)*6.25 cells between solves"):
+        flow.measure_draw(SedimentationTest(read_psd(SAMPLE2)), column, tmp_path)
+
+
 def test_plan_measures_a_short_column_two_ways_and_its_twin(tmp_path):
     """`sediment plan --measure-flow` end to end on a short column (6 cm, 2000 parcels, the buoyancy
     sphere's readings in the first minute; the machinery, not the physics of a test): both runs of each
