@@ -8,7 +8,8 @@ under `fix fluid/flow` (each parcel stirring the fluid as its real grains do), a
 the same data file, deck, steps and frames, with the fluid at rest (`-var flow no`). A draw is the
 pair; the readings' changes are paired per draw, so the parcels' sampling error, which both share,
 drops out of the change. Draws with independent seeds give its standard error, and the first draw
-run again on a coarser grid (its own twin beside it) shows what the grid changes.
+run again on a coarser grid at the same steps (its twin, the same, run again beside it) shows what
+the grid changes.
 """
 from __future__ import annotations
 
@@ -114,7 +115,8 @@ def switch_on(plan_folder: Path, scene, measured: FlowMeasurement, tolerance: fl
         decision["settings"]["flow_cells"] = measured.scene.flow_cells
     name, at, change, error = measured.largest()
     report["two_way"] = {"seeds": measured.seeds, "instrument": name, "time_s": at, "change_pp": change,
-                         "standard_error_pp": error if math.isfinite(error) else None, "tolerance_pp": tolerance, "verdict": measured.verdict(tolerance)}
+                         "standard_error_pp": error if math.isfinite(error) else None, "tolerance_pp": tolerance,
+                         "verdict": measured.verdict(tolerance)}
     scene.write(decision["settings"], Path(plan_folder) / "decision", decision["seed"])
     write_text(report_path, json.dumps(report, indent=1, default=str) + "\n")
 
@@ -166,7 +168,7 @@ def measure_flow(test: SedimentationTest, seeds: list[int], folder: Path, jobs: 
                  draw: Callable | None = None, check_cells: int | None = None, **options) -> FlowMeasurement:
     """The draws of `seeds` in folder/seed_N, `jobs` at once (`draw(test, scene, folder)` runs one:
     measure_draw by default), gathered into a FlowMeasurement. With `check_cells`, the first draw's
-    parcels also run (and their twin, at that grid's steps) with that many cells across, in
+    parcels also run with that many cells across at the first draw's steps (their twin with them), in
     folder/seed_N_cells_M: the measurement's `check`. A draw that fails stops the others (through
     `running`) and raises."""
     from concurrent.futures import ThreadPoolExecutor

@@ -405,8 +405,8 @@ def plan(psd: PSD, *, geometry: str = "column", cylinder: Cylinder = Cylinder(),
     seed : int
         Placement seed.
     flow_cells : int
-        With effects.flow: fix fluid/flow's cubic cells across the column, a size the FFTs take (16: the
-        grid check of docs/effects.md section 3).
+        With effects.flow: fix fluid/flow's cubic cells across the column, a size the FFTs take (default
+        16; docs/effects.md section 3 measures what 8 to 24 change).
 
     Returns
     -------
