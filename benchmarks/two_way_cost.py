@@ -34,9 +34,13 @@ def first_steps(deck: Path, steps: int) -> Path:
     at any time (end_time of a nanosecond)."""
     text = deck.read_text()
     head = text[:text.index("\n", text.index('"run ${stage_end}'))] + "\n"
-    head = re.sub(r"stage_end\+ceil\(ceil\(\d+/v_dt_scale\)/v_frame_every\)\*v_frame_every\)",
-                  f"stage_end+{steps})", head, count=1)
-    head = head.replace("variable        t_end equal", "variable        t_end equal 1e-9 #", 1)
+    head, stages = re.subn(r"stage_end\+ceil\(ceil\(\d+/v_dt_scale\)/v_frame_every\)\*v_frame_every\)",
+                           f"stage_end+{steps})", head, count=1)
+    head, ends = re.subn(r"^variable\s+t_end equal", "variable        t_end equal 1e-9 #", head, count=1,
+                         flags=re.MULTILINE)
+    if (stages, ends) != (1, 1):
+        raise ValueError(f"{deck}: not a deck of `sediment sample` as this benchmark knows it (its first stage or "
+                         "t_end not found)")
     cut = deck.with_name("in.first_steps")
     cut.write_text(head)
     return cut
