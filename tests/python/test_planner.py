@@ -361,7 +361,7 @@ def test_the_swirls_of_a_narrow_sample_spread_its_fall_as_segre_et_al_say():
 
 def test_two_way_coupling_is_screened_and_never_turned_on_by_the_screen():
     """The flow the grains drive is screened with the others, but never omitted on its estimate, which
-    the measured column exceeded up to 45 times (sample 5 at 30 g/L): reported at any tolerance, for
+    the measured column exceeded up to 23 times (sample 5 at 30 g/L): reported at any tolerance, for
     --measure-flow to measure (the planner's sub-volume cannot hold the swirls)."""
     psd = read_psd(SAMPLE5)
     for tolerance in (0.05, 0.5, 5.0):
