@@ -172,7 +172,7 @@ def _measure_flow(test, args: argparse.Namespace, tolerance: float, options: dic
     import json
     import sys
 
-    from ..planner.flow import coarser_cells, flow_scene, measure_draw, measure_flow
+    from ..planner.flow import coarser_cells, draw_name, flow_scene, measure_draw, measure_flow
     from ..planner.scenes import prepare
     from ..results import write_text
     from ..sim.process import Runs
@@ -192,12 +192,14 @@ def _measure_flow(test, args: argparse.Namespace, tolerance: float, options: dic
           + f" ({min(args.jobs, len(seeds) + bool(check))} at once) ...", flush=True)
     running = Runs()
     folder = prepare(args.out / "flow")
-    names = [f"seed {seed}" for seed in seeds] + ([f"seed {seeds[0]}, {check} across"] if check else [])
-    bars = {name: progress_bar(total=1, desc=f"two-way {name}", unit="step", position=k, file=sys.stderr,
-                               dynamic_ncols=True, mininterval=0.5) for k, name in enumerate(names)}
+    labels = {draw_name(seed): f"seed {seed}" for seed in seeds}
+    if check:
+        labels[draw_name(seeds[0], check)] = f"seed {seeds[0]}, {check} across"
+    bars = {name: progress_bar(total=1, desc=f"two-way {label}", unit="step", position=k, file=sys.stderr,
+                               dynamic_ncols=True, mininterval=0.5) for k, (name, label) in enumerate(labels.items())}
 
     def draw(test, scene, where):
-        bar = bars[f"seed {scene.seed}" + (f", {scene.flow_cells} across" if scene.flow_cells != across else "")]
+        bar = bars[where.name]
 
         def update(done: int, total: int) -> None:
             bar.total = total

@@ -29,26 +29,9 @@ def add_parser(commands) -> argparse.ArgumentParser:
     return parser
 
 
-def unread_variables(deck: Path, names: list[str]) -> list[str]:
-    """Those of `names` that `deck` (with the files it includes) never declares or reads: LAMMPS would
-    ignore them without a word. None is judged where the deck includes a file named by a variable."""
-    import re
-
-    from ..sim.deck import deck_text
-
-    try:
-        text = deck_text(deck)
-    except (OSError, UnicodeDecodeError, ValueError):
-        return []    # run_deck names what is wrong with the deck
-    if re.search(r"^\s*include\s+\S*\$", text, re.MULTILINE):
-        return []
-    return [name for name in names
-            if not re.search(rf"^\s*variable\s+{re.escape(name)}\s|\$\{{{re.escape(name)}\}}|\bv_{re.escape(name)}\b"
-                             + (rf"|\${re.escape(name)}" if len(name) == 1 else ""), text, re.MULTILINE)]
-
-
 def run(args: argparse.Namespace) -> int:
     """Runs the deck and says what it did."""
+    from ..sim.deck import unread_variables
     from ..sim.run import run_deck
 
     unread = unread_variables(args.deck, [name for name, _ in args.var or []])

@@ -164,6 +164,11 @@ def coarser_cells(scene: Scene) -> int | None:
     return min(sizes, key=lambda n: abs(n - 0.75 * cells)) if sizes else None
 
 
+def draw_name(seed: int, check_cells: int | None = None) -> str:
+    """The folder of a draw in a measurement: seed_N, or seed_N_cells_M for the grid check's."""
+    return f"seed_{seed}" + (f"_cells_{check_cells}" if check_cells is not None else "")
+
+
 def measure_flow(test: SedimentationTest, seeds: list[int], folder: Path, jobs: int = 1, running: Runs | None = None,
                  draw: Callable | None = None, check_cells: int | None = None, **options) -> FlowMeasurement:
     """The draws of `seeds` in folder/seed_N, `jobs` at once (`draw(test, scene, folder)` runs one:
@@ -175,11 +180,11 @@ def measure_flow(test: SedimentationTest, seeds: list[int], folder: Path, jobs: 
 
     draw = draw or (lambda test, scene, where: measure_draw(test, scene, where, running=running))
     scenes = [flow_scene(test, seed, **options) for seed in seeds]
-    folders = [Path(folder) / f"seed_{seed}" for seed in seeds]
+    folders = [Path(folder) / draw_name(seed) for seed in seeds]
     if check_cells is not None:
         # the same parcels, width, frames and steps: its twin is the first draw's, run again
         scenes.append(replace(scenes[0], flow_cells=check_cells, flow_step_cells=scenes[0].flow_cells))
-        folders.append(Path(folder) / f"seed_{seeds[0]}_cells_{check_cells}")
+        folders.append(Path(folder) / draw_name(seeds[0], check_cells))
     with ThreadPoolExecutor(max_workers=max(1, min(jobs, len(scenes)))) as pool:
         futures = [pool.submit(draw, test, scene, where) for scene, where in zip(scenes, folders)]
         try:

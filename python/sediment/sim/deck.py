@@ -29,3 +29,17 @@ def index_variables(deck: Path) -> dict[str, str]:
     for name, value in re.findall(r"^\s*variable\s+(\w+)\s+index\s+(\S+)", deck_text(deck), re.MULTILINE):
         found.setdefault(name, value)
     return found
+
+
+def unread_variables(deck: Path, names: list[str]) -> list[str]:
+    """Those of `names` that `deck` (with the files it includes) never declares or reads: LAMMPS would
+    ignore them without a word. None is judged where the deck includes a file named by a variable."""
+    try:
+        text = deck_text(deck)
+    except (OSError, UnicodeDecodeError, ValueError):
+        return []    # run_deck names what is wrong with the deck
+    if re.search(r"^\s*include\s+\S*\$", text, re.MULTILINE):
+        return []
+    return [name for name in names
+            if not re.search(rf"^\s*variable\s+{re.escape(name)}\s|\$\{{{re.escape(name)}\}}|\bv_{re.escape(name)}\b"
+                             + (rf"|\${re.escape(name)}" if len(name) == 1 else ""), text, re.MULTILINE)]

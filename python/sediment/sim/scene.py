@@ -219,10 +219,11 @@ class Scene:
             time += dt * steps
         return out
 
-    def flow_grid(self) -> tuple[int, int]:
+    def flow_grid(self, cells: int | None = None) -> tuple[int, int]:
         """Cells of fix fluid/flow's grid across the column and along its height: cubic cells,
-        flow_cells across (a width `plan` makes a whole number of them up the height)."""
-        return self.flow_cells, round(self.height * self.flow_cells / self.width)
+        flow_cells (or `cells`) across (a width `plan` makes a whole number of them up the height)."""
+        across = cells or self.flow_cells
+        return across, round(self.height * across / self.width)
 
     def flow_speed(self, time: float = 0.0, cells: int | None = None) -> float:
         """Root mean square of the fluid velocity [m/s] that the grains placed independently drive on the
@@ -234,8 +235,7 @@ class Scene:
         this after two steps, in a column of 12 cm, whose mirror images weigh more, 1.4 times. On a grid
         of `cells` across if given."""
         f, c = self.suspension, self.classes
-        across = cells or self.flow_cells
-        up = round(self.height * across / self.width)
+        across, up = self.flow_grid(cells)
         cell = self.width / across
         speed = np.array([terminal_speed(f, d, self.effects.drag) for d in c.diameter])
         falling = c.count * np.clip(1 - speed * time / self.height, 0, 1)
