@@ -504,6 +504,19 @@ SMALL = [
     ("plan", ["plan", PSD, "--screen-only", "--set", "nosuch=3", "--out", OUT], [("nosuch",)], "an unknown effect"),
     ("plan", ["plan", PSD, "--screen-only", "--set", "particles=-5", "--out", OUT], [("particles",)],
      "negative particles"),
+    # two-way coupling's options (issue 69's hostile round)
+    ("sample", ["sample", PSD, "--two-way", "--flow-cells", "7", "--out", OUT], [("7",), ("2, 3 and 5",)],
+     "a grid the FFTs do not take"),
+    ("sample", ["sample", PSD, "--two-way", "--flow-cells", "1000", "--out", OUT], [("1000 x 1000",), ("GB",)],
+     "a grid beyond memory"),
+    ("sample", ["sample", PSD, "--flow-cells", "12", "--out", OUT], [("--flow-cells",), ("--two-way",)],
+     "a grid without the flow"),
+    ("plan", ["plan", PSD, "--screen-only", "--measure-flow", "--flow-seeds", "1000000", "--out", OUT],
+     [("--flow-seeds",), ("100",)], "a million draws"),
+    ("plan", ["plan", PSD, "--screen-only", "--flow-cells", "12", "--out", OUT], [("--flow-cells",),
+     ("--measure-flow",)], "a grid without a measurement"),
+    ("run", ["run", CASE_A, "--var", "nosuchvariable", "3"], [("nosuchvariable",), ("never reads",)],
+     "a variable the deck never reads"),
 ]
 for _i, (_cmd, _args, _words, _why) in enumerate(SMALL):
     _slow = _cmd in ("paste", "sweep") and "funnel" not in _args and "restitution" not in _args
