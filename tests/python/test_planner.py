@@ -171,6 +171,7 @@ def test_a_rerun_replaces_its_own_files_and_spares_everyone_elses(tmp_path):
     (["--set", "foo=1"], "unknown effect or resolution 'foo'"),
     (["--set", "hindered=maybe"], "hindered takes yes, no, not 'maybe'"),
     (["--ladder", "nothing=1,2"], "no 'variable nothing index"),
+    (["--var", "nothing", "1"], "never reads a variable 'nothing'"),
 ])
 def test_bad_deck_plans_are_refused_with_the_reason(tmp_path, capsys, args, message):
     code = cli.main(["plan", "--deck", str(SUSPENSION), "--observe", "speed", "--out", str(tmp_path / "o"), *args])

@@ -108,6 +108,14 @@ def test_cli_prints_table_and_cheapest_step(toy, tmp_path, capsys):
         cli.main(["sweep", str(toy), "--dt", "0.1,-1", "--observe", "y"])
     assert cli.main(["sweep", str(toy), "--dt", "0.1", "--observe", "y", "--reference", "y"]) == 2
     assert "NAME=VALUE" in capsys.readouterr().err
+    # a variable the deck never reads: every run the same (--parameter), or run as if not given
+    plain = tmp_path / "in.plain"    # the toy without its integrator variable
+    plain.write_text(TOY.replace("variable integrator index nve/sphere/fluid\n", ""))
+    for deck, option, message in ((toy, ["--parameter", "dt_scale"], "--parameter dt_scale: "),
+                                  (plain, ["--integrator", "implicit"], "--integrator integrator: "),
+                                  (toy, ["--var", "flow", "yes"], "--var flow: ")):
+        assert cli.main(["sweep", str(deck), "--dt", "0.1", "--observe", "y", "--out", str(tmp_path / "o"), *option]) == 2
+        assert message in capsys.readouterr().err and not (tmp_path / "o").exists()
 
 
 def test_readout_curves_of_a_scene_barely_move_with_the_step(tmp_path):

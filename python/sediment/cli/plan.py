@@ -110,6 +110,9 @@ def run(args: argparse.Namespace) -> int:
     if args.tolerance is not None:    # its unit depends on the scene
         check(args.tolerance, "relative_tolerance" if args.deck is not None else "test_tolerance", "--tolerance")
     if args.deck is not None:
+        from ..sim.deck import refuse_unread
+
+        refuse_unread(args.deck, [name for name, _ in args.var or []])
         tolerance = args.tolerance or 0.01
         scene = DeckScene(args.deck, args.observe or [], dict(args.ladder or []), tolerance, dict(args.var or []),
                           args.np)

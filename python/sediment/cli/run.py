@@ -31,13 +31,10 @@ def add_parser(commands) -> argparse.ArgumentParser:
 
 def run(args: argparse.Namespace) -> int:
     """Runs the deck and says what it did."""
-    from ..sim.deck import unread_variables
+    from ..sim.deck import refuse_unread
     from ..sim.run import run_deck
 
-    unread = unread_variables(args.deck, [name for name, _ in args.var or []])
-    if unread:
-        raise ValueError(f"--var {unread[0]}: {args.deck} never reads a variable '{unread[0]}', so LAMMPS would run it "
-                         "as if not given")
+    refuse_unread(args.deck, [name for name, _ in args.var or []])
     try:
         result = run_deck(args.deck, ranks=args.np, variables=dict(args.var or []), progress=not args.quiet,
                           oversubscribe=args.oversubscribe, force=args.force, resume=args.resume)

@@ -45,10 +45,16 @@ def add_parser(commands) -> argparse.ArgumentParser:
 
 def run(args: argparse.Namespace) -> int:
     """Runs the sweep, prints its table and the cheapest runs, writes sweep.csv and sweep.png."""
+    from ..sim.deck import refuse_unread
     from ..studies import sweep
 
     references = dict(sweep.parse_reference(r) for r in args.reference or [])
     integrators = args.integrator.split(",") if args.integrator else None
+    # a variable the deck never reads would make every run the same, or run as if not given
+    refuse_unread(args.deck, [args.parameter], "--parameter")
+    if integrators:
+        refuse_unread(args.deck, ["integrator"], "--integrator")
+    refuse_unread(args.deck, [name for name, _ in args.var or []])
     result = sweep.run_sweep(args.deck, args.dt, args.observe, integrators, args.parameter, references,
                              dict(args.var or []), args.np, args.out / "runs", args.tau, args.rayleigh)
     result.save(args.out, args.tolerance, args.title)

@@ -43,3 +43,11 @@ def unread_variables(deck: Path, names: list[str]) -> list[str]:
     return [name for name in names
             if not re.search(rf"^\s*variable\s+{re.escape(name)}\s|\$\{{{re.escape(name)}\}}|\bv_{re.escape(name)}\b"
                              + (rf"|\${re.escape(name)}" if len(name) == 1 else ""), text, re.MULTILINE)]
+
+
+def refuse_unread(deck: Path, names: list[str], option: str = "--var") -> None:
+    """Stops, naming the first of `names` (given by `option`) that `deck` never reads (unread_variables)."""
+    unread = unread_variables(deck, names)
+    if unread:
+        raise ValueError(f"{option} {unread[0]}: {deck} never reads a variable '{unread[0]}', so LAMMPS would run it "
+                         "as if not given")
