@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <vector>
 
 namespace sediment {
 
@@ -71,6 +72,29 @@ void stokes_apply_brick(const StokesOperator &op, const int n[3], const double l
       }
     }
   }
+}
+
+void stable_profile(double *profile, int planes)
+{
+  // Blocks of pooled planes: each holds the mean of its planes; a block below one of greater value is
+  // fine (less force downwards above), one above a block of greater value is pooled with it.
+  std::vector<double> mean;
+  std::vector<int> count;
+  for (int k = 0; k < planes; ++k) {
+    mean.push_back(profile[k]);
+    count.push_back(1);
+    while (mean.size() > 1 && mean[mean.size() - 2] > mean.back()) {
+      const double value = mean.back();
+      const int n = count.back();
+      mean.pop_back();
+      count.pop_back();
+      mean.back() = (mean.back() * count.back() + value * n) / (count.back() + n);
+      count.back() += n;
+    }
+  }
+  int k = 0;
+  for (size_t b = 0; b < mean.size(); ++b)
+    for (int j = 0; j < count[b]; ++j) profile[k++] = mean[b];
 }
 
 double gaussian_self_mobility(double viscosity, double sigma)

@@ -49,7 +49,7 @@ static inline int wrap(int i, int n)
 
 FixFluidFlow::FixFluidFlow(LAMMPS *lmp, int narg, char **arg) :
     Fix(lmp, narg, arg), fluid_id(nullptr), fluid(nullptr), nzt(0), column(false), column_lo(0.0), column_hi(0.0),
-    relax(1.0), weight_index(-1), drift_limit(0.0), drift(0.0), solved_speed(0.0), unsettled(false), solved_viscosity(0.0), velocity(nullptr), solved(false), fft(nullptr),
+    relax(1.0), weight_index(-1), stratify(false), displacement(nullptr), displaced_time(0.0), drift_limit(0.0), drift(0.0), solved_speed(0.0), unsettled(false), solved_viscosity(0.0), velocity(nullptr), solved(false), fft(nullptr),
     plane_lo(0), plane_hi(-1), last_solve(-1), warned_carry(false), carries(0), carry_start(0.0), reversals(0), reversal_growth(1.0)
 {
   if (narg < 8 || strcmp(arg[4], "grid") != 0)
@@ -102,8 +102,11 @@ FixFluidFlow::FixFluidFlow(LAMMPS *lmp, int narg, char **arg) :
       drift_given = true;
     } else if (args.is("weight")) {
       weight_name = args.weight(1);
+    } else if (args.is("stratification")) {
+      args.need(1, "grains or parcels");
+      stratify = args.choice(1, {"parcels", "grains"}) == 1;
     } else {
-      args.unknown("grid, column, brinkman, width, relax, weight, every or drift");
+      args.unknown("grid, column, brinkman, width, relax, weight, stratification, every or drift");
     }
     args.next(nvalues);
   }
@@ -121,6 +124,9 @@ FixFluidFlow::FixFluidFlow(LAMMPS *lmp, int narg, char **arg) :
                "in z (boundary p p f); this box is periodic in z");
   if (!column && !domain->zperiodic)
     error->all(FLERR, "Fix fluid/flow: a box not periodic in z needs keyword 'column ZLO ZHI' (the closed column)");
+  if (stratify && (!column || weight_name.empty()))
+    error->all(FLERR, "Fix fluid/flow: 'stratification grains' is for parcels (keyword weight) in a closed column "
+               "(keyword column), whose mean density varies along z");
   if (!atom->radius_flag || !atom->rmass_flag)
     error->all(FLERR, "Fix fluid/flow requires atom attributes radius and rmass (atom_style sphere)");
   for (int d = 0; d < 3; ++d)
@@ -138,7 +144,7 @@ FixFluidFlow::FixFluidFlow(LAMMPS *lmp, int narg, char **arg) :
   size_vector = NDIAG;
   global_freq = 1;
   extvector = 0;
-  maxexchange = 3;
+  maxexchange = 4;
   create_attribute = 1;
   std::fill(diag, diag + NDIAG, 0.0);
   std::fill(self_flow, self_flow + 3, 0.0);
@@ -154,6 +160,7 @@ FixFluidFlow::~FixFluidFlow()
   atom->delete_callback(id, Atom::GROW);
   atom->delete_callback(id, Atom::RESTART);
   memory->destroy(velocity);
+  memory->destroy(displacement);
   delete fft;
   delete[] fluid_id;
 }
@@ -227,6 +234,7 @@ void FixFluidFlow::setup(int /*vflag*/)
   for (Fix *fix : sediment_fixes_of_style(lmp, "nve/sphere/fluid"))
     if (auto integrator = static_cast<FixNVESphereFluid *>(fix); integrator->has_floor()) floors.push_back(integrator);
   if (last_solve < 0) last_solve = update->ntimestep;    // a new fix, or one read from a restart
+  displaced_time = now();
   // A run continues the flow it has (from the last run, or a restart): a new one starts from one solve.
   // A run whose fluid was given another uniform velocity or viscosity since the last solve solves too.
   if (solved && !fluid_changed()) return;
@@ -246,8 +254,26 @@ bool FixFluidFlow::fluid_changed() const
       stokes.viscosity != solved_viscosity;
 }
 
+// The run's time now (LAMMPS's elapsed time, which follows changes of the timestep).
+double FixFluidFlow::now() const
+{
+  return update->atime + static_cast<double>(update->ntimestep - update->atimestep) * update->dt;
+}
+
+// stratification grains: each sphere's displacement along z by the flow, since it came into the fix.
+// Between solves a sphere keeps the fluid velocity of the last one, so the sum is exact for any every N.
+void FixFluidFlow::displace()
+{
+  const double t = now(), elapsed = t - displaced_time;
+  displaced_time = t;
+  const int *mask = atom->mask;
+  for (int i = 0; i < atom->nlocal; ++i)
+    if (mask[i] & groupbit) displacement[i] += (velocity[i][2] - solved_uniform[2]) * elapsed;
+}
+
 void FixFluidFlow::end_of_step()
 {
+  if (stratify) displace();
   if (drift_limit > 0.0) {
     // The flow follows the spheres' positions and their forces: it is stale once they may have moved
     // drift cells, or once their speeds (their drag) have changed by that fraction, as when they start
@@ -354,6 +380,78 @@ void FixFluidFlow::weigh_forces()
   for (size_t s = 0; s < spheres.size(); ++s) {
     scales[s] = sqrt(weight[spheres[s]] * sediment::hard_sphere_structure_factor(fractions[s]));
     for (int c = 0; c < 3; ++c) forces[3 * s + c] *= scales[s];
+  }
+}
+
+// stratification grains (docs/physics.md section 8, Parcels). The parcels' own forces, sqrt(w S(0))
+// grains' each, give the force density's fluctuation its real size; but where the flow displaces the
+// column's mean density profile, that displaced profile pushes back with only sqrt(S(0) / w) of the
+// real grains' force. The rest, (w - sqrt(w S(0))) grains' force per parcel, is added here as a field:
+// its mean along z, Q(z) (a profile uniform across, which moves nothing), displaced at each node by the
+// mean displacement of the spheres there since they came into the fix, zeta(x), weighted by their
+// share of Q: the vertical force density Q(z - zeta(x)) - Q(z), into `restoring` (per slab node, the
+// column's mirror image reversed as the forces' are).
+void FixFluidFlow::stratification_force()
+{
+  constexpr int nodes = sediment::FlowKernel::max_nodes;
+  const int nz = grid[2];
+  const double *weight = atom->dvector[weight_index];
+  double **x = atom->x;
+  const double per_node = 1.0 / (spacing[0] * spacing[1] * spacing[2] * grid[0] * grid[1]);
+  std::vector<double> excess(nz, 0.0);
+  tracer.assign(3 * brick.size(), 0.0);
+  for (size_t s = 0; s < spheres.size(); ++s) {
+    const int i = spheres[s];
+    const double force = (weight[i] / scales[s] - 1.0) * forces[3 * s + 2];    // forces hold sqrt(w S(0)) grains'
+    if (force == 0.0) continue;
+    int first;
+    double w[nodes];
+    kernel.weights((x[i][2] - origin[2]) / spacing[2] - 0.5, first, w);
+    for (int a = 0; a < nodes; ++a) {
+      int m = first + a;    // reflected at the bottom and the top, as the column's mirror image is
+      if (m < 0)
+        m = -m - 1;
+      else if (m >= nz)
+        m = 2 * nz - 1 - m;
+      excess[m] += w[a] * force * per_node;
+    }
+    // the displacement, weighted by the sphere's share of the profile (its class's, where classes mix)
+    const double share = std::abs(force), carried[3] = {share * displacement[i], share, 0.0};
+    spread_point(stencils[s], carried, tracer);
+  }
+  profile.resize(nz);
+  MPI_Allreduce(excess.data(), profile.data(), nz, MPI_DOUBLE, MPI_SUM, world);
+  sediment::stable_profile(profile.data(), nz);
+  // The mean displacement at each node: the ratio of the two spread with the B-spline alone, as the
+  // spheres' forces are (the solve then smooths the force density of both alike).
+  sum_into_slabs(brick, tracer, true);    // along x and y: the mirror image keeps them
+  // The lagged flow carries the spheres for the time between solves before the profile they displace
+  // pushes back; where it pushes back faster than that (a front or a bed, whose real grains restore it
+  // within milliseconds), the force would overshoot and grow from solve to solve. It is capped at the
+  // stiffness (force per displacement) that the most mobile mode on the grid, the box-wide one,
+  // relaxes in one such time: the stiff limit, in which the displaced profile is restored as fast as
+  // the step can follow (docs/physics.md section 8).
+  const double k = sediment::grid_wavenumber(1, grid[0], std::max(length[0], length[1]));    // 2 pi / width
+  const double mobility = 1.0 / (stokes.viscosity * k * k + stokes.brinkman);
+  const double interval = update->dt * static_cast<double>(std::max<bigint>(1, update->ntimestep - last_solve));
+  const double stiffest = 1.0 / (mobility * interval);
+  const long plane = static_cast<long>(grid[0]) * grid[1];
+  restoring.assign(plane * (plane_hi - plane_lo + 1), 0.0);
+  for (int q = plane_lo; q <= plane_hi; ++q) {
+    const bool mirror = q >= nz;
+    const int plane_k = mirror ? nzt - 1 - q : q;    // the plane of the column
+    const double *t = &slab[3 * plane * (q - plane_lo)];
+    double *f = &restoring[plane * (q - plane_lo)];
+    for (long m = 0; m < plane; ++m) {
+      if (!(t[3 * m + 1] > 0.0)) continue;    // no sphere's kernel reaches the node: nothing displaced
+      const double zeta = t[3 * m] / t[3 * m + 1];
+      const double from = std::clamp(plane_k - zeta / spacing[2], 0.0, nz - 1.0);
+      const int below = std::min(static_cast<int>(from), nz - 2);
+      const double u = from - below;
+      double displaced = (1.0 - u) * profile[below] + u * profile[below + 1] - profile[plane_k];
+      if (std::abs(displaced) > stiffest * std::abs(zeta)) displaced = std::copysign(stiffest * std::abs(zeta), displaced);
+      f[m] = mirror ? -displaced : displaced;
+    }
   }
 }
 
@@ -849,7 +947,9 @@ void FixFluidFlow::solve()
   double total[4];
   MPI_Allreduce(local, total, 4, MPI_DOUBLE, MPI_SUM, world);
 
+  if (stratify) stratification_force();    // it uses the slabs before the forces fill them
   sum_into_slabs(brick, spread, true);
+  for (size_t m = 0; m < restoring.size(); ++m) slab[3 * m + 2] += restoring[m];
   transform_solve();
 
   // Diagnostics: the largest mean vertical velocity over a plane of nodes in the fluid (zero: no
@@ -993,12 +1093,14 @@ double FixFluidFlow::compute_vector(int n)
 void FixFluidFlow::grow_arrays(int nmax)
 {
   memory->grow(velocity, nmax, 3, "fluid/flow:velocity");
+  memory->grow(displacement, nmax, "fluid/flow:displacement");
   array_atom = velocity;
 }
 
 void FixFluidFlow::copy_arrays(int i, int j, int /*delflag*/)
 {
   for (int c = 0; c < 3; ++c) velocity[j][c] = velocity[i][c];
+  displacement[j] = displacement[i];
 }
 
 // A sphere created during a run (create_atoms between runs, fix deposit or pour) takes the fluid
@@ -1020,18 +1122,21 @@ void FixFluidFlow::set_arrays(int i)
     read_point(at, flow, u);
   }
   for (int c = 0; c < 3; ++c) velocity[i][c] = uniform[c] + u[c];
+  displacement[i] = 0.0;
 }
 
 int FixFluidFlow::pack_exchange(int i, double *buf)
 {
   for (int c = 0; c < 3; ++c) buf[c] = velocity[i][c];
-  return 3;
+  buf[3] = displacement[i];
+  return 4;
 }
 
 int FixFluidFlow::unpack_exchange(int nlocal, double *buf)
 {
   for (int c = 0; c < 3; ++c) velocity[nlocal][c] = buf[c];
-  return 3;
+  displacement[nlocal] = buf[3];
+  return 4;
 }
 
 void FixFluidFlow::write_restart(FILE *fp)
@@ -1075,9 +1180,10 @@ void FixFluidFlow::restart(char *buf)
 
 int FixFluidFlow::pack_restart(int i, double *buf)
 {
-  buf[0] = 4;
+  buf[0] = 5;
   for (int c = 0; c < 3; ++c) buf[1 + c] = velocity[i][c];
-  return 4;
+  buf[4] = displacement[i];
+  return 5;
 }
 
 void FixFluidFlow::unpack_restart(int nlocal, int nth)
@@ -1085,18 +1191,19 @@ void FixFluidFlow::unpack_restart(int nlocal, int nth)
   double **extra = atom->extra;
   int m = 0;
   for (int k = 0; k < nth; ++k) m += static_cast<int>(extra[nlocal][m]);
-  ++m;
+  const int size = static_cast<int>(extra[nlocal][m++]);    // 4 in files written before displacement
   for (int c = 0; c < 3; ++c) velocity[nlocal][c] = extra[nlocal][m + c];
+  displacement[nlocal] = size > 4 ? extra[nlocal][m + 3] : 0.0;
 }
 
 int FixFluidFlow::size_restart(int /*i*/)
 {
-  return 4;
+  return 5;
 }
 
 int FixFluidFlow::maxsize_restart()
 {
-  return 4;
+  return 5;
 }
 
 double FixFluidFlow::memory_usage()
@@ -1109,5 +1216,6 @@ double FixFluidFlow::memory_usage()
       static_cast<double>(forces.capacity() + fractions.capacity() + scales.capacity() + diameter.capacity() +
                           speed.capacity() + voidage.capacity() + per_speed.capacity()) * sizeof(double) +
       static_cast<double>(spheres.capacity()) * sizeof(int);
-  return (3.0 * atom->nmax + grids) * sizeof(double) + per_sphere;
+  return (4.0 * atom->nmax + grids + static_cast<double>(tracer.capacity() + restoring.capacity() + profile.capacity())) *
+      sizeof(double) + per_sphere;
 }

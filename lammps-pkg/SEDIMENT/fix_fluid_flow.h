@@ -69,6 +69,11 @@ class FixFluidFlow : public Fix {
   double relax;          // u <- (1 - relax) u + relax u_solved
   std::string weight_name;    // per-atom property: the real grains each sphere (a parcel) stands for
   int weight_index;
+  // stratification grains: the column's mean density profile, displaced by the flow, pushes back with
+  // the real grains' force (w per parcel), not the parcels' sqrt(w S(0)) (stratification_force)
+  bool stratify;
+  double *displacement;       // per atom: how far the flow has carried the sphere along z (stratify)
+  double displaced_time;      // the time up to which displacement is summed
   double drift_limit;    // > 0: solve once the spheres may have moved this many cells since the last solve,
                          // or their largest speed has changed by this fraction
   static constexpr double DEFAULT_DRIFT = 0.2;    // without every or drift
@@ -139,6 +144,9 @@ class FixFluidFlow : public Fix {
   std::vector<Stencil> stencils;
   std::vector<double> forces, fractions;
   std::vector<double> scales;    // with weight: each force's factor sqrt(w S(0)) (weigh_forces)
+  std::vector<double> tracer;       // stratify: the spheres' displacements and their count, spread on brick's nodes
+  std::vector<double> restoring;    // stratify: the vertical force density of the displaced profile, per slab node
+  std::vector<double> profile;      // stratify: the mean excess force density of each plane of nodes
   std::vector<double> diameter, speed, voidage, per_speed;    // sphere_forces' columns for the drag law
 
   void solve();
@@ -166,6 +174,9 @@ class FixFluidFlow : public Fix {
   void read_point(const Stencil &at, const std::vector<double> &velocity, double *u) const;
   void sphere_forces();
   void weigh_forces();
+  double now() const;
+  void displace();
+  void stratification_force();
   double sphere_force(int i, double *force) const;
 };
 

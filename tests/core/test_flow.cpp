@@ -277,3 +277,18 @@ TEST(Flow, HardSphereStructureFactor)
   EXPECT_NEAR((1.0 - hard_sphere_structure_factor(1e-6)) / 1e-6, 8.0, 1e-4);
   EXPECT_NEAR(hard_sphere_structure_factor(0.05), 0.81450625 / 1.20950625, 1e-12);
 }
+
+// The displaced profile of stratification grains needs a stable one: pooled where the parcels' noise
+// makes a plane heavier (more negative) than the one below it, the mean force kept.
+TEST(Flow, StableProfile)
+{
+  std::vector<double> stable = {-5.0, -4.0, -4.0, -1.0, 0.0};
+  stable_profile(stable.data(), 5);
+  EXPECT_EQ(stable, (std::vector<double>{-5.0, -4.0, -4.0, -1.0, 0.0}));
+  std::vector<double> noisy = {-5.0, -3.0, -4.0, -2.0, -2.5, 0.0};    // planes 1-2 and 3-4 inverted
+  stable_profile(noisy.data(), 6);
+  EXPECT_EQ(noisy, (std::vector<double>{-5.0, -3.5, -3.5, -2.25, -2.25, 0.0}));
+  std::vector<double> inverted = {0.0, -1.0, -2.0};    // heaviest on top: one pool at the mean
+  stable_profile(inverted.data(), 3);
+  EXPECT_EQ(inverted, (std::vector<double>{-1.0, -1.0, -1.0}));
+}

@@ -85,6 +85,14 @@ double gaussian_self_mobility(double viscosity, double sigma);
 // were spread with S(0) times their number minus itself: the closure of docs/physics.md section 8.
 double hard_sphere_structure_factor(double phi);
 
+// The mean force density of a settling column along z (its planes from the bottom up), made monotone:
+// the least-squares fit that never grows upwards (pool adjacent violators; a force density is negative,
+// downwards, so "never grows" means the column is nowhere lighter below than above). A settling
+// column's mean density is stably stratified; the parcels' profile, a few per plane, is not, and its
+// noise would be read as heavy fluid over light, which the displaced profile of fix fluid/flow's
+// stratification grains would then drive as it restores a real one.
+void stable_profile(double *profile, int planes);
+
 // Nitsche & Batchelor (1997): a cloud of n spheres of radius a, terminal speed us alone, within a
 // sphere of radius r settles for n a / r >> 1 as a drop of the same viscosity, u = us (1 + 6/5 n a / r).
 double cloud_speed(double us, int n, double a, double r);
