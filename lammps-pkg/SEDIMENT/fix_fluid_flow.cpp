@@ -234,7 +234,7 @@ void FixFluidFlow::setup(int /*vflag*/)
   for (Fix *fix : sediment_fixes_of_style(lmp, "nve/sphere/fluid"))
     if (auto integrator = static_cast<FixNVESphereFluid *>(fix); integrator->has_floor()) floors.push_back(integrator);
   if (last_solve < 0) last_solve = update->ntimestep;    // a new fix, or one read from a restart
-  displaced_time = now();
+  displaced_time = sediment_time_now(update);
   // A run continues the flow it has (from the last run, or a restart): a new one starts from one solve.
   // A run whose fluid was given another uniform velocity or viscosity since the last solve solves too.
   if (solved && !fluid_changed()) return;
@@ -254,17 +254,11 @@ bool FixFluidFlow::fluid_changed() const
       stokes.viscosity != solved_viscosity;
 }
 
-// The run's time now (LAMMPS's elapsed time, which follows changes of the timestep).
-double FixFluidFlow::now() const
-{
-  return update->atime + static_cast<double>(update->ntimestep - update->atimestep) * update->dt;
-}
-
 // stratification grains: each sphere's displacement along z by the flow, since it came into the fix.
 // Between solves a sphere keeps the fluid velocity of the last one, so the sum is exact for any every N.
 void FixFluidFlow::displace()
 {
-  const double t = now(), elapsed = t - displaced_time;
+  const double t = sediment_time_now(update), elapsed = t - displaced_time;
   displaced_time = t;
   const int *mask = atom->mask;
   for (int i = 0; i < atom->nlocal; ++i)

@@ -174,7 +174,6 @@ class FixFluidFlow : public Fix {
   void read_point(const Stencil &at, const std::vector<double> &velocity, double *u) const;
   void sphere_forces();
   void weigh_forces();
-  double now() const;
   void displace();
   void stratification_force();
   double sphere_force(int i, double *force) const;

@@ -343,7 +343,7 @@ void FixLayersHDF5::take_frame(bool write_now)
   on_rank0([&] {
     for (int k = 0; k < rows; ++k)
       for (int c = 0; c < cols; ++c) pending_values.push_back(array[k][c + 1]);
-    pending_time.push_back(update->atime + (step - update->atimestep) * update->dt);
+    pending_time.push_back(sediment_time_now(update));
     pending_step.push_back(step);
     if (!fluid_id.empty()) pending_fluid.insert(pending_fluid.end(), fluid_now, fluid_now + 2);
     last_frame_step = step;
@@ -547,7 +547,7 @@ void FixLayersHDF5::write_restart(FILE *fp)
   // and LAMMPS 2021 restart files lose it (time would restart as step x the current dt).
   if (comm->me != 0) return;
   const bigint step = update->ntimestep;
-  const double numbers[RESTART_NUMBERS] = {RESTART_MARKER, update->atime + (step - update->atimestep) * update->dt,
+  const double numbers[RESTART_NUMBERS] = {RESTART_MARKER, sediment_time_now(update),
                                            static_cast<double>(step),
                                            static_cast<double>(frames - (last_frame_step == step ? 1 : 0))};
   std::vector<char> state(sizeof(numbers) + RESTART_ID_BYTES, '\0');

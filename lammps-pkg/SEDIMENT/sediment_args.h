@@ -15,6 +15,7 @@
 #include "lammps.h"
 #include "modify.h"
 #include "sediment_lammps_api.h"
+#include "update.h"
 #include "utils.h"
 
 #include <algorithm>
@@ -140,6 +141,13 @@ class StyleArgs {
   char **arg;
   int iarg;
 };
+
+// The simulated time at the current step: LAMMPS's elapsed time, which follows changes of the timestep
+// between runs (it is not step x dt).
+inline double sediment_time_now(const Update *update)
+{
+  return update->atime + static_cast<double>(update->ntimestep - update->atimestep) * update->dt;
+}
 
 // The fixes of a given style (e.g. every "fluid/drag").
 inline std::vector<Fix *> sediment_fixes_of_style(LAMMPS *lmp, const char *style)
