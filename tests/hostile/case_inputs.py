@@ -517,6 +517,12 @@ SMALL = [
      ("--measure-flow",)], "a grid without a measurement"),
     ("run", ["run", CASE_A, "--var", "nosuchvariable", "3"], [("nosuchvariable",), ("never reads",)],
      "a variable the deck never reads"),
+    ("sweep", ["sweep", CASE_A, "--dt", "1e-3", "--observe", "velocity", "--var", "nosuchvariable", "3", "--out", OUT],
+     [("nosuchvariable",), ("never reads",)], "a sweep variable the deck never reads"),
+    ("sweep", ["sweep", CASE_A, "--dt", "1,2", "--parameter", "nosuchvariable", "--observe", "velocity", "--out", OUT],
+     [("--parameter",), ("never reads",)], "a swept variable the deck never reads"),
+    ("plan", ["plan", "--deck", CASE_A, "--observe", "velocity", "--var", "nosuchvariable", "3", "--out", OUT],
+     [("nosuchvariable",), ("never reads",)], "a plan variable the deck never reads"),
 ]
 for _i, (_cmd, _args, _words, _why) in enumerate(SMALL):
     _slow = _cmd in ("paste", "sweep") and "funnel" not in _args and "restitution" not in _args
