@@ -27,6 +27,7 @@
 #include "comm.h"
 #include "domain.h"
 #include "error.h"
+#include "math_const.h"
 #include "memory.h"
 #include "modify.h"
 #include "update.h"
@@ -39,6 +40,7 @@
 
 using namespace LAMMPS_NS;
 using namespace FixConst;
+using MathConst::MY_PI;
 
 static inline int wrap(int i, int n)
 {
@@ -49,7 +51,7 @@ static inline int wrap(int i, int n)
 
 FixFluidFlow::FixFluidFlow(LAMMPS *lmp, int narg, char **arg) :
     Fix(lmp, narg, arg), fluid_id(nullptr), fluid(nullptr), nzt(0), column(false), column_lo(0.0), column_hi(0.0),
-    relax(1.0), weight_index(-1), stratify(false), displacement(nullptr), displaced_time(0.0), drift_limit(0.0), drift(0.0), solved_speed(0.0), unsettled(false), solved_viscosity(0.0), velocity(nullptr), solved(false), fft(nullptr),
+    relax(1.0), weight_index(-1), stratify(false), excess(nullptr), displaced_time(0.0), stiffest(0.0), solve_interval(0.0), lowest_class(0), excess_in_file(false), drift_limit(0.0), drift(0.0), solved_speed(0.0), unsettled(false), solved_viscosity(0.0), velocity(nullptr), solved(false), fft(nullptr),
     plane_lo(0), plane_hi(-1), last_solve(-1), warned_carry(false), carries(0), carry_start(0.0), reversals(0), reversal_growth(1.0)
 {
   if (narg < 8 || strcmp(arg[4], "grid") != 0)
@@ -160,7 +162,7 @@ FixFluidFlow::~FixFluidFlow()
   atom->delete_callback(id, Atom::GROW);
   atom->delete_callback(id, Atom::RESTART);
   memory->destroy(velocity);
-  memory->destroy(displacement);
+  memory->destroy(excess);
   delete fft;
   delete[] fluid_id;
 }
@@ -235,6 +237,7 @@ void FixFluidFlow::setup(int /*vflag*/)
     if (auto integrator = static_cast<FixNVESphereFluid *>(fix); integrator->has_floor()) floors.push_back(integrator);
   if (last_solve < 0) last_solve = update->ntimestep;    // a new fix, or one read from a restart
   displaced_time = sediment_time_now(update);
+  if (stratify) share_slopes();    // the box is known (not yet when a restart file gave the profiles)
   // A run continues the flow it has (from the last run, or a restart): a new one starts from one solve.
   // A run whose fluid was given another uniform velocity or viscosity since the last solve solves too.
   if (solved && !fluid_changed()) return;
@@ -254,15 +257,50 @@ bool FixFluidFlow::fluid_changed() const
       stokes.viscosity != solved_viscosity;
 }
 
-// stratification grains: each sphere's displacement along z by the flow, since it came into the fix.
+// stratification grains: each sphere's excess, how much denser its class is where it is than the
+// class's mean there, relative to that mean. Where the flow moves it by d zeta along z across its
+// class's profile Q_c(z), the excess grows by -(Q_c' / Q_c) d zeta: the grains of its class around it
+// came from there. Each class carries its own: a sphere left behind by a faster class's front (the sand
+// passing the silt) keeps none of the front's displacement, and one stirred about within a uniform
+// layer gains none, whatever it meets later. The slopes are held to the share the lagged flow can
+// follow: the classes' sum as the box-wide mode (share_slopes()), and each sphere's own, whose force
+// the flow it drives at the sphere follows within the interval between solves, to half of that
+// interval's (where its class is sparse, a front's edge, one sphere stands for much of the profile).
+// The class's density is kept within its profile's range and above none (the flow only moves grains).
 // Between solves a sphere keeps the fluid velocity of the last one, so the sum is exact for any every N.
 void FixFluidFlow::displace()
 {
   const double t = sediment_time_now(update), elapsed = t - displaced_time;
   displaced_time = t;
+  const int nz = grid[2], classes = static_cast<int>(profiles.size()) / nz;
+  if (classes == 0) return;    // no solve has made the profiles yet
   const int *mask = atom->mask;
-  for (int i = 0; i < atom->nlocal; ++i)
-    if (mask[i] & groupbit) displacement[i] += (velocity[i][2] - solved_uniform[2]) * elapsed;
+  double **x = atom->x;
+  for (int i = 0; i < atom->nlocal; ++i) {
+    const int c = settling_class(i) - lowest_class;
+    if (!(mask[i] & groupbit) || c < 0 || c >= classes) continue;    // a class new since the last solve
+    const double *q = &profiles[static_cast<size_t>(c) * nz];
+    const double at = std::clamp((x[i][2] - origin[2]) / spacing[2] - 0.5, 0.0, nz - 1.0);
+    const int below = std::min(static_cast<int>(at), nz - 2);
+    const double here = q[below] + (at - below) * (q[below + 1] - q[below]);
+    if (here == 0.0) continue;
+    double slope = (q[below + 1] - q[below]) / spacing[2] * slope_share[below];
+    const double own_gain = std::abs(class_force[c] * slope / here) * self_flow[2] * solve_interval;
+    if (own_gain > 0.5) slope *= 0.5 / own_gain;
+    const auto [lowest, highest] = std::minmax({0.0, q[0], q[nz - 1]});    // the stable profile's range
+    const double density = (1.0 + excess[i]) * here - slope * (velocity[i][2] - solved_uniform[2]) * elapsed;
+    excess[i] = std::clamp(density, lowest, highest) / here - 1.0;
+  }
+}
+
+// A sphere's settling class for stratification grains: its Stokes speed's scale d^2 (rho_p - rho_f) to a
+// factor sqrt(2), sinking and rising apart (even and odd); INT_MIN for one as dense as the fluid.
+int FixFluidFlow::settling_class(int i) const
+{
+  const double r = atom->radius[i];
+  const double scale = 4.0 * r * r * (atom->rmass[i] / (4.0 / 3.0 * MY_PI * r * r * r) - fluid->properties().density);
+  if (!(scale != 0.0) || !std::isfinite(scale)) return std::numeric_limits<int>::min();
+  return 2 * static_cast<int>(std::floor(2.0 * std::log2(std::abs(scale)))) + (scale < 0.0 ? 1 : 0);
 }
 
 void FixFluidFlow::end_of_step()
@@ -380,72 +418,91 @@ void FixFluidFlow::weigh_forces()
 // stratification grains (docs/physics.md section 8, Parcels). The parcels' own forces, sqrt(w S(0))
 // grains' each, give the force density's fluctuation its real size; but where the flow displaces the
 // column's mean density profile, that displaced profile pushes back with only sqrt(S(0) / w) of the
-// real grains' force. The rest, (w - sqrt(w S(0))) grains' force per parcel, is added here as a field:
-// its mean along z, Q(z) (a profile uniform across, which moves nothing), displaced at each node by the
-// mean displacement of the spheres there since they came into the fix, zeta(x), weighted by their
-// share of Q: the vertical force density Q(z - zeta(x)) - Q(z), into `restoring` (per slab node, the
-// column's mirror image reversed as the forces' are).
+// real grains' force. The rest, (w - sqrt(w S(0))) grains' force per parcel, its missing force, is
+// added here: per settling class its mean along z, Q_c(z), made stable (a profile uniform across, which
+// moves nothing, and is not added), and each sphere adds its class's mean missing force times its
+// excess (displace()) to the force it spreads, into `restoring`. Undisplaced that is nothing; displaced
+// by zeta, the spheres' sum is the real grains' -zeta dQ/dz less the parcels' share.
 void FixFluidFlow::stratification_force()
 {
   constexpr int nodes = sediment::FlowKernel::max_nodes;
   const int nz = grid[2];
   const double *weight = atom->dvector[weight_index];
   double **x = atom->x;
-  const double per_node = 1.0 / (spacing[0] * spacing[1] * spacing[2] * grid[0] * grid[1]);
-  std::vector<double> excess(nz, 0.0);
-  tracer.assign(3 * brick.size(), 0.0);
+  std::vector<int> classes(spheres.size());
+  int range[2] = {std::numeric_limits<int>::max(), std::numeric_limits<int>::max()}, span[2];    // lowest, -highest
   for (size_t s = 0; s < spheres.size(); ++s) {
-    const int i = spheres[s];
-    const double force = (weight[i] / scales[s] - 1.0) * forces[3 * s + 2];    // forces hold sqrt(w S(0)) grains'
-    if (force == 0.0) continue;
+    classes[s] = settling_class(spheres[s]);
+    if (classes[s] == std::numeric_limits<int>::min()) continue;
+    range[0] = std::min(range[0], classes[s]);
+    range[1] = std::min(range[1], -classes[s]);
+  }
+  MPI_Allreduce(range, span, 2, MPI_INT, MPI_MIN, world);
+  lowest_class = span[0];
+  const int count = span[0] <= -span[1] ? -span[1] - span[0] + 1 : 0;
+  class_force.assign(count, 0.0);
+  // Each class's mean missing force per sphere: the force of a grain settling at its terminal slip,
+  // its weight less its buoyancy, is the same everywhere in the class; a sphere's own drag at a step
+  // is not (at each solve the fluid's velocity at it jumps), and with it the excess's force would
+  // follow the flow it drives within the step, and run away where the flow carries spheres a cell.
+  std::vector<double> local(2 * static_cast<size_t>(count), 0.0), mean(local.size());
+  std::vector<double> missing_force(spheres.size(), 0.0);
+  for (size_t s = 0; s < spheres.size(); ++s) {
+    if (classes[s] == std::numeric_limits<int>::min()) continue;
+    missing_force[s] = (weight[spheres[s]] / scales[s] - 1.0) * forces[3 * s + 2];    // forces hold sqrt(w S(0)) grains'
+    local[2 * (classes[s] - lowest_class)] += missing_force[s];
+    local[2 * (classes[s] - lowest_class) + 1] += 1.0;
+  }
+  MPI_Allreduce(local.data(), mean.data(), static_cast<int>(local.size()), MPI_DOUBLE, MPI_SUM, world);
+  const double per_node = 1.0 / (spacing[0] * spacing[1] * spacing[2] * grid[0] * grid[1]);
+  std::vector<double> missing(static_cast<size_t>(count) * nz, 0.0);
+  restoring.assign(spheres.size(), 0.0);
+  for (size_t s = 0; s < spheres.size(); ++s) {
+    if (classes[s] == std::numeric_limits<int>::min() || missing_force[s] == 0.0) continue;
+    const int c = classes[s] - lowest_class;
+    const double force = class_force[c] = mean[2 * c] / mean[2 * c + 1];
+    restoring[s] = force * excess[spheres[s]];
     int first;
     double w[nodes];
-    kernel.weights((x[i][2] - origin[2]) / spacing[2] - 0.5, first, w);
+    kernel.weights((x[spheres[s]][2] - origin[2]) / spacing[2] - 0.5, first, w);
+    double *q = &missing[static_cast<size_t>(c) * nz];
     for (int a = 0; a < nodes; ++a) {
       int m = first + a;    // reflected at the bottom and the top, as the column's mirror image is
       if (m < 0)
         m = -m - 1;
       else if (m >= nz)
         m = 2 * nz - 1 - m;
-      excess[m] += w[a] * force * per_node;
+      q[m] += w[a] * force * per_node;
     }
-    // the displacement, weighted by the sphere's share of the profile (its class's, where classes mix)
-    const double share = std::abs(force), carried[3] = {share * displacement[i], share, 0.0};
-    spread_point(stencils[s], carried, tracer);
   }
-  profile.resize(nz);
-  MPI_Allreduce(excess.data(), profile.data(), nz, MPI_DOUBLE, MPI_SUM, world);
-  sediment::stable_profile(profile.data(), nz);
-  // The mean displacement at each node: the ratio of the two spread with the B-spline alone, as the
-  // spheres' forces are (the solve then smooths the force density of both alike).
-  sum_into_slabs(brick, tracer, true);    // along x and y: the mirror image keeps them
+  profiles.resize(missing.size());
+  MPI_Allreduce(missing.data(), profiles.data(), static_cast<int>(missing.size()), MPI_DOUBLE, MPI_SUM, world);
+  for (int c = 0; c < count; ++c) sediment::stable_profile(&profiles[static_cast<size_t>(c) * nz], nz);
   // The lagged flow carries the spheres for the time between solves before the profile they displace
   // pushes back; where it pushes back faster than that (a front or a bed, whose real grains restore it
-  // within milliseconds), the force would overshoot and grow from solve to solve. It is capped at the
-  // stiffness (force per displacement) that the most mobile mode on the grid, the box-wide one,
-  // relaxes in one such time: the stiff limit, in which the displaced profile is restored as fast as
-  // the step can follow (docs/physics.md section 8).
+  // within milliseconds), the force would overshoot and grow from solve to solve. The profiles' slopes
+  // are held to the stiffness (force per displacement) that the most mobile mode on the grid, the
+  // box-wide one, relaxes in one such time: the stiff limit, in which the displaced profile is restored
+  // as fast as the step can follow (docs/physics.md section 8).
   const double k = sediment::grid_wavenumber(1, grid[0], std::max(length[0], length[1]));    // 2 pi / width
   const double mobility = 1.0 / (stokes.viscosity * k * k + stokes.brinkman);
   const double interval = update->dt * static_cast<double>(std::max<bigint>(1, update->ntimestep - last_solve));
-  const double stiffest = 1.0 / (mobility * interval);
-  const long plane = static_cast<long>(grid[0]) * grid[1];
-  restoring.assign(plane * (plane_hi - plane_lo + 1), 0.0);
-  for (int q = plane_lo; q <= plane_hi; ++q) {
-    const bool mirror = q >= nz;
-    const int plane_k = mirror ? nzt - 1 - q : q;    // the plane of the column
-    const double *t = &slab[3 * plane * (q - plane_lo)];
-    double *f = &restoring[plane * (q - plane_lo)];
-    for (long m = 0; m < plane; ++m) {
-      if (!(t[3 * m + 1] > 0.0)) continue;    // no sphere's kernel reaches the node: nothing displaced
-      const double zeta = t[3 * m] / t[3 * m + 1];
-      const double from = std::clamp(plane_k - zeta / spacing[2], 0.0, nz - 1.0);
-      const int below = std::min(static_cast<int>(from), nz - 2);
-      const double u = from - below;
-      double displaced = (1.0 - u) * profile[below] + u * profile[below + 1] - profile[plane_k];
-      if (std::abs(displaced) > stiffest * std::abs(zeta)) displaced = std::copysign(stiffest * std::abs(zeta), displaced);
-      f[m] = mirror ? -displaced : displaced;
-    }
+  stiffest = 1.0 / (mobility * interval);
+  solve_interval = interval;
+  share_slopes();
+}
+
+// Per cell along z, the share of the classes' slopes the lagged flow can follow: all of them up to
+// `stiffest`, their sum held there above it.
+void FixFluidFlow::share_slopes()
+{
+  const int nz = grid[2], classes = static_cast<int>(profiles.size()) / nz;
+  slope_share.assign(std::max(nz - 1, 0), 0.0);
+  for (int m = 0; m + 1 < nz; ++m) {
+    double sum = 0.0;
+    for (int c = 0; c < classes; ++c) sum += std::abs(profiles[static_cast<size_t>(c) * nz + m + 1] - profiles[static_cast<size_t>(c) * nz + m]);
+    sum /= spacing[2];
+    slope_share[m] = sum > stiffest ? stiffest / sum : 1.0;
   }
 }
 
@@ -930,20 +987,21 @@ void FixFluidFlow::solve()
   for (size_t s = 0; s < spheres.size(); ++s) stencils[s] = stencil_at(x[spheres[s]]);
   build_brick(brick, stencils, true);
   gather_bricks(brick);
+  if (stratify) stratification_force();
   spread.assign(3 * brick.size(), 0.0);
   for (size_t s = 0; s < spheres.size(); ++s) {
     place(stencils[s], brick);
     const double *force = &forces[3 * s];
-    if (force[0] == 0.0 && force[1] == 0.0 && force[2] == 0.0) continue;
+    // the displaced stratification's force is not one the spheres lose (docs/physics.md section 8)
+    const double spreads[3] = {force[0], force[1], force[2] + (stratify ? restoring[s] : 0.0)};
+    if (spreads[0] == 0.0 && spreads[1] == 0.0 && spreads[2] == 0.0) continue;
     for (int c = 0; c < 3; ++c) local[c] += force[c];
-    spread_point(stencils[s], force, spread);
+    spread_point(stencils[s], spreads, spread);
   }
   double total[4];
   MPI_Allreduce(local, total, 4, MPI_DOUBLE, MPI_SUM, world);
 
-  if (stratify) stratification_force();    // it uses the slabs before the forces fill them
   sum_into_slabs(brick, spread, true);
-  for (size_t m = 0; m < restoring.size(); ++m) slab[3 * m + 2] += restoring[m];
   transform_solve();
 
   // Diagnostics: the largest mean vertical velocity over a plane of nodes in the fluid (zero: no
@@ -1087,14 +1145,14 @@ double FixFluidFlow::compute_vector(int n)
 void FixFluidFlow::grow_arrays(int nmax)
 {
   memory->grow(velocity, nmax, 3, "fluid/flow:velocity");
-  memory->grow(displacement, nmax, "fluid/flow:displacement");
+  memory->grow(excess, nmax, "fluid/flow:excess");
   array_atom = velocity;
 }
 
 void FixFluidFlow::copy_arrays(int i, int j, int /*delflag*/)
 {
   for (int c = 0; c < 3; ++c) velocity[j][c] = velocity[i][c];
-  displacement[j] = displacement[i];
+  excess[j] = excess[i];
 }
 
 // A sphere created during a run (create_atoms between runs, fix deposit or pour) takes the fluid
@@ -1116,48 +1174,68 @@ void FixFluidFlow::set_arrays(int i)
     read_point(at, flow, u);
   }
   for (int c = 0; c < 3; ++c) velocity[i][c] = uniform[c] + u[c];
-  displacement[i] = 0.0;
+  excess[i] = 0.0;
 }
 
 int FixFluidFlow::pack_exchange(int i, double *buf)
 {
   for (int c = 0; c < 3; ++c) buf[c] = velocity[i][c];
-  buf[3] = displacement[i];
+  buf[3] = excess[i];
   return 4;
 }
 
 int FixFluidFlow::unpack_exchange(int nlocal, double *buf)
 {
   for (int c = 0; c < 3; ++c) velocity[nlocal][c] = buf[c];
-  displacement[nlocal] = buf[3];
+  excess[nlocal] = buf[3];
   return 4;
 }
 
 void FixFluidFlow::write_restart(FILE *fp)
 {
   if (comm->me != 0) return;
-  // A negative count first: files written before it held 4 values, the first 0 or 1.
-  double state[RESTART_VALUES] = {-static_cast<double>(RESTART_VALUES), solved ? 1.0 : 0.0, drift, solved_speed,
-                                  unsettled ? 1.0 : 0.0, solved_viscosity};
-  std::copy_n(solved_uniform, 3, state + 6);
-  std::copy_n(diag, NDIAG, state + 9);
-  const int size = sizeof(state);
+  // A negative count first: files written before it held 4 values, the first 0 or 1. Last the profiles
+  // of stratification grains, whose slopes the steps before the next solve read (their classes, then them).
+  std::vector<double> state = {-static_cast<double>(RESTART_VALUES + profiles.size() + class_force.size()), solved ? 1.0 : 0.0, drift,
+                               solved_speed, unsettled ? 1.0 : 0.0, solved_viscosity};
+  state.insert(state.end(), solved_uniform, solved_uniform + 3);
+  state.insert(state.end(), diag, diag + NDIAG);
+  state.push_back(stiffest);
+  state.push_back(solve_interval);
+  state.push_back(lowest_class);
+  state.push_back(grid[2]);
+  state.insert(state.end(), profiles.begin(), profiles.end());
+  state.insert(state.end(), class_force.begin(), class_force.end());
+  const int size = static_cast<int>(state.size() * sizeof(double));
   fwrite(&size, sizeof(int), 1, fp);
-  fwrite(state, sizeof(double), RESTART_VALUES, fp);
+  fwrite(state.data(), sizeof(double), state.size(), fp);
 }
 
 void FixFluidFlow::restart(char *buf)
 {
-  // Files written before the fix kept its diagnostics and the fluid of its last solve hold 4 values:
-  // solved, drift, speed, solves (the first 0 or 1); its first run then solves again.
-  double state[RESTART_VALUES];
-  memcpy(state, buf, sizeof(double));
-  const bool before = state[0] >= 0.0;
-  if (!before && state[0] != -static_cast<double>(RESTART_VALUES))
-    error->all(FLERR, "Fix fluid/flow: the restart file holds {} values of its state, not {}: written by another "
-               "release", -state[0], static_cast<int>(RESTART_VALUES));
-  memcpy(state, buf, (before ? 4 : RESTART_VALUES) * sizeof(double));
-  const double *kept = before ? state : state + 1;    // solved, drift, speed
+  // Three layouts. Files written before the fix kept its diagnostics and the fluid of its last solve
+  // hold 4 values: solved, drift, speed, solves (the first 0 or 1); its first run then solves again.
+  // Files written before stratification grains kept its state hold UNSTRATIFIED, and the fifth value
+  // per atom some of them hold was a displacement, not an excess: it is not read. Then per class its
+  // profile (planes values), then per class its force.
+  double first;
+  memcpy(&first, buf, sizeof(double));
+  const bool before = first >= 0.0;
+  const double count = -first;
+  std::vector<double> state(before ? 4 : (count == UNSTRATIFIED ? UNSTRATIFIED : RESTART_VALUES), 0.0);
+  excess_in_file = !before && count != UNSTRATIFIED;
+  double planes = 0.0, classes = 0.0;
+  if (excess_in_file) {
+    if (count >= RESTART_VALUES) memcpy(state.data(), buf, RESTART_VALUES * sizeof(double));
+    planes = state[RESTART_VALUES - 1];
+    classes = planes >= 1.0 ? (count - RESTART_VALUES) / (planes + 1.0) : -1.0;
+    if (count < RESTART_VALUES || !(classes >= 0.0) || classes != std::floor(classes))
+      error->all(FLERR, "Fix fluid/flow: the restart file holds {} values of its state, not {} and its "
+                 "profiles: written by another release", count, static_cast<int>(RESTART_VALUES));
+  } else {
+    memcpy(state.data(), buf, state.size() * sizeof(double));
+  }
+  const double *kept = before ? state.data() : state.data() + 1;    // solved, drift, speed
   solved = kept[0] != 0.0;
   drift = kept[1];
   solved_speed = kept[2];
@@ -1168,15 +1246,25 @@ void FixFluidFlow::restart(char *buf)
   }
   unsettled = state[4] != 0.0;
   solved_viscosity = state[5];
-  std::copy_n(state + 6, 3, solved_uniform);
-  std::copy_n(state + 9, static_cast<int>(NDIAG), diag);
+  std::copy_n(&state[6], 3, solved_uniform);
+  std::copy_n(&state[9], static_cast<int>(NDIAG), diag);
+  if (!excess_in_file) return;
+  stiffest = state[9 + NDIAG];
+  solve_interval = state[10 + NDIAG];
+  lowest_class = static_cast<int>(state[11 + NDIAG]);
+  std::vector<double> stored(static_cast<size_t>(count) - RESTART_VALUES);
+  memcpy(stored.data(), buf + RESTART_VALUES * sizeof(double), stored.size() * sizeof(double));
+  const auto profile_values = static_cast<size_t>(classes * planes);
+  profiles.assign(stored.begin(), stored.begin() + profile_values);
+  class_force.assign(stored.begin() + profile_values, stored.end());
+  if (static_cast<int>(planes) != grid[2]) profiles.clear();    // another grid's: the next solve makes this one's
 }
 
 int FixFluidFlow::pack_restart(int i, double *buf)
 {
   buf[0] = 5;
   for (int c = 0; c < 3; ++c) buf[1 + c] = velocity[i][c];
-  buf[4] = displacement[i];
+  buf[4] = excess[i];
   return 5;
 }
 
@@ -1185,9 +1273,9 @@ void FixFluidFlow::unpack_restart(int nlocal, int nth)
   double **extra = atom->extra;
   int m = 0;
   for (int k = 0; k < nth; ++k) m += static_cast<int>(extra[nlocal][m]);
-  const int size = static_cast<int>(extra[nlocal][m++]);    // 4 in files written before displacement
+  const int size = static_cast<int>(extra[nlocal][m++]);    // 4 in files written before the excess
   for (int c = 0; c < 3; ++c) velocity[nlocal][c] = extra[nlocal][m + c];
-  displacement[nlocal] = size > 4 ? extra[nlocal][m + 3] : 0.0;
+  excess[nlocal] = size > 4 && excess_in_file ? extra[nlocal][m + 3] : 0.0;    // restart() read the layout
 }
 
 int FixFluidFlow::size_restart(int /*i*/)
@@ -1210,6 +1298,8 @@ double FixFluidFlow::memory_usage()
       static_cast<double>(forces.capacity() + fractions.capacity() + scales.capacity() + diameter.capacity() +
                           speed.capacity() + voidage.capacity() + per_speed.capacity()) * sizeof(double) +
       static_cast<double>(spheres.capacity()) * sizeof(int);
-  return (4.0 * atom->nmax + grids + static_cast<double>(tracer.capacity() + restoring.capacity() + profile.capacity())) *
-      sizeof(double) + per_sphere;
+  const double stratification =
+      static_cast<double>(profiles.capacity() + class_force.capacity() + slope_share.capacity() + restoring.capacity()) *
+          sizeof(double);
+  return (4.0 * atom->nmax + grids) * sizeof(double) + per_sphere + stratification;
 }

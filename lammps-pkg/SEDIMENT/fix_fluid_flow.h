@@ -72,8 +72,12 @@ class FixFluidFlow : public Fix {
   // stratification grains: the column's mean density profile, displaced by the flow, pushes back with
   // the real grains' force (w per parcel), not the parcels' sqrt(w S(0)) (stratification_force)
   bool stratify;
-  double *displacement;       // per atom: how far the flow has carried the sphere along z (stratify)
-  double displaced_time;      // the time up to which displacement is summed
+  double *excess;             // per atom: its class's density where it is over the class's mean there, less 1
+  double displaced_time;      // the time up to which excess is summed
+  double stiffest;            // the largest slope of the profiles the lagged flow can follow (last solve)
+  double solve_interval;      // the time between the last two solves
+  int lowest_class;           // the settling class of profiles' first row (settling_class())
+  bool excess_in_file;        // the restart file read holds each sphere's excess (restart())
   double drift_limit;    // > 0: solve once the spheres may have moved this many cells since the last solve,
                          // or their largest speed has changed by this fraction
   static constexpr double DEFAULT_DRIFT = 0.2;    // without every or drift
@@ -124,7 +128,9 @@ class FixFluidFlow : public Fix {
   // Diagnostics of the last solve (compute_vector)
   enum { FX, FY, FZ, FLUX, PEAK, LEFT_OUT, SOLVES, NDIAG };
   double diag[NDIAG];
-  static constexpr int RESTART_VALUES = 9 + NDIAG;    // count, solved, drift, speed, unsettled, viscosity, uniform, diag
+  // count, solved, drift, speed, unsettled, viscosity, uniform, diag (UNSTRATIFIED: files written
+  // before stratification grains kept its state), then stiffest, solve_interval, lowest_class, planes
+  static constexpr int UNSTRATIFIED = 9 + NDIAG, RESTART_VALUES = 13 + NDIAG;
 
   bigint last_solve;         // the step of the last solve (-1: none yet in this fix)
   bool warned_carry;         // the warning that the flow carries spheres a cell between solves was given
@@ -144,9 +150,10 @@ class FixFluidFlow : public Fix {
   std::vector<Stencil> stencils;
   std::vector<double> forces, fractions;
   std::vector<double> scales;    // with weight: each force's factor sqrt(w S(0)) (weigh_forces)
-  std::vector<double> tracer;       // stratify: the spheres' displacements and their count, spread on brick's nodes
-  std::vector<double> restoring;    // stratify: the vertical force density of the displaced profile, per slab node
-  std::vector<double> profile;      // stratify: the mean excess force density of each plane of nodes
+  // stratify: per settling class, the mean missing force density of each plane of nodes (made stable;
+  // [class][plane]) and the mean missing force per sphere; the share of the sum of their slopes the
+  // lagged flow can follow, per cell along z; and each solve's sphere's restoring force along z
+  std::vector<double> profiles, class_force, slope_share, restoring;
   std::vector<double> diameter, speed, voidage, per_speed;    // sphere_forces' columns for the drag law
 
   void solve();
@@ -176,6 +183,8 @@ class FixFluidFlow : public Fix {
   void weigh_forces();
   void displace();
   void stratification_force();
+  int settling_class(int i) const;
+  void share_slopes();
   double sphere_force(int i, double *force) const;
 };
 
