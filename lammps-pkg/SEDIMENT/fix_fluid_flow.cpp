@@ -277,8 +277,11 @@ void FixFluidFlow::displace()
   const int *mask = atom->mask;
   double **x = atom->x;
   for (int i = 0; i < atom->nlocal; ++i) {
-    const int c = settling_class(i) - lowest_class;
-    if (!(mask[i] & groupbit) || c < 0 || c >= classes) continue;    // a class new since the last solve
+    if (!(mask[i] & groupbit)) continue;
+    const int key = settling_class(i);
+    // as dense as the fluid, or of a class new since the last solve
+    if (key == std::numeric_limits<int>::min() || key < lowest_class || key - lowest_class >= classes) continue;
+    const int c = key - lowest_class;
     const double *q = &profiles[static_cast<size_t>(c) * nz];
     const double at = std::clamp((x[i][2] - origin[2]) / spacing[2] - 0.5, 0.0, nz - 1.0);
     const int below = std::min(static_cast<int>(at), nz - 2);
