@@ -97,6 +97,19 @@ void stable_profile(double *profile, int planes)
     for (int j = 0; j < count[b]; ++j) profile[k++] = mean[b];
 }
 
+double carried_excess(double excess, const double *profile, int planes, double spacing, double at, double share,
+                      double largest_relative_slope, double lift)
+{
+  const int below = std::clamp(static_cast<int>(at), 0, planes - 2);
+  const double rise = profile[below + 1] - profile[below], here = profile[below] + (at - below) * rise;
+  if (here == 0.0) return excess;
+  double slope = rise / spacing * share;
+  if (const double relative = std::abs(slope / here); relative > largest_relative_slope)
+    slope *= largest_relative_slope / relative;
+  const auto [lowest, highest] = std::minmax({0.0, profile[0], profile[planes - 1]});    // a stable profile's range
+  return std::clamp((1.0 + excess) * here - slope * lift, lowest, highest) / here - 1.0;
+}
+
 double gaussian_self_mobility(double viscosity, double sigma)
 {
   return 1.0 / (6.0 * pi * viscosity * sigma * std::sqrt(pi));

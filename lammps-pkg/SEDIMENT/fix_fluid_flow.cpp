@@ -282,17 +282,13 @@ void FixFluidFlow::displace()
     // as dense as the fluid, or of a class new since the last solve
     if (key == std::numeric_limits<int>::min() || key < lowest_class || key - lowest_class >= classes) continue;
     const int c = key - lowest_class;
-    const double *q = &profiles[static_cast<size_t>(c) * nz];
     const double at = std::clamp((x[i][2] - origin[2]) / spacing[2] - 0.5, 0.0, nz - 1.0);
     const int below = std::min(static_cast<int>(at), nz - 2);
-    const double here = q[below] + (at - below) * (q[below + 1] - q[below]);
-    if (here == 0.0) continue;
-    double slope = (q[below + 1] - q[below]) / spacing[2] * slope_share[below];
-    const double own_gain = std::abs(class_force[c] * slope / here) * self_flow[2] * solve_interval;
-    if (own_gain > 0.5) slope *= 0.5 / own_gain;
-    const auto [lowest, highest] = std::minmax({0.0, q[0], q[nz - 1]});    // the stable profile's range
-    const double density = (1.0 + excess[i]) * here - slope * (velocity[i][2] - solved_uniform[2]) * elapsed;
-    excess[i] = std::clamp(density, lowest, highest) / here - 1.0;
+    // the sphere's own force, m_c |Q'/Q| per displacement, drives s (self-flow) per force: gain 0.5 at most
+    const double own = std::abs(class_force[c]) * self_flow[2] * solve_interval;
+    excess[i] = sediment::carried_excess(excess[i], &profiles[static_cast<size_t>(c) * nz], nz, spacing[2], at,
+                                         slope_share[below], own > 0.0 ? 0.5 / own : HUGE_VAL,
+                                         (velocity[i][2] - solved_uniform[2]) * elapsed);
   }
 }
 
@@ -1256,7 +1252,7 @@ void FixFluidFlow::restart(char *buf)
   solve_interval = state[10 + NDIAG];
   lowest_class = static_cast<int>(state[11 + NDIAG]);
   std::vector<double> stored(static_cast<size_t>(count) - RESTART_VALUES);
-  memcpy(stored.data(), buf + RESTART_VALUES * sizeof(double), stored.size() * sizeof(double));
+  if (!stored.empty()) memcpy(stored.data(), buf + RESTART_VALUES * sizeof(double), stored.size() * sizeof(double));
   const auto profile_values = static_cast<size_t>(classes * planes);
   profiles.assign(stored.begin(), stored.begin() + profile_values);
   class_force.assign(stored.begin() + profile_values, stored.end());

@@ -292,3 +292,28 @@ TEST(Flow, StableProfile)
   stable_profile(inverted.data(), 3);
   EXPECT_EQ(inverted, (std::vector<double>{-1.0, -1.0, -1.0}));
 }
+
+TEST(Flow, CarriedExcess)
+{
+  // A class's profile falling linearly from -4 on the floor to none at plane 4, planes 1 mm apart
+  const std::vector<double> q = {-4.0, -3.0, -2.0, -1.0, 0.0};
+  const double mm = 1e-3, free = HUGE_VAL;
+  // Lifted 0.5 mm from plane 2 it brings plane 1.5's density, -2.5: half as dense again as the mean there
+  EXPECT_DOUBLE_EQ(carried_excess(0.0, q.data(), 5, mm, 2.0, 1.0, free, 0.5 * mm), 0.25);
+  // and lowered back it has none; settling (no lift) leaves it as it is
+  EXPECT_NEAR(carried_excess(0.25, q.data(), 5, mm, 2.0, 1.0, free, -0.5 * mm), 0.0, 1e-15);
+  EXPECT_DOUBLE_EQ(carried_excess(0.25, q.data(), 5, mm, 3.0, 1.0, free, 0.0), 0.25);
+  // The lagged flow's share of the slope, and the sphere's own limit on |Q'/Q| (0.5 /mm here), scale it
+  EXPECT_DOUBLE_EQ(carried_excess(0.0, q.data(), 5, mm, 2.0, 0.5, free, 0.5 * mm), 0.125);
+  EXPECT_DOUBLE_EQ(carried_excess(0.0, q.data(), 5, mm, 2.0, 1.0, 0.25 / mm, 0.5 * mm), 0.125);
+  // Never denser than the floor's -4, nor below none: lifted 5 mm from plane 3, lowered 5 mm from plane 1
+  EXPECT_DOUBLE_EQ(carried_excess(0.0, q.data(), 5, mm, 3.0, 1.0, free, 5.0 * mm), 3.0);
+  EXPECT_DOUBLE_EQ(carried_excess(0.0, q.data(), 5, mm, 1.0, 1.0, free, -5.0 * mm), -1.0);
+  // A uniform class gains nothing however far it is stirred, and is nowhere denser than itself; an
+  // empty profile leaves the excess
+  const std::vector<double> uniform = {-2.0, -2.0, -2.0};
+  EXPECT_NEAR(carried_excess(-0.1, uniform.data(), 3, mm, 1.0, 1.0, free, 0.3 * mm), -0.1, 1e-15);
+  EXPECT_DOUBLE_EQ(carried_excess(0.1, uniform.data(), 3, mm, 1.0, 1.0, free, 0.0), 0.0);
+  const std::vector<double> empty = {0.0, 0.0, 0.0};
+  EXPECT_DOUBLE_EQ(carried_excess(0.1, empty.data(), 3, mm, 1.0, 1.0, free, 0.3 * mm), 0.1);
+}

@@ -93,6 +93,16 @@ double hard_sphere_structure_factor(double phi);
 // stratification grains would then drive as it restores a real one.
 void stable_profile(double *profile, int planes);
 
+// stratification grains: a sphere's excess r, how much denser its settling class is around it than
+// the class's mean at its height, relative to that mean, once the flow has lifted it by `lift` along z.
+// `profile` is the class's stable profile (`planes` planes from the bottom up, `spacing` apart), `at`
+// the sphere's place in planes (0 to planes - 1), `share` the part of the slope there the lagged flow
+// can follow, `largest_relative_slope` the most of |Q'/Q| the sphere's own force may follow. The
+// density its class brings with it is kept, (1 + r) Q changing by -Q' lift, within the profile's range
+// and above none; where the profile is empty, r stays.
+double carried_excess(double excess, const double *profile, int planes, double spacing, double at, double share,
+                      double largest_relative_slope, double lift);
+
 // Nitsche & Batchelor (1997): a cloud of n spheres of radius a, terminal speed us alone, within a
 // sphere of radius r settles for n a / r >> 1 as a drop of the same viscosity, u = us (1 + 6/5 n a / r).
 double cloud_speed(double us, int n, double a, double r);
