@@ -51,7 +51,7 @@ static inline int wrap(int i, int n)
 
 FixFluidFlow::FixFluidFlow(LAMMPS *lmp, int narg, char **arg) :
     Fix(lmp, narg, arg), fluid_id(nullptr), fluid(nullptr), nzt(0), column(false), column_lo(0.0), column_hi(0.0),
-    relax(1.0), weight_index(-1), stratify(false), excess(nullptr), displaced_time(0.0), stiffest(0.0), solve_interval(0.0), lowest_class(0), excess_in_file(false), drift_limit(0.0), drift(0.0), solved_speed(0.0), unsettled(false), solved_viscosity(0.0), velocity(nullptr), solved(false), fft(nullptr),
+    relax(1.0), weight_index(-1), stratify(false), excess(nullptr), displaced_time(0.0), solve_interval(0.0), lowest_class(0), excess_in_file(false), drift_limit(0.0), drift(0.0), solved_speed(0.0), unsettled(false), solved_viscosity(0.0), velocity(nullptr), solved(false), fft(nullptr),
     plane_lo(0), plane_hi(-1), last_solve(-1), warned_carry(false), carries(0), carry_start(0.0), reversals(0), reversal_growth(1.0)
 {
   if (narg < 8 || strcmp(arg[4], "grid") != 0)
@@ -483,18 +483,17 @@ void FixFluidFlow::stratification_force()
   // are held to the stiffness (force per displacement) that the most mobile mode on the grid, the
   // box-wide one, relaxes in one such time: the stiff limit, in which the displaced profile is restored
   // as fast as the step can follow (docs/physics.md section 8).
-  const double k = sediment::grid_wavenumber(1, grid[0], std::max(length[0], length[1]));    // 2 pi / width
-  const double mobility = 1.0 / (stokes.viscosity * k * k + stokes.brinkman);
-  const double interval = update->dt * static_cast<double>(std::max<bigint>(1, update->ntimestep - last_solve));
-  stiffest = 1.0 / (mobility * interval);
-  solve_interval = interval;
+  solve_interval = update->dt * static_cast<double>(std::max<bigint>(1, update->ntimestep - last_solve));
   share_slopes();
 }
 
-// Per cell along z, the share of the classes' slopes the lagged flow can follow: all of them up to
-// `stiffest`, their sum held there above it.
+// Per cell along z, the share of the classes' slopes the lagged flow can follow: all of them up to the
+// stiffest slope, at which the box-wide mode relaxes in solve_interval, their sum held there above it.
 void FixFluidFlow::share_slopes()
 {
+  const double k = sediment::grid_wavenumber(1, grid[0], std::max(length[0], length[1]));    // 2 pi / width
+  const double mobility = 1.0 / (stokes.viscosity * k * k + stokes.brinkman);
+  const double stiffest = 1.0 / (mobility * solve_interval);
   const int nz = grid[2], classes = static_cast<int>(profiles.size()) / nz;
   slope_share.assign(std::max(nz - 1, 0), 0.0);
   for (int m = 0; m + 1 < nz; ++m) {
@@ -1199,7 +1198,6 @@ void FixFluidFlow::write_restart(FILE *fp)
                                solved_speed, unsettled ? 1.0 : 0.0, solved_viscosity};
   state.insert(state.end(), solved_uniform, solved_uniform + 3);
   state.insert(state.end(), diag, diag + NDIAG);
-  state.push_back(stiffest);
   state.push_back(solve_interval);
   state.push_back(lowest_class);
   state.push_back(grid[2]);
@@ -1248,9 +1246,8 @@ void FixFluidFlow::restart(char *buf)
   std::copy_n(&state[6], 3, solved_uniform);
   std::copy_n(&state[9], static_cast<int>(NDIAG), diag);
   if (!excess_in_file) return;
-  stiffest = state[9 + NDIAG];
-  solve_interval = state[10 + NDIAG];
-  lowest_class = static_cast<int>(state[11 + NDIAG]);
+  solve_interval = state[9 + NDIAG];
+  lowest_class = static_cast<int>(state[10 + NDIAG]);
   std::vector<double> stored(static_cast<size_t>(count) - RESTART_VALUES);
   if (!stored.empty()) memcpy(stored.data(), buf + RESTART_VALUES * sizeof(double), stored.size() * sizeof(double));
   const auto profile_values = static_cast<size_t>(classes * planes);

@@ -74,7 +74,6 @@ class FixFluidFlow : public Fix {
   bool stratify;
   double *excess;             // per atom: its class's density where it is over the class's mean there, less 1
   double displaced_time;      // the time up to which excess is summed
-  double stiffest;            // the largest slope of the profiles the lagged flow can follow (last solve)
   double solve_interval;      // the time between the last two solves
   int lowest_class;           // the settling class of profiles' first row (settling_class())
   bool excess_in_file;        // the restart file read holds each sphere's excess (restart())
@@ -129,8 +128,8 @@ class FixFluidFlow : public Fix {
   enum { FX, FY, FZ, FLUX, PEAK, LEFT_OUT, SOLVES, NDIAG };
   double diag[NDIAG];
   // count, solved, drift, speed, unsettled, viscosity, uniform, diag (UNSTRATIFIED: files written
-  // before stratification grains kept its state), then stiffest, solve_interval, lowest_class, planes
-  static constexpr int UNSTRATIFIED = 9 + NDIAG, RESTART_VALUES = 13 + NDIAG;
+  // before stratification grains kept its state), then solve_interval, lowest_class, planes
+  static constexpr int UNSTRATIFIED = 9 + NDIAG, RESTART_VALUES = 12 + NDIAG;
 
   bigint last_solve;         // the step of the last solve (-1: none yet in this fix)
   bool warned_carry;         // the warning that the flow carries spheres a cell between solves was given
