@@ -442,6 +442,49 @@ def test_a_run_that_starts_after_the_stop_is_stopped_at_once(tmp_path):
         run_batch(deck, running=runs)
 
 
+def test_the_wait_for_the_runs_takes_a_signal_another_thread_received():
+    """The kernel may hand SIGINT or SIGTERM to any thread that does not block it: to a worker waiting on
+    its run, Python's handler then runs in the main thread only once that thread runs again. Waiting on
+    the workers without a timeout (concurrent.futures.as_completed), the main thread did not, and a plan
+    whose runs were paused hung after the signal (1 time in 8 on a loaded machine). Here the signal goes
+    to the worker while the main thread waits on it; the wait raises the handler's exception at once."""
+    from concurrent.futures import ThreadPoolExecutor
+
+    from sediment.sim.process import finished_in_turn
+
+    class Stopped(Exception):
+        pass
+
+    def stop(_signum, _frame):
+        raise Stopped
+
+    started, release = threading.Event(), threading.Event()
+    worker = []
+
+    def wait_in_worker() -> None:
+        worker.append(threading.get_ident())
+        started.set()
+        release.wait(60)    # a hang guard only: the test ends long before
+
+    previous = signal.signal(signal.SIGUSR1, stop)
+    try:
+        with ThreadPoolExecutor(max_workers=1) as pool:
+            future = pool.submit(wait_in_worker)
+            started.wait()
+            to_worker = threading.Timer(0.3, signal.pthread_kill, (worker[0], signal.SIGUSR1))
+            begun = time.monotonic()
+            try:
+                with pytest.raises(Stopped):
+                    to_worker.start()
+                    for _ in finished_in_turn([future]):
+                        pass
+            finally:
+                release.set()
+            assert time.monotonic() - begun < 30
+    finally:
+        signal.signal(signal.SIGUSR1, previous)
+
+
 def test_a_stopped_run_leaves_no_process_holding_its_output(tmp_path):
     """A one-rank run is an Open MPI singleton whose daemon (orted) sets up a session of its own and holds
     the run's stdout; stopping only the run's session left it there, and the reader of the run's output

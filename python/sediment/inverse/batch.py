@@ -11,7 +11,7 @@ import json
 import math
 import subprocess
 import sys
-from concurrent.futures import ThreadPoolExecutor, as_completed
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -19,6 +19,7 @@ import numpy as np
 
 from .. import figures
 from ..results import Table, write_text
+from ..sim.process import finished_in_turn
 
 OPTIONS_FILE = "sample.json"
 FILE_OPTIONS = ("hydrometer-calibration", "budget")    # options whose value is a file of the sample's folder
@@ -127,7 +128,7 @@ def run_batch(samples: list[Sample], common: list[str], out: Path, logs: Path, j
 
     with ThreadPoolExecutor(max_workers=max(1, jobs)) as pool:
         futures = [pool.submit(invert_one, sample, key) for sample, key in todo]
-        for future in as_completed(futures):
+        for future in finished_in_turn(futures):
             row = future.result()
             rows[row["sample"]] = row
             print(f"[{len(rows)}/{total}] {row['sample']}: {row['status']}", flush=True)

@@ -23,7 +23,7 @@ import numpy as np
 
 from .. import _core
 from ..results import Table
-from ..sim.process import Runs
+from ..sim.process import Runs, results_of
 from ..sim.run import run_batch
 from ..sim.scene import Effects, Scene, plan
 from ..sim.scenefiles import write
@@ -188,7 +188,7 @@ def measure_flow(test: SedimentationTest, seeds: list[int], folder: Path, jobs: 
     with ThreadPoolExecutor(max_workers=max(1, min(jobs, len(scenes)))) as pool:
         futures = [pool.submit(draw, test, scene, where) for scene, where in zip(scenes, folders)]
         try:
-            results = [f.result() for f in futures]
+            results = results_of(futures)
         except BaseException:    # Ctrl-C or a failed draw: stop the others too
             if running is not None:
                 running.stop()

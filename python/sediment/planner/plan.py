@@ -23,7 +23,7 @@ import itertools
 import json
 import math
 import sys
-from concurrent.futures import ThreadPoolExecutor, as_completed
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
@@ -32,6 +32,7 @@ import numpy as np
 from .. import figures
 from ..progress import bar as progress_bar
 from ..results import Table, write_text
+from ..sim.process import finished_in_turn
 from .scenes import Knob, Outcome, prepare
 from .screening import INCLUDE, MEASURE, Screen
 
@@ -494,7 +495,7 @@ def _run_all(scene, trials: list[Trial], runs: Path, jobs: int, progress: bool, 
     try:
         for t in trials:
             futures[pool.submit(scene.run, t.settings, runs / t.name, t.seed)] = t
-        for future in as_completed(futures):
+        for future in finished_in_turn(futures):
             futures[future].outcome = future.result()
             if bar is not None:
                 bar.update()

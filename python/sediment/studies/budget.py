@@ -36,6 +36,7 @@ from ..planner.scenes import SampleScene
 from ..progress import bar as progress_bar
 from ..results import Table, write_text
 from ..sim.layers import read_layers
+from ..sim.process import finished_in_turn
 from ..sim.run import run_batch
 from ..sim.scene import Cylinder, Effects, plan
 from ..sim.scenefiles import write
@@ -224,8 +225,9 @@ def error_budget(psd: PSD, folder: Path, *, particles: int = 20000, courant: flo
         bar = progress_bar(total=len(runs), desc=f"budget {name}", unit="run")
     results = {}
     with ThreadPoolExecutor(max_workers=jobs) as pool:
-        for key, found in zip(runs, pool.map(one, runs)):
-            results[key] = found
+        futures = {pool.submit(one, key): key for key in runs}
+        for future in finished_in_turn(futures):
+            results[futures[future]] = future.result()
             if bar is not None:
                 bar.update()
     if bar is not None:

@@ -24,6 +24,7 @@ from .. import figures
 from ..progress import bar as progress_bar
 from ..results import Table, write_text
 from ..sim.deck import index_variables
+from ..sim.process import finished_in_turn, results_of
 from ..sim.run import run_batch
 from .paste import EXAMPLES, PASTE, PLASTIC_VISCOSITY
 
@@ -263,8 +264,10 @@ def funnel_study(runs: int = 15, jobs: int = 2, dt: float = 1e-6, settings: dict
     if settings.get("law") in PLASTIC_VISCOSITY and "eta_B" not in settings:    # the viscosity goes with the law
         settings["eta_B"] = f"{PLASTIC_VISCOSITY[settings['law']]:g}"
     with ThreadPoolExecutor(max_workers=jobs) as pool:
-        pours = pool.map(lambda seed: pour(seed, dt, settings=settings), range(1, runs + 1))
-        return FunnelStudy(list(progress_bar(pours, total=runs, desc="pours", unit="run", disable=not progress)), settings, dt)
+        futures = [pool.submit(pour, seed, dt, settings=settings) for seed in range(1, runs + 1)]
+        for _ in progress_bar(finished_in_turn(futures), total=runs, desc="pours", unit="run", disable=not progress):
+            pass
+        return FunnelStudy(results_of(futures), settings, dt)
 
 
 @dataclass
