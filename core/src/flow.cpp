@@ -33,7 +33,8 @@ double grid_wavenumber(int m, int n, double length)
 void StokesOperator::apply(const double k[3], const double *f, double *u, double scale) const
 {
   const double k2 = k[0] * k[0] + k[1] * k[1] + k[2] * k[2];
-  if (!(k2 > 0.0)) {    // the mean: no net flux
+  // the mean: no net flux; with vessel_across, no flow uniform across either
+  if (!(k2 > 0.0) || (vessel_across && k[0] == 0.0 && k[1] == 0.0)) {
     for (int c = 0; c < 6; ++c) u[c] = 0.0;
     return;
   }

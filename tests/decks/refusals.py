@@ -247,6 +247,8 @@ BAD_INPUT = [
     (FLOW + "fix u all fluid/flow f grid 2 2 2", "Fix fluid/flow: grid size 2 in x is smaller than the kernel's 4 nodes"),
     (FLOW + "fix u all fluid/flow f grid 8 8 8 stratification real", "Fix fluid/flow: stratification must be parcels or grains"),
     (FLOW + "fix u all fluid/flow f grid 8 8 8 stratification", "Fix fluid/flow: keyword 'stratification' needs grains or parcels"),
+    (FLOW + "fix u all fluid/flow f grid 8 8 8 across wide", "Fix fluid/flow: across must be vessel or periodic"),
+    (FLOW + "fix u all fluid/flow f grid 8 8 8 across", "Fix fluid/flow: keyword 'across' needs vessel or periodic"),
     (FLOW + "fix w all property/atom d_w\nfix u all fluid/flow f grid 8 8 8 weight d_w stratification grains",
      "Fix fluid/flow: 'stratification grains' is for parcels (keyword weight) in a closed column"),
     ("fix f all fluid density 1000 viscosity -1e-3\nfix u all fluid/flow f grid 8 8 8", "Fix fluid: viscosity must be finite and > 0"),

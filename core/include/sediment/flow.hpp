@@ -22,6 +22,12 @@ double grid_wavenumber(int m, int n, double length);
 // space u(k) = (I - k k / k^2) f(k) / (mu k^2 + brinkman): the pressure takes the longitudinal part
 // of the force. The k = 0 mode is set to zero: the mean force is held by the mean pressure gradient
 // of a closed column (or the periodic box's frame), so the net volume flux is zero (the return flow).
+// With vessel_across, so are the modes uniform across: in a periodic box, a horizontal force whose mean
+// over the box's section is not zero in some plane acts the same in every image, over the whole of an
+// infinitely wide plane, and drives a shear flow of mobility 1 / (mu kz^2), for a column of height H
+// up to (H / pi)^2 / mu: (H / W)^2 / 4 times the box-wide mode's. In a vessel much wider than the box,
+// the neighbouring parts of a plane are pushed independently, their mean over the vessel's section is
+// nil, and its walls hold what is left; such a flow would also take H^2 / nu (hours) to grow.
 // With `smoothing` s^2 > 0 every mode is also multiplied by exp(-k^2 s^2): a Gaussian of variance
 // s^2 / 2 applied to the force as it is spread and again to the velocity as it is read (the part of
 // the kernel's width the grid does not take, FlowKernel).
@@ -29,6 +35,9 @@ struct StokesOperator {
   double viscosity = 1.0;
   double brinkman = 0.0;     // 0: Stokes; > 0: the resistance per unit volume of a Brinkman medium
   double smoothing = 0.0;    // s^2 [length^2]
+  // true: the box across is a sample of a much wider vessel, and the modes uniform across (kx = ky =
+  // 0, a flow the same over each whole horizontal plane) carry no flow; false: a periodic array.
+  bool vessel_across = false;
   // u(k) from f(k), one mode, complex values as (re, im) pairs: f[2 c] + i f[2 c + 1], c = 0, 1, 2.
   // `scale` multiplies the result (1 / N for an unscaled inverse transform). u may be f.
   void apply(const double k[3], const double *f, double *u, double scale = 1.0) const;
