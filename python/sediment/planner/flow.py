@@ -146,9 +146,8 @@ def measure_draw(test: SedimentationTest, scene: Scene, folder: Path, running: R
             # the steps were planned from the start's flow; swirls that outgrow it cannot be followed
             raise RuntimeError(f"seed {scene.seed}'s column: the swirls outgrew the steps planned from the start's "
                                f"flow ({scene.flow_speed() * 1e3:.3g} mm/s rms), and the run stopped before its "
-                               f"result went wrong. Sample 5's column at 60 g/L did so "
-                               f"(docs/effects.md section 3): this column cannot be measured at these steps.\n  "
-                               f"{exc}") from None
+                               f"result went wrong: this column cannot be measured at these steps (a finer grid, "
+                               f"--flow-cells, plans shorter ones; docs/effects.md section 3).\n  {exc}") from None
         seconds[kind] = sum(s for s, _ in out.loops)
     return (*read_draw(test, folder), (seconds["two"], seconds["one"]))
 
