@@ -223,15 +223,14 @@ def error_budget(psd: PSD, folder: Path, *, particles: int = 20000, courant: flo
     bar = None
     if progress:
         bar = progress_bar(total=len(runs), desc=f"budget {name}", unit="run")
-    results = {}
     with ThreadPoolExecutor(max_workers=jobs) as pool:
-        futures = {pool.submit(one, key): key for key in runs}
-        for future in finished_in_turn(futures):
-            results[futures[future]] = future.result()
+        futures = {key: pool.submit(one, key) for key in runs}
+        for _ in finished_in_turn(futures.values()):
             if bar is not None:
                 bar.update()
     if bar is not None:
         bar.close()
+    results = {key: future.result() for key, future in futures.items()}    # in the runs' order, as before
     ref = results["reference"]
     rows = []
     for c in choices:
