@@ -50,7 +50,7 @@ static inline int wrap(int i, int n)
 }
 
 FixFluidFlow::FixFluidFlow(LAMMPS *lmp, int narg, char **arg) :
-    Fix(lmp, narg, arg), fluid_id(nullptr), fluid(nullptr), nzt(0), column(false), column_lo(0.0), column_hi(0.0), across(Across::DEFAULT),
+    Fix(lmp, narg, arg), fluid_id(nullptr), fluid(nullptr), nzt(0), column(false), column_lo(0.0), column_hi(0.0),
     relax(1.0), weight_index(-1), stratify(false), excess(nullptr), displaced_time(0.0), solve_interval(0.0), lowest_class(0), excess_in_file(false), drift_limit(0.0), drift(0.0), solved_speed(0.0), unsettled(false), solved_viscosity(0.0), velocity(nullptr), solved(false), fft(nullptr),
     plane_lo(0), plane_hi(-1), last_solve(-1), warned_carry(false), carries(0), carry_start(0.0), reversals(0), reversal_growth(1.0)
 {
@@ -59,6 +59,7 @@ FixFluidFlow::FixFluidFlow(LAMMPS *lmp, int narg, char **arg) :
   fluid_id = utils::strdup(arg[3]);
   StyleArgs args(lmp, FLERR, "Fix fluid/flow", narg, arg, 4);
   bool every_given = false, drift_given = false;
+  int across = -1;    // across: 0 vessel, 1 periodic; -1 not given (a column's default is vessel)
   while (args.more()) {
     int nvalues = 1;
     if (args.is("grid")) {
@@ -106,7 +107,7 @@ FixFluidFlow::FixFluidFlow(LAMMPS *lmp, int narg, char **arg) :
       weight_name = args.weight(1);
     } else if (args.is("across")) {
       args.need(1, "vessel or periodic");
-      across = args.choice(1, {"vessel", "periodic"}) == 0 ? Across::VESSEL : Across::PERIODIC;
+      across = args.choice(1, {"vessel", "periodic"});
     } else if (args.is("stratification")) {
       args.need(1, "grains or parcels");
       stratify = args.choice(1, {"parcels", "grains"}) == 1;
@@ -115,6 +116,7 @@ FixFluidFlow::FixFluidFlow(LAMMPS *lmp, int narg, char **arg) :
     }
     args.next(nvalues);
   }
+  stokes.vessel_across = across < 0 ? column : across == 0;
   if (drift_given && every_given)
     error->all(FLERR, "Fix fluid/flow: give 'every N' or 'drift D', not both (drift chooses the steps between solves)");
   // By default the fix chooses the steps between solves: the flow is then never more than a fifth of a
@@ -199,7 +201,6 @@ void FixFluidFlow::init()
       error->all(FLERR, "Fix fluid/flow: the grid's cells must be cubes, not {} x {} x {} (grid counts in proportion "
                  "to the box{})", spacing[0], spacing[1], spacing[2], column ? " and the column" : "");
   stokes.smoothing = kernel.fourier_variance() * spacing[0] * spacing[0];
-  stokes.vessel_across = across == Across::VESSEL || (across == Across::DEFAULT && column);
 
   if (!fft) {
     const int nprocs = comm->nprocs, me = comm->me;

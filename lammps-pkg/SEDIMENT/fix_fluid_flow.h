@@ -66,7 +66,6 @@ class FixFluidFlow : public Fix {
   int nzt;               // planes of the transform: grid[2], or 2 grid[2] with the column's mirror
   bool column;           // closed in z: free slip at column_lo and column_hi
   double column_lo, column_hi;
-  enum class Across { DEFAULT, VESSEL, PERIODIC } across;    // the flow uniform across: held (a wider vessel) or free
   double relax;          // u <- (1 - relax) u + relax u_solved
   std::string weight_name;    // per-atom property: the real grains each sphere (a parcel) stands for
   int weight_index;

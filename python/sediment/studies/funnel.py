@@ -24,7 +24,7 @@ from .. import figures
 from ..progress import bar as progress_bar
 from ..results import Table, write_text
 from ..sim.deck import index_variables
-from ..sim.process import finished_in_turn, results_of
+from ..sim.process import finished_in_turn
 from ..sim.run import run_batch
 from .paste import EXAMPLES, PASTE, PLASTIC_VISCOSITY
 
@@ -267,7 +267,7 @@ def funnel_study(runs: int = 15, jobs: int = 2, dt: float = 1e-6, settings: dict
         futures = [pool.submit(pour, seed, dt, settings=settings) for seed in range(1, runs + 1)]
         for _ in progress_bar(finished_in_turn(futures), total=runs, desc="pours", unit="run", disable=not progress):
             pass
-        return FunnelStudy(results_of(futures), settings, dt)
+        return FunnelStudy([future.result() for future in futures], settings, dt)
 
 
 @dataclass
