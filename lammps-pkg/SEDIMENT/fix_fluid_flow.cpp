@@ -217,6 +217,7 @@ void FixFluidFlow::init()
     int buffer = 0;
     fft = sediment_make_fft3d(lmp, world, grid[0], grid[1], nzt, 0, grid[0] - 1, 0, grid[1] - 1, plane_lo, plane_hi,
                               &buffer);
+    if (comm->me == 0) report_settings();
   }
   measure_self_flow();
   if (!solved) {    // until the first solve, the fluid's uniform velocity
@@ -225,6 +226,30 @@ void FixFluidFlow::init()
       for (int c = 0; c < 3; ++c) velocity[i][c] = u[c];
     std::copy_n(u, 3, solved_uniform);
   }
+}
+
+// What the keywords and their defaults made of the solve, once, as PPPM reports its grid: a user sees
+// the transform's size (its cost), whether the flow uniform across is held and when the fix solves.
+void FixFluidFlow::report_settings() const
+{
+  std::string text = fmt::format("fix {} fluid/flow: {} x {} x {} cells of {:.4g} m", id, grid[0], grid[1], grid[2],
+                                 spacing[0]);
+  if (column)
+    text += fmt::format(" over the closed column z = {:.6g} to {:.6g} m (transformed with its mirror image: {} planes)",
+                        column_lo, column_hi, nzt);
+  else
+    text += " over the periodic box";
+  text += stokes.vessel_across ? "\n  the flow uniform across held at rest (across vessel)"
+                               : "\n  the flow uniform across solved as in a periodic array (across periodic)";
+  if (drift_limit > 0.0)
+    text += fmt::format("; a solve once the spheres have drifted {:.3g} cells", drift_limit);
+  else
+    text += fmt::format("; a solve every {} steps", nevery);
+  if (stokes.brinkman > 0.0) text += fmt::format("; Brinkman resistance {:.6g}", stokes.brinkman);
+  if (relax < 1.0) text += fmt::format("; relaxed by {:.3g}", relax);
+  if (!weight_name.empty())
+    text += fmt::format("\n  parcels of d_{} grains each, stratification {}", weight_name, stratify ? "grains" : "parcels");
+  utils::logmesg(lmp, text + "\n");
 }
 
 void FixFluidFlow::setup(int /*vflag*/)

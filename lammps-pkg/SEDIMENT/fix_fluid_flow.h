@@ -159,6 +159,7 @@ class FixFluidFlow : public Fix {
   bool outside_column(const double *x) const;
   bool left_out(int i) const;
   bool fluid_changed() const;
+  void report_settings() const;
   double largest_speed() const;
   void check_stable(const double *change);
   void check_carry(double peak);

@@ -171,8 +171,16 @@ print "RESULT ux $(c_ux:%.17g)"
     with tempfile.TemporaryDirectory() as tmp:
         path = Path(tmp) / "sheet.lmp"
         path.write_text(deck)
-        ux = {mode: run_deck(path, {"across": mode}, np_ranks, cwd=Path(tmp)).results["ux"]
-              for mode in ("periodic", "default", "vessel")}
+        outputs = {mode: run_deck(path, {"across": mode}, np_ranks, cwd=Path(tmp))
+                   for mode in ("periodic", "default", "vessel")}
+    ux = {mode: out.results["ux"] for mode, out in outputs.items()}
+    # the log says which the fix solved, as the keyword or the column's default made it (once a run)
+    for mode, held in (("periodic", False), ("default", True), ("vessel", True)):
+        said = re.findall(r"fix flow fluid/flow: 8 x 8 x 128 cells of 0\.00025 m over the closed column z = 0 to "
+                          r"0\.032 m \(transformed with its mirror image: 256 planes\)\n  the flow uniform across "
+                          r"(held at rest \(across vessel\)|solved as in a periodic array \(across periodic\)); "
+                          r"a solve every 1 steps", outputs[mode].text)
+        assert said == ["held at rest (across vessel)" if held else "solved as in a periodic array (across periodic)"]
     report(f"fluid at the sheet: across periodic {ux['periodic']:.5g} m/s (expected {expected:.5g}), a column's "
            f"default {ux['default']:.2g} m/s, across vessel {ux['vessel']:.2g} m/s")
     assert ux["periodic"] == pytest.approx(expected, rel=0.02)
