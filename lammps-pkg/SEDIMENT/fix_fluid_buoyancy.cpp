@@ -82,17 +82,7 @@ void FixFluidBuoyancy::init()
   fluid = FixFluid::find(lmp, fluid_id, "Fix fluid/buoyancy");
 
   const std::string caller = "Fix fluid/buoyancy";
-  Fix *gravity_fix = nullptr;
-  if (gravity_id) {
-    gravity_fix = sediment_find_fix<Fix>(lmp, gravity_id, "gravity", caller, "gravity");
-  } else {
-    const auto gravities = sediment_fixes_of_style(lmp, "gravity");
-    if (gravities.size() > 1)
-      error->all(FLERR, "Fix fluid/buoyancy: several fix gravity are defined; choose one with keyword 'gravity'");
-    if (gravities.empty())
-      error->all(FLERR, "Fix fluid/buoyancy needs a fix gravity to know the direction and strength of gravity");
-    gravity_fix = gravities.front();
-  }
+  gravity = sediment_find_gravity(lmp, gravity_id, caller, "choose one with keyword 'gravity'");
   mixture = mixture_id ? ComputeConcentrationGrid::find_fraction(lmp, mixture_id, caller) : nullptr;
   // Two fixes of one fluid on the same atom would add its buoyancy twice.
   for (Fix *other : sediment_fixes_of_style(lmp, "fluid/buoyancy")) {
@@ -106,9 +96,6 @@ void FixFluidBuoyancy::init()
                  "{} and {}): it would count twice; give each atom one", id, other->id, fluid_id, both_all,
                  group->names[igroup], group->names[other->igroup]);
   }
-  int dim = 0;
-  gravity = static_cast<double *>(gravity_fix->extract("gvec", dim));
-  if (!gravity) error->all(FLERR, "Fix fluid/buoyancy: fix gravity does not expose its vector");
   if (!fluid->fills_space()) warn_of_bobbing();
 }
 

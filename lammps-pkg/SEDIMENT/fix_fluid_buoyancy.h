@@ -35,7 +35,7 @@ class FixFluidBuoyancy : public Fix {
   double solid_density;         // density of the suspended solids, for the mixture density
   double max_fraction;          // the local solid fraction is capped here
   class FixFluid *fluid;
-  double *gravity;            // acceleration vector owned by the fix gravity
+  const double *gravity;      // acceleration vector owned by the fix gravity
   RankSums<4> totals;         // force on the group (3) and number of spheres in the fluid
 };
 

@@ -51,7 +51,7 @@ static inline int wrap(int i, int n)
 
 FixFluidFlow::FixFluidFlow(LAMMPS *lmp, int narg, char **arg) :
     Fix(lmp, narg, arg), fluid_id(nullptr), fluid(nullptr), nzt(0), column(false), column_lo(0.0), column_hi(0.0),
-    relax(1.0), weight_index(-1), stratify(false), excess(nullptr), displaced_time(0.0), solve_interval(0.0), lowest_class(0), excess_in_file(false), drift_limit(0.0), drift(0.0), solved_speed(0.0), unsettled(false), solved_viscosity(0.0), velocity(nullptr), solved(false), fft(nullptr),
+    relax(1.0), weight_index(-1), stratify(false), excess(nullptr), gravity(nullptr), displaced_time(0.0), solve_interval(0.0), lowest_class(0), excess_in_file(false), drift_limit(0.0), drift(0.0), solved_speed(0.0), unsettled(false), solved_viscosity(0.0), velocity(nullptr), solved(false), fft(nullptr),
     plane_lo(0), plane_hi(-1), last_solve(-1), warned_carry(false), carries(0), carry_start(0.0), reversals(0), reversal_growth(1.0)
 {
   if (narg < 8 || strcmp(arg[4], "grid") != 0)
@@ -185,6 +185,9 @@ void FixFluidFlow::init()
                fluid_id);
   stokes.viscosity = fluid->properties().viscosity;
   if (!weight_name.empty()) weight_index = sediment_find_weights(lmp, weight_name, groupbit, "Fix fluid/flow");
+  if (stratify)
+    gravity = sediment_find_gravity(lmp, nullptr, "Fix fluid/flow with 'stratification grains'",
+                                    "it weighs the grains with the deck's only one");
 
   // The grid: cubic cells over the periodic box in x and y and the box or the column in z.
   for (int d = 0; d < 3; ++d) {
@@ -470,15 +473,19 @@ void FixFluidFlow::stratification_force()
   lowest_class = span[0];
   const int count = span[0] <= -span[1] ? -span[1] - span[0] + 1 : 0;
   class_force.assign(count, 0.0);
-  // Each class's mean missing force per sphere: the force of a grain settling at its terminal slip,
-  // its weight less its buoyancy, is the same everywhere in the class; a sphere's own drag at a step
-  // is not (at each solve the fluid's velocity at it jumps), and with it the excess's force would
-  // follow the flow it drives within the step, and run away where the flow carries spheres a cell.
+  // Each class's mean missing force per sphere. A grain settling at its terminal slip puts its weight
+  // less its buoyancy on the fluid, which that sets, not its drag at the step: at each solve the fluid's
+  // velocity at a sphere jumps, and a sphere entering a denser layer (the bed's top) has a drag many
+  // times its weight until its speed has followed its hindrance. A force that followed the drags would
+  // follow the flow it drives within the step, or jump with one sphere of a sparse class.
+  const double density = fluid->properties().density;
   std::vector<double> local(2 * static_cast<size_t>(count), 0.0), mean(local.size());
   std::vector<double> missing_force(spheres.size(), 0.0);
   for (size_t s = 0; s < spheres.size(); ++s) {
     if (classes[s] == std::numeric_limits<int>::min()) continue;
-    missing_force[s] = (weight[spheres[s]] / scales[s] - 1.0) * forces[3 * s + 2];    // forces hold sqrt(w S(0)) grains'
+    const int i = spheres[s];
+    const double r = atom->radius[i], buoyant_mass = atom->rmass[i] - density * 4.0 / 3.0 * MY_PI * r * r * r;
+    missing_force[s] = (weight[i] - scales[s]) * buoyant_mass * gravity[2];    // scales: sqrt(w S(0)) grains' own
     local[2 * (classes[s] - lowest_class)] += missing_force[s];
     local[2 * (classes[s] - lowest_class) + 1] += 1.0;
   }

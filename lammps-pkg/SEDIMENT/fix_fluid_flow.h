@@ -73,6 +73,7 @@ class FixFluidFlow : public Fix {
   // the real grains' force (w per parcel), not the parcels' sqrt(w S(0)) (stratification_force)
   bool stratify;
   double *excess;             // per atom: its class's density where it is over the class's mean there, less 1
+  const double *gravity;      // stratification grains: fix gravity's acceleration (the grains' weight)
   double displaced_time;      // the time up to which excess is summed
   double solve_interval;      // the time between the last two solves
   int lowest_class;           // the settling class of profiles' first row (settling_class())

@@ -172,6 +172,26 @@ T *sediment_find_fix(LAMMPS *lmp, const char *id, const char *style, const std::
   return typed;
 }
 
+// The acceleration vector of fix gravity `id`, or of the deck's only fix gravity when `id` is null;
+// `caller` names the style asking and `choose` tells how to choose among several.
+inline const double *sediment_find_gravity(LAMMPS *lmp, const char *id, const std::string &caller, const char *choose)
+{
+  Fix *fix = nullptr;
+  if (id) {
+    fix = sediment_find_fix<Fix>(lmp, id, "gravity", caller, "gravity");
+  } else {
+    const auto gravities = sediment_fixes_of_style(lmp, "gravity");
+    if (gravities.size() > 1) lmp->error->all(FLERR, "{}: several fix gravity are defined; {}", caller, choose);
+    if (gravities.empty())
+      lmp->error->all(FLERR, "{} needs a fix gravity to know the direction and strength of gravity", caller);
+    fix = gravities.front();
+  }
+  int dim = 0;
+  const auto *gravity = static_cast<const double *>(fix->extract("gvec", dim));
+  if (!gravity) lmp->error->all(FLERR, "{}: fix gravity does not expose its vector", caller);
+  return gravity;
+}
+
 // Compute `id` (a leading "c_" is dropped); `caller` names the style asking.
 inline Compute *sediment_find_compute(LAMMPS *lmp, const char *id, const std::string &caller)
 {

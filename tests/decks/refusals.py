@@ -130,6 +130,8 @@ print "RESULT atoms $(atoms) outside $(f_step[3])"
 OUT_OF_RANGE = "is out of range"
 ONE_SPHERE = "create_atoms 1 single 0.5 0.5 0.5\nset atom 1 diameter 1e-3 density 2500\n"
 FLOW = "fix f all fluid density 1000 viscosity 1e-3\nfix d all fluid/drag f law stokes\n"
+STRATIFIED_FLOW = ("fix w all property/atom d_w\nfix u all fluid/flow f grid 8 8 8 column 0 1 weight d_w "
+                   "stratification grains\nrun 0")
 BAD_INPUT = [
     ("fix f all fluid density -1 viscosity 1e-3", "density must be finite and > 0"),
     ("fix f all fluid density 1e400 viscosity 1e-3", ("density must be finite and > 0", OUT_OF_RANGE)),
@@ -251,6 +253,10 @@ BAD_INPUT = [
     (FLOW + "fix u all fluid/flow f grid 8 8 8 across", "Fix fluid/flow: keyword 'across' needs vessel or periodic"),
     (FLOW + "fix w all property/atom d_w\nfix u all fluid/flow f grid 8 8 8 weight d_w stratification grains",
      "Fix fluid/flow: 'stratification grains' is for parcels (keyword weight) in a closed column"),
+    ("unfix grav\nchange_box all boundary p p f\n" + FLOW + STRATIFIED_FLOW,
+     "Fix fluid/flow with 'stratification grains' needs a fix gravity"),
+    ("fix tilt all gravity 1 vector 1 0 0\nchange_box all boundary p p f\n" + FLOW + STRATIFIED_FLOW,
+     "Fix fluid/flow with 'stratification grains': several fix gravity are defined"),
     ("fix f all fluid density 1000 viscosity -1e-3\nfix u all fluid/flow f grid 8 8 8", "Fix fluid: viscosity must be finite and > 0"),
     ("fix u all fluid/flow water grid 8 8 8\nrun 0", "Fix fluid/flow: fluid fix 'water' does not exist"),
     ("fix f all fluid density 1000 viscosity 1e-3\nfix u all fluid/flow f grid 8 8 8\nrun 0",
