@@ -17,7 +17,7 @@ from sediment.lab.psd import read_psd
 from sediment.planner.flow import FlowMeasurement, coarser_cells, measure_flow
 from sediment.planner.screening import SedimentationTest
 from sediment.sim import scene as sc
-from sediment.sim.scenefiles import write
+from sediment.sim.scenefiles import STRATIFICATION, write
 
 REPO = Path(__file__).resolve().parents[2]
 SAMPLE2 = REPO / "examples" / "granulometry" / "psd" / "sample2.csv"
@@ -124,10 +124,13 @@ def test_the_deck_runs_the_flow_or_its_one_way_twin(column, tmp_path):
     across, tall = column.flow_grid()
     assert "variable        flow index yes" in deck
     assert (f'if "${{flow}} == yes" then "fix             flow all fluid/flow water grid {across} {across} {tall} '
-            f'column 0 {column.height:.12g} weight d_weight"') in deck
+            f'column 0 {column.height:.12g} weight d_weight stratification ${{stratification}}"') in deck
+    assert f"variable        stratification index {STRATIFICATION} " in deck
     assert "fix             surface all wall/reflect zhi EDGE" in deck
     typo = run_batch(tmp_path / "in.sedimentation", {"flow": "yse"}, check=False)
     assert typo.returncode == 2 and "variable flow must be yes or no, not yse" in typo.text
+    typo = run_batch(tmp_path / "in.sedimentation", {"stratification": "grain"}, check=False)
+    assert typo.returncode == 2 and "variable stratification must be parcels or grains, not grain" in typo.text
     assert "fluid/flow" not in (write(sc.plan(read_psd(SAMPLE2)), tmp_path / "one") and
                                 (tmp_path / "one" / "in.sedimentation").read_text())
 

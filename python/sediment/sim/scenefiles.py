@@ -18,6 +18,9 @@ from .scene import LOAD_CONCENTRATION, OVERLAP_TOLERANCE, POISSON_RATIO, RESTART
 
 
 SAMPLE_FILES = ("sample.data", "in.sedimentation", "input_psd.csv", "simulated_psd.csv", "classes.csv")
+# A two-way column of parcels: how its displaced stratification pushes back, the deck's default
+# (`-var stratification grains|parcels`; fix fluid/flow, docs/effects.md section 3)
+STRATIFICATION = "parcels"
 
 
 def write(scene: Scene, out: Path, layer_file: str = "layers.h5", force: bool = False) -> list[Path]:
@@ -155,11 +158,17 @@ def _deck(scene: Scene, data: str, layer_file: str) -> str:
         "variable        restart_file index restart.a.bin",
         "variable        timing index no     # yes: LAMMPS's timing breakdown after each stage (where the time goes)",
     ]
+    parcels = e.flow and not np.all(scene.weight == 1)
     if e.flow:
         lines += ["variable        flow index yes      # no: the one-way twin of this scene (the same grains, steps and "
                   "frames; the fluid at rest)",
                   'if "${flow} != yes && ${flow} != no" then &',
                   '  "print \'ERROR: variable flow must be yes or no, not ${flow}\'" "quit 2"']
+    if parcels:
+        lines += [f"variable        stratification index {STRATIFICATION}    # grains: the displaced stratification "
+                  "pushes back with its real grains' force, not the parcels' (fix fluid/flow)",
+                  'if "${stratification} != parcels && ${stratification} != grains" then &',
+                  '  "print \'ERROR: variable stratification must be parcels or grains, not ${stratification}\'" "quit 2"']
     lines += [
         "",
     ]
@@ -193,11 +202,11 @@ def _deck(scene: Scene, data: str, layer_file: str) -> str:
     lines.append(f"fix             drag all fluid/drag water {e.fix_arguments()}")
     if e.flow:
         across, tall = scene.flow_grid()
-        parcels = "" if np.all(scene.weight == 1) else " weight d_weight"
+        weights = " weight d_weight stratification ${stratification}" if parcels else ""
         lines += [f"# the flow the grains drive (two-way coupling): {across} x {across} x {tall} cells over the column, "
                   "closed by free slip at the floor and the surface",
                   f'if "${{flow}} == yes" then "fix             flow all fluid/flow water grid {across} {across} {tall} '
-                  f'column 0 {scene.height:.12g}{parcels}"',
+                  f'column 0 {scene.height:.12g}{weights}"',
                   "fix             surface all wall/reflect zhi EDGE    # the swirls lift fine grains to the surface"]
     if e.interacting:
         lines += pair_lines(scene)
@@ -316,7 +325,10 @@ def describe(scene: Scene) -> str:
         lines.append(f"two-way: fix fluid/flow on {across} x {across} x {tall} cells of "
                      f"{scene.width / across * 1e3:.3g} mm; "
                      f"the start's flow, {scene.flow_speed() * 1e3:.3g} mm/s rms, sets the first step "
-                     f"({scene.flow_time_step():.3g} s); `-var flow no` runs the one-way twin")
+                     f"({scene.flow_time_step():.3g} s); `-var flow no` runs the one-way twin"
+                     + ("" if np.all(scene.weight == 1) else
+                        "; `-var stratification grains|parcels`: the displaced stratification pushes back with "
+                        f"its real grains' force or the parcels' own (default {STRATIFICATION})"))
     first, last = scene.psd.percent_finer[0], scene.psd.percent_finer[-1]
     if first > 0 or last < 100:
         lines.append(f"note: the PSD table runs from {first:g} to {last:g} % finer; the {first + 100 - last:g} % of the "
