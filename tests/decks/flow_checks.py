@@ -266,12 +266,14 @@ def run_with_state(deck: str, np_ranks: int):
 @check
 def flow_runaway(np_ranks: int):
     """A dense scene (6000 spheres of 100 um at 40 % solids, Richardson & Zaki, 9 cells a side) at a
-    step where the flow carries them 3.6 cells between solves (dt 2e-2 s): the density the flow is
+    step where the flow carries them 3.2 cells between solves (dt 2e-2 s): the density the flow is
     solved from jumps, and the flow runs away without reversing (0.040, 0.038, 0.059 m/s, then 0.11
     and 0.36, when LAMMPS loses atoms on 2 ranks: the current LAMMPS reported them at step 6, before
     the tenfold growth over four solves that the fix stopped such runs at). The fix warns at the
-    first such solve and stops the run once a solve carries the spheres across half the box: at
-    step 3 (5.3 cells of 9). Not a result gone wrong, nor atoms lost. At dt 2e-3 s it runs, unwarned.
+    first such solve and stops the run once a solve carries the spheres across half the box, measured
+    (drift) by how far the fastest sphere has moved: warned at step 2 (3.2 cells), stopped at step 4
+    (4.9 cells of 9; by the grid's largest velocity, 5.3 cells at step 3). Not a result gone wrong, nor
+    atoms lost. At dt 2e-3 s it runs, unwarned.
     (At 20 % solids this scene ran away the same way until the drag step took a jump of the fluid's
     velocity whole, DragBlock::relinearize_at_end; it now stays near 0.02 m/s, warned, until the
     flow's 1.7 cells a step lose atoms at step 10.)"""
@@ -288,9 +290,10 @@ print "RESULT peak $(f_flow[5])"
         path = Path(tmp) / "dense.lmp"
         path.write_text(deck)
         out = run_deck(path, {"dt": 2e-2}, np_ranks, expect_failure=True, cwd=Path(tmp))
-        assert re.search(r"WARNING: Fix fluid/flow: the flow carries spheres 3\.\d+ cells between solves", out.text), \
+        assert re.search(r"WARNING: Fix fluid/flow: the flow carries spheres 3\.\d+ cells between solves \(1 steps of 0\.02 / cell "
+                         r"0\.000222, the fastest sphere's path; step 2\)", out.text), \
             out.text[-2000:]
-        assert "more than half the box across (9 cells" in out.text and "step 3)" in out.text, out.error
+        assert "more than half the box across (9 cells" in out.text and "step 4)" in out.text, out.error
         calm = run_deck(path, {"dt": 2e-3}, np_ranks, cwd=Path(tmp))
     report(f"dense scene at dt 2e-2 s: warned, then stopped ({out.error.strip()[:100]}...); at dt 2e-3 s ran "
            f"unwarned, largest fluid velocity {calm.results['peak']:.3g} m/s")
