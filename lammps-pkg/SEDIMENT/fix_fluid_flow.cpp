@@ -492,15 +492,20 @@ void FixFluidFlow::stratification_force()
   MPI_Allreduce(local.data(), mean.data(), static_cast<int>(local.size()), MPI_DOUBLE, MPI_SUM, world);
   const double per_node = 1.0 / (spacing[0] * spacing[1] * spacing[2] * grid[0] * grid[1]);
   std::vector<double> missing(static_cast<size_t>(count) * nz, 0.0);
-  restoring.assign(spheres.size(), 0.0);
+  std::vector<double> own(spheres.size(), 0.0);    // each sphere's own share of its class's profile where it is
+  auto height_of = [&](size_t s) {
+    const double at = std::clamp((x[spheres[s]][2] - origin[2]) / spacing[2] - 0.5, 0.0, nz - 1.0);
+    const int below = std::min(static_cast<int>(at), nz - 2);
+    return std::make_pair(below, at - below);
+  };
   for (size_t s = 0; s < spheres.size(); ++s) {
     if (classes[s] == std::numeric_limits<int>::min() || missing_force[s] == 0.0) continue;
     const int c = classes[s] - lowest_class;
     const double force = class_force[c] = mean[2 * c] / mean[2 * c + 1];
-    restoring[s] = force * excess[spheres[s]];
     int first;
     double w[nodes];
     kernel.weights((x[spheres[s]][2] - origin[2]) / spacing[2] - 0.5, first, w);
+    const auto [below, above] = height_of(s);
     double *q = &missing[static_cast<size_t>(c) * nz];
     for (int a = 0; a < nodes; ++a) {
       int m = first + a;    // reflected at the bottom and the top, as the column's mirror image is
@@ -509,11 +514,26 @@ void FixFluidFlow::stratification_force()
       else if (m >= nz)
         m = 2 * nz - 1 - m;
       q[m] += w[a] * force * per_node;
+      if (m == below || m == below + 1) own[s] += w[a] * force * per_node * (m == below ? 1.0 - above : above);
     }
   }
   profiles.resize(missing.size());
   MPI_Allreduce(missing.data(), profiles.data(), static_cast<int>(missing.size()), MPI_DOUBLE, MPI_SUM, world);
   for (int c = 0; c < count; ++c) sediment::stable_profile(&profiles[static_cast<size_t>(c) * nz], nz);
+  // A sphere's excess is its class's density around it over the class's mean at its height; what it
+  // displaces is the others' share of that mean. A sphere alone at its height (a straggler its class's
+  // front has left) displaces none: with its own share counted, such a parcel hovered on the flow its
+  // own excess drove, 2 mm under the surface of sample 2's column for hours (0.9 mm/s).
+  restoring.assign(spheres.size(), 0.0);
+  for (size_t s = 0; s < spheres.size(); ++s) {
+    if (own[s] == 0.0) continue;
+    const int c = classes[s] - lowest_class;
+    const auto [below, above] = height_of(s);
+    const double *q = &profiles[static_cast<size_t>(c) * nz];
+    const double here = q[below] + above * (q[below + 1] - q[below]);
+    const double others = here != 0.0 ? std::clamp(1.0 - own[s] / here, 0.0, 1.0) : 0.0;
+    restoring[s] = class_force[c] * excess[spheres[s]] * others;
+  }
   // The lagged flow carries the spheres for the time between solves before the profile they displace
   // pushes back; where it pushes back faster than that (a front or a bed, whose real grains restore it
   // within milliseconds), the force would overshoot and grow from solve to solve. The profiles' slopes

@@ -515,9 +515,9 @@ def flow_stratified(np_ranks: int):
     8 x 8 x 32 cells) against 265 parcels of 27 placed independently, 16 configurations each: the flow
     the random start drives is damped as it displaces the stratification, and the variance of the
     spheres' vertical velocity falls from 0.2 s to 1.6 s at a mean rate of 1.67 /s for the grains,
-    1.33 /s for the parcels with `stratification grains` and 0.62 /s with their own forces alone
+    1.31 /s for the parcels with `stratification grains` and 0.62 /s with their own forces alone
     (`parcels`, which give the displaced profile sqrt(27) of 27 grains' force). The ratio of the first
-    two, 0.80, has a standard error of 0.06 (both rates' over the configurations); the band 0.7-1.2
+    two, 0.79, has a standard error of 0.06 (both rates' over the configurations); the band 0.7-1.2
     takes it within that and fails the parcels' own 0.37, the option's force halved (0.66) or its sign
     reversed (-0.72: the flow grows)."""
     d, phi0, top, side, height, w = 2e-5, 0.02, 3e-3, 1e-3, 4e-3, 27
