@@ -523,7 +523,7 @@ void FixFluidFlow::stratification_force()
   // A sphere's excess is its class's density around it over the class's mean at its height; what it
   // displaces is the others' share of that mean. A sphere alone at its height (a straggler its class's
   // front has left) displaces none: with its own share counted, such a parcel hovered on the flow its
-  // own excess drove, 2 mm under the surface of sample 2's column for hours (0.9 mm/s).
+  // own excess drove, 2 mm under the surface of sample 2's column for over an hour (0.9 mm/s).
   restoring.assign(spheres.size(), 0.0);
   for (size_t s = 0; s < spheres.size(); ++s) {
     if (own[s] == 0.0) continue;
@@ -1141,7 +1141,7 @@ void FixFluidFlow::solve()
 // which the fix has measured; with every N, the grid's largest velocity over the steps, which bounds
 // it where the spheres go with their fluid (not a sphere held where the flow pushes it into the free
 // surface, whose flow carries nothing: late in sample 2's column the grid's 88 um/s over 128 steps of
-// a solve made 297 cells, where no sphere had moved a fifth of one).
+// a solve made 297 cells, where the fastest sphere had moved the fifth of one that drift allows).
 void FixFluidFlow::check_carry(double peak)
 {
   const bigint steps = std::max<bigint>(1, update->ntimestep - last_solve);
