@@ -315,14 +315,23 @@ void FixFluidFlow::displace()
     // as dense as the fluid, or of a class new since the last solve
     if (key == std::numeric_limits<int>::min() || key < lowest_class || key - lowest_class >= classes) continue;
     const int c = key - lowest_class;
-    const double at = std::clamp((x[i][2] - origin[2]) / spacing[2] - 0.5, 0.0, nz - 1.0);
-    const int below = std::min(static_cast<int>(at), nz - 2);
+    const auto [below, above] = profile_place(x[i][2]);
     // the sphere's own force, m_c |Q'/Q| per displacement, drives s (self-flow) per force: gain 0.5 at most
     const double own = std::abs(class_force[c]) * self_flow[2] * solve_interval;
-    excess[i] = sediment::carried_excess(excess[i], &profiles[static_cast<size_t>(c) * nz], nz, spacing[2], at,
+    excess[i] = sediment::carried_excess(excess[i], &profiles[static_cast<size_t>(c) * nz], nz, spacing[2], below + above,
                                          slope_share[below], own > 0.0 ? 0.5 / own : HUGE_VAL,
                                          (velocity[i][2] - solved_uniform[2]) * elapsed);
   }
+}
+
+// Where height z lies on the classes' profiles (nodes at cell centres): the node below it and how far
+// up to the next, clamped to the column's first and last nodes.
+std::pair<int, double> FixFluidFlow::profile_place(double z) const
+{
+  const int nz = grid[2];
+  const double at = std::clamp((z - origin[2]) / spacing[2] - 0.5, 0.0, nz - 1.0);
+  const int below = std::min(static_cast<int>(at), nz - 2);
+  return {below, at - below};
 }
 
 // A sphere's settling class for stratification grains: its Stokes speed's scale d^2 (rho_p - rho_f) to a
@@ -493,11 +502,6 @@ void FixFluidFlow::stratification_force()
   const double per_node = 1.0 / (spacing[0] * spacing[1] * spacing[2] * grid[0] * grid[1]);
   std::vector<double> missing(static_cast<size_t>(count) * nz, 0.0);
   std::vector<double> own(spheres.size(), 0.0);    // each sphere's own share of its class's profile where it is
-  auto height_of = [&](size_t s) {
-    const double at = std::clamp((x[spheres[s]][2] - origin[2]) / spacing[2] - 0.5, 0.0, nz - 1.0);
-    const int below = std::min(static_cast<int>(at), nz - 2);
-    return std::make_pair(below, at - below);
-  };
   for (size_t s = 0; s < spheres.size(); ++s) {
     if (classes[s] == std::numeric_limits<int>::min() || missing_force[s] == 0.0) continue;
     const int c = classes[s] - lowest_class;
@@ -505,7 +509,7 @@ void FixFluidFlow::stratification_force()
     int first;
     double w[nodes];
     kernel.weights((x[spheres[s]][2] - origin[2]) / spacing[2] - 0.5, first, w);
-    const auto [below, above] = height_of(s);
+    const auto [below, above] = profile_place(x[spheres[s]][2]);
     double *q = &missing[static_cast<size_t>(c) * nz];
     for (int a = 0; a < nodes; ++a) {
       int m = first + a;    // reflected at the bottom and the top, as the column's mirror image is
@@ -528,7 +532,7 @@ void FixFluidFlow::stratification_force()
   for (size_t s = 0; s < spheres.size(); ++s) {
     if (own[s] == 0.0) continue;
     const int c = classes[s] - lowest_class;
-    const auto [below, above] = height_of(s);
+    const auto [below, above] = profile_place(x[spheres[s]][2]);
     const double *q = &profiles[static_cast<size_t>(c) * nz];
     const double here = q[below] + above * (q[below + 1] - q[below]);
     const double others = here != 0.0 ? std::clamp(1.0 - own[s] / here, 0.0, 1.0) : 0.0;

@@ -23,6 +23,7 @@ FixStyle(fluid/flow,FixFluidFlow);
 #include "sediment/flow.hpp"
 
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace LAMMPS_NS {
@@ -184,6 +185,7 @@ class FixFluidFlow : public Fix {
   void weigh_forces();
   void displace();
   void stratification_force();
+  std::pair<int, double> profile_place(double z) const;
   int settling_class(int i) const;
   void share_slopes();
   double sphere_force(int i, double *force) const;
