@@ -528,3 +528,19 @@ for _i, (_cmd, _args, _words, _why) in enumerate(SMALL):
     _slow = _cmd in ("paste", "sweep") and "funnel" not in _args and "restitution" not in _args
     add(f"{_cmd}/value-{_i:02d}-{_why.replace(' ', '-')}", _cmd, "value",
         opt_case(_args, _words, timeout=30 if _slow else 8), quick=not _slow)
+
+
+def stratification_typo(ctx: Ctx):
+    """A two-way sample's deck run with its stratification variable misspelt: refused before any step,
+    no layer file left behind."""
+    out = ctx.tmp / "out"
+    written = sed("sample", PSD, "--two-way", *TINY, "--out", out, timeout=60)
+    if written.rc != 0:
+        return "wrong", f"sample --two-way failed: {written.last}"
+    done = sed("run", out / "in.sedimentation", "--var", "stratification", "grain", timeout=60)
+    if any(out.glob("layers.h5*")):
+        return "wrong", f"refused, but a layer file was left: {sorted(p.name for p in out.glob('layers.h5*'))}"
+    return refusal(done, [("stratification",), ("grain",), ("parcels or grains",)])
+
+
+add("run/value-two-way-stratification-misspelt", "run", "value", stratification_typo, quick=True)
