@@ -56,6 +56,8 @@ class FixFluidDrag : public Fix {
   // c when the drag of a wholly immersed sphere of diameter d is F = c d w, else 0.
   double linear_per_diameter() const { return model->linear_coefficient(1.0); }
   const sediment::DragModel *drag_model() const { return model.get(); }
+  // True when the hindrance reads a concentration compute's local fractions.
+  bool reads_concentration() const { return concentration_id != nullptr; }
   // The drag on local atom i of the group when uniform(): its diameter and local fraction only.
   sediment::SphereDrag immersed_drag(int i) const { return immersed().drag(i); }
   // immersed_drag() with the per-atom arrays taken once, for an integrator's per-atom loop (inline

@@ -33,6 +33,7 @@ class FixFluidFlow : public Fix {
   FixFluidFlow(class LAMMPS *, int, char **);
   ~FixFluidFlow() override;
   int setmask() override;
+  void post_integrate() override;
   void init() override;
   void setup(int) override;
   void end_of_step() override;
@@ -89,6 +90,9 @@ class FixFluidFlow : public Fix {
   sediment::StokesOperator stokes;
   sediment::FlowKernel kernel;
   double **velocity;     // per atom: the fluid velocity its drag is taken against
+  // per atom: the voidage its drag's hindrance read in this step (post_integrate()); < 0: none yet
+  double *stepped_voidage;
+  bool hindered;         // some drag's hindrance reads a concentration
   bool solved;           // velocity holds a solve (or was read from a restart)
   class FFT3d *fft;
   int plane_lo, plane_hi;         // this rank's planes of the transform grid
@@ -189,6 +193,7 @@ class FixFluidFlow : public Fix {
   int settling_class(int i) const;
   void share_slopes();
   double sphere_force(int i, double *force) const;
+  double stepped(int i, double now) const { return stepped_voidage[i] >= 0.0 ? stepped_voidage[i] : now; }
 };
 
 }    // namespace LAMMPS_NS
