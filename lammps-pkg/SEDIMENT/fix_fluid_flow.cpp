@@ -291,7 +291,7 @@ void FixFluidFlow::setup(int /*vflag*/)
   std::fill_n(stepped_voidage, atom->nlocal, -1.0);    // a solve before the first step: the fractions as they are
   floors.clear();
   for (Fix *fix : sediment_fixes_of_style(lmp, "nve/sphere/fluid"))
-    if (auto integrator = static_cast<FixNVESphereFluid *>(fix); integrator->has_floor()) floors.push_back(integrator);
+    if (auto integrator = static_cast<FixNVESphereFluid *>(fix); integrator->has_floor_or_surface()) floors.push_back(integrator);
   if (last_solve < 0) last_solve = update->ntimestep;    // a new fix, or one read from a restart
   displaced_time = sediment_time_now(update);
   if (stratify) share_slopes();    // the box is known (not yet when a restart file gave the profiles)
@@ -1042,6 +1042,13 @@ bool FixFluidFlow::outside_column(const double *x) const
 // against the flow would only resist it, and a deposit's many resist it so stiffly that the lagged
 // flow diverges within a few solves of the first landings; a bed's, capped, hold its spheres to the
 // fluid, which they then stir as a suspension far denser than the bed (docs/physics.md section 8).
+bool FixFluidFlow::held_at_surface(int i) const
+{
+  for (const FixNVESphereFluid *integrator : floors)
+    if (integrator->held_at_surface(i)) return true;
+  return false;
+}
+
 bool FixFluidFlow::left_out(int i) const
 {
   if (outside_column(atom->x[i])) return true;
@@ -1067,6 +1074,15 @@ void FixFluidFlow::solve()
       spheres.push_back(i);
   }
   sphere_forces();
+  // A sphere held at a surface of fix nve/sphere/fluid pushes the surface, which takes the force; it
+  // reads the flow where it is, which keeps it there while the flow presses it up.
+  held.assign(spheres.size(), 0);
+  for (size_t s = 0; s < spheres.size(); ++s)
+    if (held_at_surface(spheres[s])) {
+      held[s] = 1;
+      local[3] += 1.0;
+      for (int c = 0; c < 3; ++c) forces[3 * s + c] = 0.0;
+    }
   stencils.resize(spheres.size());
   for (size_t s = 0; s < spheres.size(); ++s) stencils[s] = stencil_at(x[spheres[s]]);
   build_brick(brick, stencils, true);
@@ -1077,7 +1093,7 @@ void FixFluidFlow::solve()
     place(stencils[s], brick);
     const double *force = &forces[3 * s];
     // the displaced stratification's force is not one the spheres lose (docs/physics.md section 8)
-    const double spreads[3] = {force[0], force[1], force[2] + (stratify ? restoring[s] : 0.0)};
+    const double spreads[3] = {force[0], force[1], force[2] + (stratify && !held[s] ? restoring[s] : 0.0)};
     if (spreads[0] == 0.0 && spreads[1] == 0.0 && spreads[2] == 0.0) continue;
     for (int c = 0; c < 3; ++c) local[c] += force[c];
     spread_point(stencils[s], spreads, spread);
@@ -1228,7 +1244,8 @@ void FixFluidFlow::check_stable(const double *change)
 double FixFluidFlow::compute_vector(int n)
 {
   // force on the fluid (x, y, z), largest |mean u_z| over a plane of nodes, largest |u| component on
-  // the grid, spheres of the group left out (outside the column or on a floor; all of the last solve); solves so far
+  // the grid, spheres of the group whose force was left out (outside the column, on a floor, held under a surface,
+  // capped; all of the last solve); solves so far
   return diag[n];
 }
 

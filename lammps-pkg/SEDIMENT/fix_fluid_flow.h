@@ -63,7 +63,7 @@ class FixFluidFlow : public Fix {
   char *fluid_id;
   class FixFluid *fluid;
   std::vector<class FixFluidDrag *> drags;    // the fluid/drag fixes of this fluid (setup())
-  std::vector<class FixNVESphereFluid *> floors;    // the nve/sphere/fluid fixes with a floor (setup())
+  std::vector<class FixNVESphereFluid *> floors;    // the nve/sphere/fluid fixes with a floor or a surface (setup())
   int grid[3];           // cells of the fluid: x, y, and z of the box (periodic) or of the column
   int nzt;               // planes of the transform: grid[2], or 2 grid[2] with the column's mirror
   bool column;           // closed in z: free slip at column_lo and column_hi
@@ -154,6 +154,7 @@ class FixFluidFlow : public Fix {
   std::vector<int> spheres;
   std::vector<Stencil> stencils;
   std::vector<double> forces, fractions;
+  std::vector<char> held;    // the solve's spheres held at a surface (their force not spread)
   std::vector<double> scales;    // with weight: each force's factor sqrt(w S(0)) (weigh_forces)
   // stratify: per settling class, the mean missing force density of each plane of nodes (made stable;
   // [class][plane]) and the mean missing force per sphere; the share of the sum of their slopes the
@@ -164,6 +165,7 @@ class FixFluidFlow : public Fix {
   void solve();
   bool outside_column(const double *x) const;
   bool left_out(int i) const;
+  bool held_at_surface(int i) const;
   bool fluid_changed() const;
   void report_settings() const;
   double largest_speed() const;

@@ -90,19 +90,26 @@ template <class Loop> static inline void with_floor_or_not(int floor_axis, Loop 
 
 FixNVESphereFluid::FixNVESphereFluid(LAMMPS *lmp, int narg, char **arg) :
     Fix(lmp, narg, arg), weights(nullptr), general(nullptr), drag_memos(nullptr), spin_memos(nullptr), nmax_rows(0), uniform(nullptr),
-    half_step(HalfStep::General), linear_per_diameter(0.0), floor_axis(-1), floor_level(0.0)
+    half_step(HalfStep::General), linear_per_diameter(0.0), floor_axis(-1), floor_level(-HUGE_VAL), surface_level(HUGE_VAL)
 {
   StyleArgs args(lmp, FLERR, "Fix nve/sphere/fluid", narg, arg, 3);
+  bool floor_given = false, surface_given = false;
   while (args.more()) {
-    if (args.is("floor")) {
-      args.need(2, "an axis and a coordinate");
-      if (floor_axis >= 0) args.fail("one floor per fix: a second floor would replace the first, not add to it");
-      floor_axis = args.axis(1, "floor axis");
-      if (floor_axis == 2 && domain->dimension == 2) args.fail("a floor along z in a 2d simulation");
-      floor_level = args.number(2);
-    } else {
-      args.unknown("floor");
-    }
+    const bool floor = args.is("floor");
+    if (!floor && !args.is("surface")) args.unknown("floor or surface");
+    const char *what = floor ? "floor" : "surface";
+    args.need(2, "an axis and a coordinate");
+    if (floor ? floor_given : surface_given)
+      args.fail("one {} per fix: a second {} would replace the first, not add to it", what, what);
+    const int axis = args.axis(1, fmt::format("{} axis", what).c_str());
+    if (axis == 2 && domain->dimension == 2) args.fail("a {} along z in a 2d simulation", what);
+    if (floor_axis >= 0 && axis != floor_axis)
+      args.fail("the floor and the surface lie across one axis, not {} and {}", "xyz"[floor_axis], "xyz"[axis]);
+    floor_axis = axis;
+    (floor ? floor_level : surface_level) = args.number(2);
+    (floor ? floor_given : surface_given) = true;
+    if (!(surface_level > floor_level))
+      args.fail("the surface {} must lie above the floor {}", surface_level, floor_level);
     args.next(2);
   }
   // The per-atom arrays of atom_style sphere (newer LAMMPS has no sphere_flag; fix nve/sphere checks the same).
@@ -150,7 +157,7 @@ void FixNVESphereFluid::init()
 
 void FixNVESphereFluid::setup(int /*vflag*/)
 {
-  if (floor_axis >= 0) check_floor();
+  if (floor_axis >= 0) check_column();
   // After every fix's init(): the drag fixes know their fluid only then.
   uniform = drags.size() == 1 && drags.front()->immersed_everywhere() ? drags.front() : nullptr;
   bool nonlinear = false, set_valued = false;
@@ -180,9 +187,20 @@ void FixNVESphereFluid::setup(int /*vflag*/)
 // A sphere whose centre lies below the floor is lifted onto it at its first step, through the grains
 // above it (and a shrink-wrapped box grown to it). A floor above every sphere of the group (or above
 // the box) is a mistake in the deck, refused naming the lowest sphere; below some of them it is a
-// warning with their count (a scene may drop its grains onto a floor inside them on purpose).
-void FixNVESphereFluid::check_floor()
+// warning with their count (a scene may drop its grains onto a floor inside them on purpose). A
+// sphere reaching above the surface is set under it at its first step, with a warning.
+void FixNVESphereFluid::check_column()
 {
+  if (std::isfinite(surface_level)) {
+    bigint above = 0, all_above;
+    for (int i = 0; i < atom->nlocal; ++i)
+      if ((atom->mask[i] & groupbit) && atom->x[i][floor_axis] + atom->radius[i] > surface_level) ++above;
+    MPI_Allreduce(&above, &all_above, 1, MPI_LMP_BIGINT, MPI_SUM, world);
+    if (all_above > 0 && comm->me == 0)
+      error->warning(FLERR, "Fix nve/sphere/fluid: {} spheres reach above surface {} {}: they are set under it at their "
+                     "first step", all_above, "xyz"[floor_axis], surface_level);
+  }
+  if (!std::isfinite(floor_level)) return;
   double **x = atom->x;
   int *mask = atom->mask;
   const double none = std::numeric_limits<double>::max();
@@ -215,22 +233,30 @@ void FixNVESphereFluid::check_floor()
 
 // A perfectly inelastic floor without a bed: a sphere reaching it stops with its lowest point on
 // it, and stays while the forces press it down (only the settling is resolved, not the deposit).
-// Taken at the end of each atom's half step, with the floor (axis >= 0, level) in locals the
-// compiler keeps in registers. A NaN position or velocity is left as it is, not put on the floor at
-// rest, for the check to find.
-static inline void settle_on_floor(double *x, double *v, double *omega, double radius, int axis, double level)
+// The free surface likewise: a sphere the flow carries into it stops with its highest point on it,
+// and stays while the flow and its buoyancy press it up (a submerged grain cannot leave the water; a
+// sphere turned back by fix wall/reflect took the reflection of its velocity into the next drag,
+// and spread on the fluid a drag it never felt). Taken at the end of each atom's half step, with the
+// floor and the surface (axis >= 0, -inf and +inf where not given) in locals the compiler keeps in
+// registers. A NaN position or velocity is left as it is, not put at rest, for the check to find.
+static inline void settle_in_column(double *x, double *v, double *omega, double radius, int axis, double floor,
+                                    double surface)
 {
-  const double rest = level + radius;
-  if (!(x[axis] < rest || (x[axis] == rest && v[axis] <= 0.0))) return;
-  x[axis] = rest;
+  const double rest = floor + radius, held = surface - radius;
+  if (x[axis] < rest || (x[axis] == rest && v[axis] <= 0.0))
+    x[axis] = rest;
+  else if (x[axis] > held || (x[axis] == held && v[axis] >= 0.0))
+    x[axis] = held;
+  else
+    return;
   v[0] = v[1] = v[2] = 0.0;
   omega[0] = omega[1] = omega[2] = 0.0;
 }
 
 // At rest on the floor, pressed onto it or not pushed at all, with nothing that moves it along the
 // floor (force or flow): under a drag law without set-valued points (linear or smooth) the step
-// would take it into the floor and settle_on_floor would put it back where it was, at rest, its
-// rotation stopped; the second half would add a velocity into the floor that settle_on_floor takes
+// would take it into the floor and settle_in_column would put it back where it was, at rest, its
+// rotation stopped; the second half would add a velocity into the floor that settle_in_column takes
 // away again. So the step is the identity, bit for bit. Inline, on the arrays the step has loaded:
 // most grains of a finished test rest, and this runs for every grain and step.
 static inline bool rests_on_floor(const double *x, const double *v, const double *f, double radius,
@@ -244,7 +270,7 @@ static inline bool rests_on_floor(const double *x, const double *v, const double
 }
 
 // A sphere that rests_on_floor held there: no weights for the second half (nor the torque's: a
-// uniform step's second half gives it fix nve/sphere's, and settle_on_floor takes the rotation away
+// uniform step's second half gives it fix nve/sphere's, and settle_in_column takes the rotation away
 // again, as the sphere's velocity stays 0), left where it is with its rotation stopped. Returns its
 // state_sum (its position along the floor is not among what the test reads).
 static inline double hold_on_floor(double *weights, double *x, double *v, double *omega, double radius, int axis,
@@ -252,7 +278,7 @@ static inline double hold_on_floor(double *weights, double *x, double *v, double
 {
   std::fill(weights, weights + sediment::PACKED_WEIGHTS_SIZE, 0.0);
   const double state = state_sum(x, v);
-  settle_on_floor(x, v, omega, radius, axis, level);
+  settle_in_column(x, v, omega, radius, axis, level, HUGE_VAL);
   return state;
 }
 
@@ -265,7 +291,7 @@ void FixNVESphereFluid::first_half(Lookup lookup)
   const auto drag_memo_rows = flat_rows<sediment::PHI_MEMO_SIZE>(drag_memos);
   const auto spin_memo_rows = flat_rows<sediment::PHI_MEMO_SIZE>(spin_memos);
   const int floor_dim = floor_axis;    // locals: the stores into the atom arrays cannot change them
-  const double floor_at = floor_level;
+  const double floor_at = floor_level, surface_at = surface_level;
   const double dt = update->dt;
   const double ftm2v = force->ftm2v;
   const HalfKick kick = sediment::half_kick(dt, ftm2v);
@@ -300,7 +326,7 @@ void FixNVESphereFluid::first_half(Lookup lookup)
     }
     if constexpr (keeps_all) general_rows[i][SPIN] = spin;
     if constexpr (keeps_weights) sediment::pack_weights(corr, per_mass, weight_rows[i]);
-    if (on_floor) settle_on_floor(x[i], v[i], omega[i], radius[i], floor_dim, floor_at);
+    if (on_floor) settle_in_column(x[i], v[i], omega[i], radius[i], floor_dim, floor_at, surface_at);
     return state;
   };
 
@@ -359,7 +385,7 @@ void FixNVESphereFluid::first_half(Lookup lookup)
     if (!sphere.model) {
       counts[OUTSIDE] += 1.0;
       state += nve_sphere_kick_drift(x[i], v[i], omega[i], f[i], torque[i], radius[i], rmass[i], kick, dt);
-      if (on_floor) settle_on_floor(x[i], v[i], omega[i], radius[i], floor_dim, floor_at);
+      if (on_floor) settle_in_column(x[i], v[i], omega[i], radius[i], floor_dim, floor_at, surface_at);
       continue;
     }
 
@@ -425,7 +451,7 @@ template <bool on_floor> void FixNVESphereFluid::first_half_immersed()
   static const double no_flow[3] = {0.0, 0.0, 0.0};
   const double *flow = flow_rows ? no_flow : uniform->fluid_fix()->velocity();
   const int floor_dim = floor_axis;
-  const double floor_at = floor_level;
+  const double floor_at = floor_level, surface_at = surface_level;
   const double dt = update->dt;
   const HalfKick kick = sediment::half_kick(dt, force->ftm2v);
 
@@ -440,7 +466,7 @@ template <bool on_floor> void FixNVESphereFluid::first_half_immersed()
     if constexpr (on_floor)
       for (int n = 0; n < size; ++n) {
         const int i = waiting[n];
-        settle_on_floor(x[i], v[i], omega[i], radius[i], floor_dim, floor_at);
+        settle_in_column(x[i], v[i], omega[i], radius[i], floor_dim, floor_at, surface_at);
       }
     size = 0;
   };
@@ -449,7 +475,7 @@ template <bool on_floor> void FixNVESphereFluid::first_half_immersed()
     if (!(mask[i] & drag_bit)) {
       ++outside;
       state += nve_sphere_kick_drift(x[i], v[i], omega[i], f[i], torque[i], radius[i], rmass[i], kick, dt);
-      if constexpr (on_floor) settle_on_floor(x[i], v[i], omega[i], radius[i], floor_dim, floor_at);
+      if constexpr (on_floor) settle_in_column(x[i], v[i], omega[i], radius[i], floor_dim, floor_at, surface_at);
       continue;
     }
     if (immersed.capped(i)) ++capped;
@@ -496,7 +522,7 @@ void FixNVESphereFluid::initial_integrate(int /*vflag*/)
   if (drags.empty()) {    // every fluid effect off: fix nve/sphere's step, no per-atom bookkeeping
     const auto [x, v, f, omega, torque, radius, rmass, mask, nlocal] = sphere_arrays(atom);
     const int floor_dim = floor_axis;
-    const double floor_at = floor_level;
+    const double floor_at = floor_level, surface_at = surface_level;
     const double dt = update->dt;
     const HalfKick kick = sediment::half_kick(dt, force->ftm2v);
     int outside = 0;    // local sums: a store into the fix would alias the atom arrays
@@ -506,7 +532,7 @@ void FixNVESphereFluid::initial_integrate(int /*vflag*/)
         if (mask[i] & groupbit) {
           state += nve_sphere_kick_drift(x[i], v[i], omega[i], f[i], torque[i], radius[i], rmass[i], kick, dt);
           if constexpr (decltype(with_floor)::value)
-            settle_on_floor(x[i], v[i], omega[i], radius[i], floor_dim, floor_at);
+            settle_in_column(x[i], v[i], omega[i], radius[i], floor_dim, floor_at, surface_at);
           ++outside;
         }
     });
@@ -566,7 +592,7 @@ void FixNVESphereFluid::final_integrate()
   const auto general_rows = flat_rows<NGENERAL>(general);
   const auto drag_memo_rows = flat_rows<sediment::PHI_MEMO_SIZE>(drag_memos);
   const int floor_dim = floor_axis;
-  const double floor_at = floor_level;
+  const double floor_at = floor_level, surface_at = surface_level;
   const double ftm2v = force->ftm2v;
 
   const HalfKick kick = sediment::half_kick(update->dt, ftm2v);
@@ -576,7 +602,7 @@ void FixNVESphereFluid::final_integrate()
         if (mask[i] & groupbit) {
           nve_sphere_kick(v[i], omega[i], f[i], torque[i], radius[i], rmass[i], kick);
           if constexpr (decltype(with_floor)::value)
-            settle_on_floor(x[i], v[i], omega[i], radius[i], floor_dim, floor_at);
+            settle_in_column(x[i], v[i], omega[i], radius[i], floor_dim, floor_at, surface_at);
         }
     });
     return;
@@ -617,12 +643,12 @@ void FixNVESphereFluid::final_integrate()
             sediment::drag_step_final_rows(rows, first, count, kick);
             if constexpr (on_floor)
               for (int i = first; i < first + count; ++i)
-                settle_on_floor(x[i], v[i], omega[i], radius[i], floor_dim, floor_at);
+                settle_in_column(x[i], v[i], omega[i], radius[i], floor_dim, floor_at, surface_at);
           },
           [&](int i) {
             if (!(mask[i] & groupbit)) return;
             nve_sphere_kick(v[i], omega[i], f[i], torque[i], radius[i], rmass[i], kick);
-            if constexpr (on_floor) settle_on_floor(x[i], v[i], omega[i], radius[i], floor_dim, floor_at);
+            if constexpr (on_floor) settle_in_column(x[i], v[i], omega[i], radius[i], floor_dim, floor_at, surface_at);
           });
     });
     return;
@@ -643,7 +669,7 @@ void FixNVESphereFluid::final_integrate()
         omega[i][2] += spin * torque[i][2];
       }
       if constexpr (decltype(with_floor)::value)
-        settle_on_floor(x[i], v[i], omega[i], radius[i], floor_dim, floor_at);
+        settle_in_column(x[i], v[i], omega[i], radius[i], floor_dim, floor_at, surface_at);
     }
   });
 }
@@ -668,6 +694,13 @@ void FixNVESphereFluid::find_non_finite() const
                "(x {} {} {}, v {} {} {}, f {} {} {}); check the forces acting on it and the timestep",
                atom->tag[i], update->ntimestep, x[0], x[1], x[2], v[0], v[1], v[2], f[0], f[1], f[2]);
   }
+}
+
+// Only the surface puts a sphere exactly there, and only when the step carried it into the surface: the
+// second half may then have given it the new force's velocity, away from the surface (its weight).
+bool FixNVESphereFluid::held_at_surface(int i) const
+{
+  return floor_axis >= 0 && (atom->mask[i] & groupbit) && atom->x[i][floor_axis] == surface_level - atom->radius[i];
 }
 
 bool FixNVESphereFluid::at_rest_on_floor(int i) const

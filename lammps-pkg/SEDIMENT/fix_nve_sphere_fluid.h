@@ -43,7 +43,10 @@ class FixNVESphereFluid : public Fix {
   // Whether sphere i lies stopped on this fix's floor (its lowest point on it, at rest): part of the
   // deposit, which fix fluid/flow leaves out of the fluid it resolves.
   bool at_rest_on_floor(int i) const;
-  bool has_floor() const { return floor_axis >= 0; }
+  // Whether sphere i is held at this fix's surface (its highest point on it), carried into it this step:
+  // fix fluid/flow spreads no force of its (the surface holds it) and gives it the flow where it is.
+  bool held_at_surface(int i) const;
+  bool has_floor_or_surface() const { return floor_axis >= 0; }
 
  private:
   // Per atom, from the first half of the step to the second: the weights of the new force along and
@@ -105,10 +108,11 @@ class FixNVESphereFluid : public Fix {
   // first_half of the uniform drag of a smooth law: every sphere of its group is wholly immersed, and
   // the block takes it through its whole first half (sediment::DragBlock::step_spheres).
   template <bool on_floor> void first_half_immersed();
-  void check_floor();    // every sphere of the group at or above the floor, or an error
+  void check_column();    // every sphere of the group at or above the floor, or an error; under the surface
 
-  int floor_axis;         // -1: no floor
-  double floor_level;     // spheres stop with their lowest point here
+  int floor_axis;         // the axis across which the floor and the surface lie; -1: neither
+  double floor_level;     // spheres stop with their lowest point here (-inf: no floor)
+  double surface_level;   // spheres stop with their highest point here (+inf: no surface)
 
   // Diagnostics of the last step (compute_vector): spheres stuck by the yield stress, held at a
   // Cd jump, outside every fluid, and with their local solid fraction capped (hindered drag).

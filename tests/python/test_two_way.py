@@ -126,7 +126,7 @@ def test_the_deck_runs_the_flow_or_its_one_way_twin(column, tmp_path):
     assert (f'if "${{flow}} == yes" then "fix             flow all fluid/flow water grid {across} {across} {tall} '
             f'column 0 {column.height:.12g} weight d_weight stratification ${{stratification}}"') in deck
     assert f"variable        stratification index {STRATIFICATION} " in deck
-    assert "fix             surface all wall/reflect zhi EDGE" in deck
+    assert f"fix             step all nve/sphere/fluid floor z 0.0 surface z {column.height:.12g}" in deck
     typo = run_batch(tmp_path / "in.sedimentation", {"flow": "yse"}, check=False)
     assert typo.returncode == 2 and "variable flow must be yes or no, not yse" in typo.text
     typo = run_batch(tmp_path / "in.sedimentation", {"stratification": "grain"}, check=False)

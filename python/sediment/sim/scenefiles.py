@@ -206,19 +206,20 @@ def _deck(scene: Scene, data: str, layer_file: str) -> str:
         lines += [f"# the flow the grains drive (two-way coupling): {across} x {across} x {tall} cells over the column, "
                   "closed by free slip at the floor and the surface",
                   f'if "${{flow}} == yes" then "fix             flow all fluid/flow water grid {across} {across} {tall} '
-                  f'column 0 {scene.height:.12g}{weights}"',
-                  "fix             surface all wall/reflect zhi EDGE    # the swirls lift fine grains to the surface"]
+                  f'column 0 {scene.height:.12g}{weights}"']
+    # the swirls lift fine grains to the surface, which holds them while the flow presses them up
+    surface = f" surface {up} {scene.height:.12g}" if e.flow else ""
     if e.interacting:
         lines += pair_lines(scene)
         lines += [f"fix             floor all wall/gran granular {contact_model(scene)} {up}plane 0 NULL",
-                  "fix             step all nve/sphere/fluid",
+                  f"fix             step all nve/sphere/fluid{surface}",
                   "# Soft contacts, made for overlaps up to "
                   f"{OVERLAP_TOLERANCE:.0%} of a diameter: the largest is reported, and twice that stops the run.",
                   "compute         overlap all contact/overlap",
                   "variable        overlap equal c_overlap",
                   f"fix             overlap_guard all halt 100 v_overlap > {2 * OVERLAP_TOLERANCE:g} error hard message yes"]
     else:
-        lines.append(f"fix             step all nve/sphere/fluid floor {up} 0.0")
+        lines.append(f"fix             step all nve/sphere/fluid floor {up} 0.0{surface}")
     lines += [
         "# a frame every frame_every steps, and each stage a whole number of them at any dt_scale: the last",
         "# frame is then the run's last step, at t_end or up to a frame past it",
