@@ -270,7 +270,7 @@ for _kind, _uses in USES.items():
 PATIENCE = {"value": 45.0}  # how long a command that must refuse may work before it counts as accepting
 
 
-def opt_case(args: list, words, needs=(), timeout: float = 8, prepare: Callable | None = None) -> Callable:
+def opt_case(args: list, words, needs=(), timeout: float = 8) -> Callable:
     def fn(ctx: Ctx):
         timeout_ = max(timeout, PATIENCE["value"])
         out = ctx.tmp / "out"

@@ -159,6 +159,11 @@ class Scene:
         return self.cylinder.height
 
     @property
+    def parcels(self) -> bool:
+        """Whether some atom stands for several real grains (a weight other than 1)."""
+        return not np.all(self.weight == 1)
+
+    @property
     def dimension(self) -> int:
         """2 for the slab, 3 for the column."""
         return 2 if self.geometry == "slab" else 3

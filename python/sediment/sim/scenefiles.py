@@ -158,7 +158,7 @@ def _deck(scene: Scene, data: str, layer_file: str) -> str:
         "variable        restart_file index restart.a.bin",
         "variable        timing index no     # yes: LAMMPS's timing breakdown after each stage (where the time goes)",
     ]
-    parcels = e.flow and not np.all(scene.weight == 1)
+    parcels = e.flow and scene.parcels
     if e.flow:
         lines += ["variable        flow index yes      # no: the one-way twin of this scene (the same grains, steps and "
                   "frames; the fluid at rest)",
@@ -327,7 +327,7 @@ def describe(scene: Scene) -> str:
                      f"{scene.width / across * 1e3:.3g} mm; "
                      f"the start's flow, {scene.flow_speed() * 1e3:.3g} mm/s rms, sets the first step "
                      f"({scene.flow_time_step():.3g} s); `-var flow no` runs the one-way twin"
-                     + ("" if np.all(scene.weight == 1) else
+                     + ("" if not scene.parcels else
                         "; `-var stratification grains|parcels`: the displaced stratification pushes back with "
                         f"its real grains' force or the parcels' own (default {STRATIFICATION})"))
     first, last = scene.psd.percent_finer[0], scene.psd.percent_finer[-1]
