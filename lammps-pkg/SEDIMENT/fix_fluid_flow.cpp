@@ -1042,13 +1042,6 @@ bool FixFluidFlow::outside_column(const double *x) const
 // against the flow would only resist it, and a deposit's many resist it so stiffly that the lagged
 // flow diverges within a few solves of the first landings; a bed's, capped, hold its spheres to the
 // fluid, which they then stir as a suspension far denser than the bed (docs/physics.md section 8).
-bool FixFluidFlow::held_at_surface(int i) const
-{
-  for (const FixNVESphereFluid *integrator : floors)
-    if (integrator->held_at_surface(i)) return true;
-  return false;
-}
-
 bool FixFluidFlow::left_out(int i) const
 {
   if (outside_column(atom->x[i])) return true;
@@ -1056,6 +1049,14 @@ bool FixFluidFlow::left_out(int i) const
     if (floor->at_rest_on_floor(i)) return true;
   for (const FixFluidDrag *drag : drags)
     if (drag->fraction_capped(i)) return true;
+  return false;
+}
+
+// A sphere held under the surface of a fix nve/sphere/fluid (solve() spreads none of its force).
+bool FixFluidFlow::held_at_surface(int i) const
+{
+  for (const FixNVESphereFluid *integrator : floors)
+    if (integrator->held_at_surface(i)) return true;
   return false;
 }
 
