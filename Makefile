@@ -19,9 +19,6 @@ export OMPI_MCA_odls_base_sigkill_timeout := 0
 # library loaded at each start (Omni-Path's spends 0.1 s per core timing the clock), 0.35 s -> 0.16 s
 # per start of a serial run; the tests start some thousands
 export OMPI_MCA_pml := ob1
-# A serial run is an Open MPI singleton: isolated, it starts no daemon of its own (whose start hung a
-# run at times, waiting with no time used; python/sediment/sim/process.py), 0.16 -> 0.04 s per start
-export OMPI_MCA_ess_singleton_isolated := 1
 
 .PHONY: deps build build-demo demo docs test test-cpp test-python check-sanitize test-lammps-current test-lammps-2022 bench clean
 

@@ -24,13 +24,9 @@ def run_environment() -> dict[str, str]:
     where ob1's shared memory carries the ranks' messages; choosing it spares loading the fabrics'
     layers, one of which (Intel Omni-Path's libpsm2, a dependency of Debian's Open MPI) spends 0.1 s
     per core timing the clock whenever a process starts: 0.35 s -> 0.16 s per start of a serial run
-    on 2 cores. A serial run (no mpirun) is an Open MPI singleton, which starts a daemon (orted) of
-    its own unless told not to; it needs none, and that daemon's start hung a run at times (twice in
-    one `make test` here, each run waiting on it with no time used): it starts isolated, 0.16 ->
-    0.04 s per start. Under mpirun the setting does nothing."""
+    on 2 cores."""
     env = dict(os.environ, OMP_NUM_THREADS="1", OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
     env.setdefault("OMPI_MCA_pml", "ob1")
-    env.setdefault("OMPI_MCA_ess_singleton_isolated", "1")
     return env
 
 
