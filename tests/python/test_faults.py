@@ -442,6 +442,49 @@ def test_a_run_that_starts_after_the_stop_is_stopped_at_once(tmp_path):
         run_batch(deck, running=runs)
 
 
+@pytest.mark.parametrize("starts_hanging", [1, 2])
+def test_a_start_that_hangs_silently_is_tried_again_once(tmp_path, monkeypatch, starts_hanging):
+    """Open MPI's singleton start hung twice in one make test (MPI_Init waiting on its daemon, no CPU
+    time, until killed by hand). A run that prints nothing is stopped after START_WAIT and started once
+    more; after two such starts it is an error that says so. The stand-in for LAMMPS hangs silently on
+    its first `starts_hanging` starts, then prints like a run."""
+    from sediment.sim import process
+    from sediment.sim.run import run_deck
+
+    monkeypatch.setattr(process, "START_WAIT", 1.0)
+    starts = tmp_path / "starts"
+    fake = tmp_path / "lmp_fake"
+    fake.write_text("#!/bin/sh\n"
+                    f"echo x >> {starts}\n"
+                    f'[ "$(wc -l < {starts})" -le {starts_hanging} ] && exec sleep 600\n'
+                    'while [ "$1" != -log ]; do shift; done\n'
+                    "echo 'LAMMPS (fake)'; echo 'Loop time of 0.1 on 1 procs for 0 steps' | tee $2\n")
+    fake.chmod(0o755)
+    monkeypatch.setenv("SEDIMENT_LMP", str(fake))
+    deck = tmp_path / "in.none"
+    deck.write_text("print hello\n")
+    began = time.monotonic()
+    if starts_hanging == 1:
+        out = run_batch(deck)
+        assert "Loop time" in out.text and out.returncode == 0
+        starts.unlink()
+        result = run_deck(deck, progress=False)
+        assert "Loop time" in result.log.read_text() and starts.read_text().count("x") == 2
+    else:
+        with pytest.raises(RuntimeError, match="printed nothing in 1 s after each of 2 starts"):
+            run_batch(deck)
+    assert time.monotonic() - began < 60    # the hung starts were stopped, not waited on
+    assert not [pid for pid in map(int, filter(str.isdigit, os.listdir("/proc")))
+                if Path(f"/proc/{pid}/cmdline").exists() and b"sleep\x00600" in _cmdline(pid)]
+
+
+def _cmdline(pid: int) -> bytes:
+    try:
+        return Path(f"/proc/{pid}/cmdline").read_bytes()
+    except OSError:
+        return b""
+
+
 def test_the_wait_for_the_runs_takes_a_signal_another_thread_received():
     """The kernel may hand SIGINT or SIGTERM to any thread that does not block it: to a worker waiting on
     its run, Python's handler then runs in the main thread only once that thread runs again. Waiting on

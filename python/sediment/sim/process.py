@@ -118,6 +118,42 @@ def stop_process(proc: subprocess.Popen, grace: float = 10.0) -> None:
     release(proc)
 
 
+START_WAIT = 120.0    # s: LAMMPS prints its banner within a second of its start, even on a loaded machine
+START_TRIES = 2
+
+
+class StartWatch:
+    """Stops a run that printed nothing `seconds` after its start (`stalled`). Open MPI 4.1's singleton
+    start hangs at times in MPI_Init, waiting on the daemon it started with no CPU time (two serial runs
+    of one `make test`, for 12 and 25 minutes); LAMMPS prints its banner right after MPI_Init, so a run
+    silent that long has not begun: it wrote nothing, and starting it again is safe."""
+
+    def __init__(self, proc: subprocess.Popen, seconds: float | None = None) -> None:
+        self.stalled = False
+        self._printed = threading.Event()
+        self._timer = threading.Timer(START_WAIT if seconds is None else seconds, self._check, (proc,))
+        self._timer.daemon = True
+        self._timer.start()
+
+    def printed(self) -> None:
+        """The run printed a line: it has started."""
+        self._printed.set()
+
+    def _check(self, proc: subprocess.Popen) -> None:
+        if not self._printed.is_set():
+            self.stalled = True
+            stop_process(proc)
+
+    def cancel(self) -> None:
+        self._timer.cancel()
+
+
+def start_hung(cmd: list[str], tries: int) -> RuntimeError:
+    """The error of a run whose every start printed nothing (`StartWatch`)."""
+    return RuntimeError(f"LAMMPS printed nothing in {START_WAIT:g} s after each of {tries} starts ({' '.join(cmd)}): "
+                        "MPI_Init did not return (an Open MPI start that hung); nothing was run or written")
+
+
 class RunInterrupted(RuntimeError):
     """The run was stopped by SIGINT or SIGTERM; every rank has been stopped."""
 

@@ -26,7 +26,8 @@ from ..folders import folder_lock
 from ..progress import bar as progress_bar
 from ..results import write_atomic
 from .printed import parse_printed
-from .process import RunInterrupted, Runs, launch_command, release, signals_stop, start_process, stop_process
+from .process import (START_TRIES, RunInterrupted, Runs, StartWatch, launch_command, release, signals_stop, start_hung,
+                      start_process, stop_process)
 from .provenance import (COMPARED, RECORD, already_finished, check_partial, check_written, file_digest, finished,
                          input_files, layer_file_of, read_record, restart_damage, resume_id, run_id, stamp,
                          unresumable, write_record)
@@ -255,11 +256,20 @@ def _run(deck: Path, ranks: int, variables: dict[str, str], progress: bool) -> R
     proc = None
     try:
         with signals_stop() as launch:
-            proc = launch.start(cmd, env, folder, stdout=subprocess.PIPE, stderr=subprocess.STDOUT)
-            assert proc.stdout is not None
-            for line in proc.stdout:
-                take(line)
-            code = proc.wait()
+            for _ in range(START_TRIES):
+                proc = launch.start(cmd, env, folder, stdout=subprocess.PIPE, stderr=subprocess.STDOUT)
+                watch = StartWatch(proc)
+                assert proc.stdout is not None
+                for line in proc.stdout:
+                    watch.printed()
+                    take(line)
+                code = proc.wait()
+                watch.cancel()
+                if not watch.stalled:
+                    break
+                release(proc)
+            else:
+                raise start_hung(cmd, START_TRIES)
     except RunInterrupted as exc:
         layers = layer_file_of(deck, variables)
         if layers is not None and finished(layers, variables.get("sediment_run_id", "")):
@@ -357,10 +367,29 @@ def run_batch(deck: Path, variables: dict[str, object] | None = None, ranks: int
     if not deck.is_file():
         raise FileNotFoundError(f"{deck}: no such deck")
     cmd, env = launch_command(str(deck), "none", ranks, variables)
-    if getattr(running, "stopped", False):
-        raise RunInterrupted("the runs were stopped before this one began")
     start = time.monotonic()
-    proc = start_process(cmd, env, cwd or deck.parent, stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    for _ in range(START_TRIES):
+        if getattr(running, "stopped", False):
+            raise RunInterrupted("the runs were stopped before this one began")
+        printed = _collect(cmd, env, cwd or deck.parent, timeout, running, on_line)
+        if printed is not None:
+            break
+    else:
+        raise start_hung(cmd, START_TRIES)
+    stdout, stderr, returncode = printed
+    wall = time.monotonic() - start
+    parsed = parse_printed(stdout)
+    out = DeckOutput(stdout + stderr, returncode, wall, parsed.samples, parsed.results)
+    if check and out.error:
+        raise RuntimeError(f"{deck.name} failed: {out.error}")
+    return out
+
+
+def _collect(cmd: list[str], env: dict[str, str], cwd: Path, timeout: float | None, running: Runs | None,
+             on_line: Callable[[str], None] | None) -> tuple[str, str, int] | None:
+    """One start of a `run_batch` run: its standard output, standard error and exit status, or None if
+    it printed nothing (`StartWatch`) and was stopped."""
+    proc = start_process(cmd, env, cwd, stdout=subprocess.PIPE, stderr=subprocess.PIPE)
     if running is not None:
         running.add(proc)
     # Standard output is read line by line as it comes (standard error by a thread, so that neither
@@ -374,6 +403,7 @@ def run_batch(deck: Path, variables: dict[str, object] | None = None, ranks: int
         stop_process(proc)
 
     timer = threading.Timer(timeout, overstayed) if timeout is not None else None
+    watch = StartWatch(proc)
     lines = []
     try:
         reader.start()
@@ -381,6 +411,7 @@ def run_batch(deck: Path, variables: dict[str, object] | None = None, ranks: int
             timer.start()
         assert proc.stdout is not None
         for line in proc.stdout:
+            watch.printed()
             lines.append(line)
             if on_line is not None:
                 on_line(line)
@@ -390,20 +421,17 @@ def run_batch(deck: Path, variables: dict[str, object] | None = None, ranks: int
         stop_process(proc)
         raise
     finally:
+        watch.cancel()
         release(proc)
         if timer is not None:
             timer.cancel()
         if running is not None:
             running.discard(proc)
+    if watch.stalled:
+        return None
     if timed_out.is_set():
         raise subprocess.TimeoutExpired(cmd, timeout)
-    stdout, stderr = "".join(lines), "".join(stderr_text)
-    wall = time.monotonic() - start
-    printed = parse_printed(stdout)
-    out = DeckOutput(stdout + stderr, proc.returncode, wall, printed.samples, printed.results)
-    if check and out.error:
-        raise RuntimeError(f"{deck.name} failed: {out.error}")
-    return out
+    return "".join(lines), "".join(stderr_text), proc.returncode
 
 
 def _is_float(word: str) -> bool:
