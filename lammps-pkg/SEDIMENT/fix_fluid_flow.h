@@ -84,6 +84,11 @@ class FixFluidFlow : public Fix {
                          // or their largest speed has changed by this fraction
   static constexpr double DEFAULT_DRIFT = 0.2;    // without every or drift
   double drift;          // cells the fastest sphere of each step has moved since the last solve, summed
+  double cfl;            // > 0: the step is shortened so that the flow carries no sphere more than this many
+                         // cells in one step (with every N, between two solves)
+  double longest_dt;     // the input's timestep: the step cfl shortens and lengthens back to
+  double applied_dt;     // the step cfl last set (0: none), to tell it from a new timestep command
+  bool told_shortened;   // the first shortening of a run is reported
   double solved_speed;   // the largest speed at the last solve
   bool unsettled;        // the last solve changed the spheres' fluid velocities by more than drift_limit
   double solved_uniform[3], solved_viscosity;    // the fluid's uniform velocity and viscosity at the last solve
@@ -134,8 +139,10 @@ class FixFluidFlow : public Fix {
   enum { FX, FY, FZ, FLUX, PEAK, LEFT_OUT, SOLVES, NDIAG };
   double diag[NDIAG];
   // count, solved, drift, speed, unsettled, viscosity, uniform, diag (UNSTRATIFIED: files written
-  // before stratification grains kept its state), then solve_interval, lowest_class, planes
-  static constexpr int UNSTRATIFIED = 9 + NDIAG, RESTART_VALUES = 12 + NDIAG;
+  // before stratification grains kept its state), then solve_interval, lowest_class, planes, then
+  // (files whose solved value is STEP_STATE more) the longest and the applied step of cfl
+  static constexpr int UNSTRATIFIED = 9 + NDIAG, RESTART_VALUES = 12 + NDIAG, STEP_VALUES = 2;
+  static constexpr double STEP_STATE = 2.0;
 
   bigint last_solve;         // the step of the last solve (-1: none yet in this fix)
   bool warned_carry;         // the warning that the flow carries spheres a cell between solves was given
@@ -168,7 +175,9 @@ class FixFluidFlow : public Fix {
   bool held_at_surface(int i) const;
   bool fluid_changed() const;
   void report_settings() const;
-  double largest_speed() const;
+  double largest_speed(double *const *v) const;
+  bool stale();
+  void limit_step();
   void check_stable(const double *change);
   void check_carry(double peak);
   void transform_solve();

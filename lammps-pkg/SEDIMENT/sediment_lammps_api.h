@@ -19,6 +19,7 @@
 #include "modify.h"
 #include "neigh_request.h"
 #include "neighbor.h"
+#include "output.h"
 #include "pair.h"
 #include "region.h"
 
@@ -119,6 +120,13 @@ namespace sediment_api {
     return abort.universe;
   }
 
+  // Output's reset_dt (its dumps and thermo by simulated time) came after 29 Sep 2021, which has none.
+  template <class O> auto reset_output_dt(O *output, int) -> decltype(output->reset_dt(), void())
+  {
+    output->reset_dt();
+  }
+  template <class O> void reset_output_dt(O *, long) {}
+
 }    // namespace sediment_api
 
 // Fix `id`, or nullptr.
@@ -161,6 +169,11 @@ inline void sediment_forward_comm(Comm *comm, Pair *pair)
 inline void sediment_reverse_comm(Comm *comm, Pair *pair)
 {
   sediment_api::reverse_comm(comm, pair, 0);
+}
+// After a style changed the timestep mid-run: output's intervals by simulated time, where it keeps them.
+inline void sediment_reset_output_dt(Output *output)
+{
+  sediment_api::reset_output_dt(output, 0);
 }
 // The communicator an aborting error (error->one) was raised on.
 inline MPI_Comm sediment_abort_universe(const LAMMPSAbortException &abort)

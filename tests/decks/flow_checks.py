@@ -352,14 +352,84 @@ print "RESULT left_out $(f_flow[6]) peak $(f_flow[5])"
     assert 0 < out.results["peak"] < 0.01
 
 
-def spread_forces(deck: str, np_ranks: int) -> np.ndarray:
-    """Runs `deck`, which prints `FORCE step f_flow[3] f_flow[6]` at each step: those rows."""
+def dump_frames(path: Path, columns: int) -> dict[int, np.ndarray]:
+    """The frames of a `dump custom` file: per step, its atoms' rows (`columns` values each)."""
+    lines, frames, k = path.read_text().splitlines(), {}, 0
+    while k < len(lines):
+        step, count = int(lines[k + 1]), int(lines[k + 3])
+        frames[step] = np.array([[float(v) for v in line.split()] for line in lines[k + 9:k + 9 + count]]).reshape(-1, columns)
+        k += 9 + count
+    return frames
+
+
+@check
+def flow_step_limit(np_ranks: int):
+    """Keyword cfl 0.5: 300 quartz grains of 100 um fall 2-4 mm onto the floor of a closed column (8 x 8 x
+    32 cells of 0.125 mm) at an input step of 0.05 s, which would carry them 3.6 cells (the flow's
+    warning at step 1, from rest). After each step the step is what carries the fastest fluid at a sphere
+    half a cell at most (0.0106 s after the first step, 0.0053 at the flow's peak): exactly half where
+    it changes, more than 0.5/1.2 where it is kept (it lengthens once it may grow by a fifth), and the
+    time is the sum of the steps taken. Once the grains rest on the
+    floor the flow stops and the step is the input's again. A timestep command gives a new longest
+    step; a run after a run keeps the last one; a run resumed from a restart file takes the same steps."""
+    fixes = """fix fall all gravity 9.81 vector 0 0 -1
+fix water all fluid density 1000 viscosity 1e-3
+fix buoy all fluid/buoyancy water
+fix drag all fluid/drag water law stokes
+fix flow all fluid/flow water grid 8 8 32 column 0 4e-3 cfl 0.5
+fix step all nve/sphere/fluid floor z 0
+fix show all print 1 "STEP $(step) $(dt:%.17g) $(time:%.17g) $(f_flow[6])" screen yes
+"""
+    deck = quartz_box("p p f", (1e-3, 1e-3, 4e-3), """region top block 0 1e-3 0 1e-3 2e-3 3.9e-3
+create_atoms 1 random 300 2468 top""") + fixes + """restart 20 limit.*.restart
+dump u all custom 1 u.txt id f_flow[1] f_flow[2] f_flow[3]
+dump_modify u format float %.17g
+timestep 0.05
+run 60
+undump u
+timestep 0.02
+run 5
+run 5
+"""
     with tempfile.TemporaryDirectory() as tmp:
-        path = Path(tmp) / "budget.lmp"
+        path = Path(tmp) / "limit.lmp"
         path.write_text(deck)
         out = run_deck(path, {}, np_ranks, cwd=Path(tmp))
-    return np.array([[float(v) for v in line.split()[1:4]] for line in out.text.splitlines()
-                     if line.startswith("FORCE ")])
+        frames = dump_frames(Path(tmp) / "u.txt", 4)
+        # resumed from step 20's restart file, with no timestep command: the steps as before
+        path.write_text("read_restart limit.20.restart\ncomm_modify cutoff 1e-4\n" + fixes + "run 40\n")
+        resumed = step_rows(run_deck(path, {}, np_ranks, cwd=Path(tmp)).text)
+    rows = step_rows(out.text)
+    cell = 1e-3 / 8
+    fastest = {step: float(np.linalg.norm(frame[:, 1:], axis=1).max()) for step, frame in frames.items()}
+    carried = np.array([fastest[n] * rows[n][0] / cell for n in range(1, 61)])    # cells in the next step
+    shortened = np.array([rows[n][0] < 0.05 for n in range(1, 61)])
+    report(f"cfl 0.5: the next step carries the fastest fluid at a sphere {carried.max():.12f} cells at most, "
+           f"{carried[shortened].min():.12f} where shortened ({shortened.sum()} steps; from {rows[1][0]:.4g} s, "
+           f"shortest {min(rows[n][0] for n in range(61)):.4g} s); at step 60 {rows[60][2]:.0f} grains on the floor, "
+           f"step {rows[60][0]:g} s; after timestep 0.02: {rows[65][0]:g} and {rows[70][0]:g} s")
+    assert "shortened from 0.05 to 0.0106" in out.text
+    changed = np.array([rows[n][0] != rows[n - 1][0] for n in range(1, 61)])
+    assert np.all(carried <= 0.5 * (1 + 1e-12)) and np.all(np.abs(carried[shortened & changed] - 0.5) < 1e-9)
+    assert np.all(carried[shortened] > 0.5 / 1.2 * (1 - 1e-12))    # lengthened once it may grow by a fifth
+    assert shortened[:30].all() and rows[60][0] == 0.05 and rows[60][2] == 300
+    times = np.array([rows[n][1] for n in range(61)])
+    steps = np.array([0.05] + [rows[n][0] for n in range(60)])
+    assert np.allclose(np.diff(times), steps[1:], rtol=1e-12, atol=0)
+    assert rows[65][0] == 0.02 and rows[70][0] == 0.02
+    # (the time is not compared: LAMMPS 2021's restart files do not keep it; fix layers/hdf5 does)
+    assert all(resumed[n][0] == pytest.approx(rows[n][0], rel=1e-12) and resumed[n][2] == rows[n][2]
+               for n in range(20, 61))
+
+
+def step_rows(text: str) -> dict[int, tuple[float, float, float]]:
+    """The `STEP step dt time left-out` rows a deck prints, by step (a run's setup repeats the last)."""
+    rows: dict[int, tuple[float, float, float]] = {}
+    for line in text.splitlines():
+        if line.startswith("STEP "):
+            step, *values = line.split()[1:]
+            rows.setdefault(int(step), tuple(float(v) for v in values))
+    return rows
 
 
 def spread_forces(deck: str, np_ranks: int) -> np.ndarray:

@@ -14,7 +14,7 @@ from ..lab.psd import PSD
 from ..lab.readout import Suspension
 from ..results import write_text
 from .provenance import RUN_OUTPUTS, inputs_id
-from .scene import LOAD_CONCENTRATION, OVERLAP_TOLERANCE, POISSON_RATIO, RESTART_SPACING, Scene
+from .scene import FLOW_COURANT, LOAD_CONCENTRATION, OVERLAP_TOLERANCE, POISSON_RATIO, RESTART_SPACING, Scene
 
 
 SAMPLE_FILES = ("sample.data", "in.sedimentation", "input_psd.csv", "simulated_psd.csv", "classes.csv")
@@ -204,9 +204,10 @@ def _deck(scene: Scene, data: str, layer_file: str) -> str:
         across, tall = scene.flow_grid()
         weights = " weight d_weight stratification ${stratification}" if parcels else ""
         lines += [f"# the flow the grains drive (two-way coupling): {across} x {across} x {tall} cells over the column, "
-                  "closed by free slip at the floor and the surface",
+                  "closed by free slip at the floor and the surface; a step that would carry a grain more than",
+                  f"# {FLOW_COURANT:g} cells is shortened (cfl), as the schedule's steps are sized at the start",
                   f'if "${{flow}} == yes" then "fix             flow all fluid/flow water grid {across} {across} {tall} '
-                  f'column 0 {scene.height:.12g}{weights}"']
+                  f'column 0 {scene.height:.12g}{weights} cfl {FLOW_COURANT:g}"']
     # the swirls lift fine grains to the surface, which holds them while the flow presses them up
     surface = f" surface {up} {scene.height:.12g}" if e.flow else ""
     if e.interacting:
@@ -248,6 +249,13 @@ def _deck(scene: Scene, data: str, layer_file: str) -> str:
             + ([f'"timestep $({dt:.17g}*v_dt_scale)"'] if first else []) + ['"run ${stage_end} upto post ${timing}"']
         lines += [f"variable        stage_end equal $(v_stage_end+ceil(ceil({steps}/v_dt_scale)/v_frame_every)*v_frame_every)",
                   f'if "$(step) < ${{stage_end}}" then {" ".join(commands)}']
+    if e.flow:
+        lines += ["# Steps the flow shortened leave the stages short of t_end: the run goes on at the last stage's step",
+                  "# (shortened where the flow asks) and stops at the first frame at or past t_end",
+                  "variable        reached equal time>=${t_end}*(1-1e-9)",
+                  'if "$(v_reached) == 0" then &',
+                  '  "fix             finish all halt ${frame_every} v_reached != 0 error continue message no" &',
+                  '  "run             1000000000 post ${timing}"']
     return "\n".join(lines) + "\n"
 
 
