@@ -5,10 +5,11 @@ papers' one-way assumption").
 The screening bounds the swirls from above with Segre et al.'s measurements. This measures them: the
 test's column of parcels FLOW_SWIRLS swirls wide and the cylinder's height, placed independently,
 under `fix fluid/flow` (each parcel stirring the fluid as its real grains do), and its one-way twin:
-the same data file, deck, steps and frames, with the fluid at rest (`-var flow no`). A draw is the
+the same data file, deck and schedule, with the fluid at rest (`-var flow no`; the flow may shorten the
+two-way run's steps, fix fluid/flow's cfl, and the readings are taken at the instruments' times). A draw is the
 pair; the readings' changes are paired per draw, so the parcels' sampling error, which both share,
 drops out of the change. Draws with independent seeds give its standard error, and the first draw
-run again on a coarser grid at the same steps (its twin, the same, run again beside it) shows what
+run again on a coarser grid on the same schedule (its twin, the same, run again beside it) shows what
 the grid changes.
 """
 from __future__ import annotations

@@ -160,8 +160,8 @@ def _deck(scene: Scene, data: str, layer_file: str) -> str:
     ]
     parcels = e.flow and scene.parcels
     if e.flow:
-        lines += ["variable        flow index yes      # no: the one-way twin of this scene (the same grains, steps and "
-                  "frames; the fluid at rest)",
+        lines += ["variable        flow index yes      # no: the one-way twin of this scene (the same grains and "
+                  "schedule, whose steps the flow may shorten; the fluid at rest)",
                   'if "${flow} != yes && ${flow} != no" then &',
                   '  "print \'ERROR: variable flow must be yes or no, not ${flow}\'" "quit 2"']
     if parcels:
