@@ -179,6 +179,38 @@ def test_a_killed_run_keeps_the_earlier_result_and_resumes_to_the_same_frames(tm
     assert np.max(np.abs(a.fraction - b.fraction)) < 1e-12
 
 
+def test_a_two_way_run_killed_past_its_stages_resumes_to_the_same_frames(tmp_path):
+    """At four times its planned steps a two-way column's flow shortens them (fix fluid/flow cfl): its
+    stages end short of t_end (after 834 steps) and the deck runs on until its frames reach it (2812
+    steps). Killed there, after its restart file at step 2000, and resumed, it ends on the frames of
+    the run that was not killed: the shortened steps come back with the restart file."""
+    decks = []
+    for name in ("whole", "cut"):
+        done = sediment("sample", REPO / "examples" / "granulometry" / "psd" / "sample2.csv", "--two-way", "--height",
+                        0.06, "--t-end", 60, "--particles", 1000, "--out", tmp_path / name)
+        assert done.returncode == 0, done.stderr
+        decks.append(tmp_path / name / "in.sedimentation")
+    whole, cut = decks
+    longer = ("--var", "dt_scale", "4")
+    assert sediment("run", whole, "--quiet", *longer).returncode == 0
+    log = (whole.parent / "log.lammps").read_text()
+    assert "fix flow fluid/flow: step 1 shortened from" in log
+    assert log.count("Loop time of") == whole.read_text().count('if "$(step) < ${stage_end}"') + 1    # and on to t_end
+    run = subprocess.Popen(SEDIMENT + ["run", str(cut), "--quiet", *longer], stdout=subprocess.DEVNULL,
+                           stderr=subprocess.DEVNULL)
+    wait_for(lambda: (cut.parent / "restart.a.bin").is_file(), process=run)
+    run.send_signal(signal.SIGKILL)
+    run.wait()
+    wait_for(lambda: not processes_in(cut.parent))
+    assert not (cut.parent / "layers.h5").exists()    # killed before it finished
+    resumed = sediment("run", "--resume", cut, "--quiet", *longer)
+    assert resumed.returncode == 0, resumed.stderr
+    a, b = read_layers(whole.parent / "layers.h5"), read_layers(cut.parent / "layers.h5")
+    assert a.complete and b.complete and 60 <= a.time[-1] < 60 + 2 * np.diff(a.time)[-1] and a.step[-1] > 2000
+    assert np.array_equal(a.step, b.step) and np.allclose(a.time, b.time, rtol=1e-12, atol=0)
+    assert np.max(np.abs(a.fraction - b.fraction)) < 1e-12
+
+
 def test_a_batch_run_streams_its_lines_and_is_stopped_at_its_timeout(tmp_path):
     """run_batch hands each line to a reader as LAMMPS prints it, and a run past its timeout is
     stopped (no LAMMPS left behind) with TimeoutExpired, not taken for a result."""

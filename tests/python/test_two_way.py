@@ -136,24 +136,6 @@ def test_the_deck_runs_the_flow_or_its_one_way_twin(column, tmp_path):
                                 (tmp_path / "one" / "in.sedimentation").read_text())
 
 
-def test_steps_the_flow_shortens_still_end_at_the_tests_end(tmp_path):
-    """At four times the planned steps the flow carries the parcels past half a cell a step: fix fluid/flow
-    (cfl) shortens them, the stages end short of t_end, and the deck runs on until its frames reach it:
-    the layer file is complete, its last frame the first at or past t_end."""
-    from sediment.sim.layers import read_layers
-    from sediment.sim.run import run_deck
-
-    assert cli.main(["sample", str(SAMPLE2), "--two-way", "--height", "0.06", "--t-end", "60", "--particles", "1000",
-                     "--out", str(tmp_path)]) == 0
-    result = run_deck(tmp_path / "in.sedimentation", variables={"dt_scale": "4"}, progress=False)
-    log = result.log.read_text()
-    assert "fix flow fluid/flow: step 1 shortened from" in log
-    stages = (tmp_path / "in.sedimentation").read_text().count('if "$(step) < ${stage_end}"')
-    assert log.count("Loop time of") == stages + 1    # the stages, then the run on to t_end
-    time = read_layers(tmp_path / "layers.h5").time
-    assert 60 <= time[-1] < 60 + 2 * np.diff(time)[-1]
-
-
 @pytest.mark.parametrize("options, message", [
     ({"geometry": "slab"}, "two-way coupling is simulated in a column"),
     ({"flow_cells": 14}, "a product of 2, 3 and 5"),

@@ -282,7 +282,9 @@ def _run(deck: Path, ranks: int, variables: dict[str, str], progress: bool) -> R
             if layers is not None:
                 partial = layers.with_name(layers.name + ".partial")
                 left = f"its frames so far are in {partial.name}" if partial.exists() else "it wrote no frames"
-            raise RunInterrupted(f"{exc} at step {step} of {total_steps or '?'} (t = {now:.6g} s): every rank was "
+            # a two-way deck may take more steps than it planned (the flow shortens them)
+            of = "of ?" if not total_steps else f"of {total_steps}" if step <= total_steps else f"({total_steps} planned)"
+            raise RunInterrupted(f"{exc} at step {step} {of} (t = {now:.6g} s): every rank was "
                                  f"stopped; {left}, an earlier result is untouched; sediment run --resume continues "
                                  "it from its last restart file") from None
     except BaseException:
