@@ -215,6 +215,15 @@ void FixFluidFlow::init()
     error->all(FLERR, "Fix fluid/flow: fluid '{}' is a Bingham fluid; the flow is solved for a Newtonian one",
                fluid_id);
   stokes.viscosity = fluid->properties().viscosity;
+  if (cfl > 0.0) {    // one style sets the step, or the last to act would undo the others' limits
+    for (Fix *fix : sediment_fixes_of_style(lmp, "dt/reset"))
+      error->all(FLERR, "Fix fluid/flow: keyword cfl sets the time step, as fix {} dt/reset does: give one of them",
+                 fix->id);
+    for (Fix *fix : sediment_fixes_of_style(lmp, "fluid/flow"))
+      if (fix != this && static_cast<FixFluidFlow *>(fix)->cfl > 0.0)
+        error->all(FLERR, "Fix fluid/flow: keyword cfl of fix {} and of fix {} both set the time step: give it to one",
+                   fix->id, id);
+  }
   if (!weight_name.empty()) weight_index = sediment_find_weights(lmp, weight_name, groupbit, "Fix fluid/flow");
   if (stratify)
     gravity = sediment_find_gravity(lmp, nullptr, "Fix fluid/flow with 'stratification grains'",

@@ -247,6 +247,8 @@ BAD_INPUT = [
     (FLOW + "fix u all fluid/flow f grid 8 8 8 cfl 0", "Fix fluid/flow: cfl must be finite and > 0"),
     (FLOW + "fix u all fluid/flow f grid 8 8 8 cfl 1.5", "Fix fluid/flow: cfl 1.5 must be at most 1"),
     (FLOW + "fix u all fluid/flow f grid 8 8 8 cfl", "Fix fluid/flow: keyword 'cfl' needs a distance in cells"),
+    (FLOW + "fix u all fluid/flow f grid 8 8 8 cfl 0.5\nfix r all dt/reset 1 NULL NULL 1e-6\nrun 0",
+     "Fix fluid/flow: keyword cfl sets the time step, as fix r dt/reset does: give one of them"),
     (FLOW + "fix u all fluid/flow f grid 8 8 8 column 0 1e-3", "Fix fluid/flow: keyword 'column' closes the fluid at its"),
     (FLOW + "fix u all fluid/flow f grid 8 8 8 weight 8", "Fix fluid/flow: 'weight' needs a per-atom property d_NAME"),
     (FLOW + "fix u all fluid/flow f grid 8 8 8 weight d_w\nrun 0",
