@@ -145,6 +145,7 @@ class StartWatch:
             stop_process(proc)
 
     def cancel(self) -> None:
+        """The run is over: the watch goes without acting."""
         self._timer.cancel()
 
 
