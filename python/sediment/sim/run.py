@@ -236,6 +236,10 @@ def _run(deck: Path, ranks: int, variables: dict[str, str], progress: bool) -> R
         loops += line.startswith("Loop time of ")
         if line.startswith("ERROR"):
             errors.append(line.strip())
+        elif line.startswith("SEDIMENT end") and len(words) >= 6:    # where a run halted on time ended
+            step, now = int(words[3]), float(words[5])
+            if bar is not None:
+                bar.update(min(now, t_end) - bar.n)
         elif line.startswith("SEDIMENT plan") and len(words) >= 6:
             total_steps, t_end = int(words[3]), float(words[5])
             if progress:
@@ -245,8 +249,11 @@ def _run(deck: Path, ranks: int, variables: dict[str, str], progress: bool) -> R
         elif len(words) >= 2 and words[0].isdigit() and _is_float(words[1]):
             step, now = int(words[0]), float(words[1])
             if bar is not None and step:
-                left = (time.monotonic() - start) * (total_steps - step) / step
-                bar.set_postfix_str(f"ETA {_clock(left)}", refresh=False)
+                if step < total_steps:
+                    left = (time.monotonic() - start) * (total_steps - step) / step
+                    bar.set_postfix_str(f"ETA {_clock(left)}", refresh=False)
+                else:    # a two-way deck whose flow shortened its steps runs on to t_end
+                    bar.set_postfix_str(f"past the {total_steps} planned steps, ETA unknown", refresh=False)
                 bar.update(min(now, t_end) - bar.n)
 
     def keep_failed_log() -> None:

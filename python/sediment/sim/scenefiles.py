@@ -255,7 +255,8 @@ def _deck(scene: Scene, data: str, layer_file: str) -> str:
                   "variable        reached equal time>=${t_end}*(1-1e-9)",
                   'if "$(v_reached) == 0" then &',
                   '  "fix             finish all halt ${frame_every} v_reached != 0 error continue message no" &',
-                  '  "run             1000000000 post ${timing}"']
+                  '  "run             1000000000 post ${timing}" &',
+                  '  \'print "SEDIMENT end step $(step) t $(time:%.12g)"\'    # a halted run prints no last thermo row']
     return "\n".join(lines) + "\n"
 
 
