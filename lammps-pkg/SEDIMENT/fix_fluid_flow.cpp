@@ -27,9 +27,9 @@
 #include "comm.h"
 #include "domain.h"
 #include "error.h"
+#include "force.h"
 #include "math_const.h"
 #include "memory.h"
-#include "force.h"
 #include "modify.h"
 #include "output.h"
 #include "pair.h"
@@ -421,8 +421,8 @@ bool FixFluidFlow::stale()
 // ran away within 21 steps), the step is shortened to cfl cells at the largest fluid velocity at a
 // sphere, and lengthened back to the input's as the flow slows (by a fifth or more at a time, or to
 // the input's). The spheres' own settling is not counted: it moves their density and its flow along
-// together.
-// As fix dt/reset: the time is summed up to this step at the old step, and every style hears of it.
+// together. As fix dt/reset: the time is summed up to this step at the old step, and every style hears
+// of the new one.
 void FixFluidFlow::limit_step()
 {
   const double speed = largest_speed(velocity);
@@ -434,8 +434,8 @@ void FixFluidFlow::limit_step()
   if (wanted < longest_dt && !told_shortened && comm->me == 0) {
     told_shortened = true;
     utils::logmesg(lmp, "fix {} fluid/flow: step {} shortened from {:.4g} to {:.4g} (the flow at a sphere up to {:.4g}, "
-                   "cfl {:.3g} cells of {:.4g}){}\n", id, update->ntimestep, longest_dt, wanted, speed, cfl, spacing[0],
-                   " (reported once a run; thermo keyword dt follows it)");
+                   "cfl {:.3g} cells of {:.4g}) (reported once a run; thermo keyword dt follows it)\n", id,
+                   update->ntimestep, longest_dt, wanted, speed, cfl, spacing[0]);
   }
   update->update_time();
   update->dt = wanted;
