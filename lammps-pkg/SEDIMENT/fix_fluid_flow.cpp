@@ -316,9 +316,6 @@ void FixFluidFlow::setup(int /*vflag*/)
   if (stratify) share_slopes();    // the box is known (not yet when a restart file gave the profiles)
   // A run continues the flow it has (from the last run, or a restart): a new one starts from one solve.
   // A run whose fluid was given another uniform velocity or viscosity since the last solve solves too.
-  // The input's timestep is the longest step: a timestep command since the step cfl last set gives it
-  // anew (a new stage of a deck, or a resumed run), else the last one holds (a run after a run).
-  if (update->dt != applied_dt) longest_dt = update->dt;
   told_shortened = false;
   if (!solved || fluid_changed()) {
     const double keep = relax;
@@ -419,12 +416,19 @@ bool FixFluidFlow::stale()
 // carries spheres faster than the input's timestep allows (sample 5 at 100 g/L with stratification
 // grains: parcels above the deposit at 0.35-0.47 mm/s, 1.7-2.2 cells a step of 1.52 s, and the column
 // ran away within 21 steps), the step is shortened to cfl cells at the largest fluid velocity at a
-// sphere, and lengthened back to the input's as the flow slows (by a fifth or more at a time, or to
-// the input's). The spheres' own settling is not counted: it moves their density and its flow along
-// together. As fix dt/reset: the time is summed up to this step at the old step, and every style hears
-// of the new one.
+// sphere (the fluid's uniform velocity included), and lengthened back to the input's as the flow slows
+// (by a fifth or more at a time, or to the input's). The spheres' own settling is not counted: a
+// test's schedule is sized for it, and drift solves again as they move.
 void FixFluidFlow::limit_step()
 {
+  // A timestep command since the step this fix last set gives the longest step anew (a deck's new
+  // stage, also in a run with pre no, whose setup this fix does not see); one that gives the same
+  // longest again (a resumed deck's stage) continues at the step this fix had set, as the run that was
+  // not stopped did.
+  if (update->dt != applied_dt) {
+    if (applied_dt > 0.0 && update->dt == longest_dt) set_step(applied_dt);
+    else longest_dt = update->dt;
+  }
   const double speed = largest_speed(velocity);
   const double between = drift_limit > 0.0 ? 1.0 : static_cast<double>(nevery);
   const double allowed = speed > 0.0 ? cfl * spacing[0] / (speed * between) : longest_dt;
@@ -437,10 +441,17 @@ void FixFluidFlow::limit_step()
                    "cfl {:.3g} cells of {:.4g}) (reported once a run; thermo keyword dt follows it)\n", id,
                    update->ntimestep, longest_dt, wanted, speed, cfl, spacing[0]);
   }
+  set_step(wanted);
+}
+
+// The time step from now on: as fix dt/reset, the time is summed up to this step at the old step, and
+// every style hears of the new one.
+void FixFluidFlow::set_step(double dt)
+{
   update->update_time();
-  update->dt = wanted;
+  update->dt = dt;
   update->dt_default = 0;
-  applied_dt = wanted;
+  applied_dt = dt;
   if (force->pair) force->pair->reset_dt();
   sediment_for_each_fix(modify, [](Fix *fix) { fix->reset_dt(); });
   sediment_reset_output_dt(output);
@@ -1184,9 +1195,10 @@ void FixFluidFlow::solve()
   read_from_slabs(brick, flow);
   for (int c = 0; c < 3; ++c) diag[FX + c] = total[c];
   diag[FLUX] = overall[0];
+  const double carried_by = diag[PEAK];    // the flow the spheres moved in since the last solve
   diag[PEAK] = overall[1];
   diag[LEFT_OUT] = total[3];
-  check_carry(overall[1]);
+  check_carry(overall[1], carried_by);
 
   // Each sphere's fluid velocity: the uniform flow of fix fluid plus what the grid gives it, less what
   // its own force and its periodic images give it, S(0) times over in a suspension (the neighbours
@@ -1246,15 +1258,16 @@ void FixFluidFlow::solve()
 // in which it has done so at four solves in a row while the grid's largest velocity grew tenfold
 // stops, before its results go wrong (and before the spheres jump across the box, which LAMMPS
 // reports as lost atoms). How far: with drift, the path of the fastest sphere since the last solve,
-// which the fix has measured; with every N, the grid's largest velocity over the steps, which bounds
-// it where the spheres go with their fluid (not a sphere held where the flow pushes it into the free
+// which the fix has measured; with every N, the grid's largest velocity over the steps (the last
+// solve's, which moved them: the new one's would count a flow that has only just started, and cfl
+// shortens the steps it will carry them), which bounds it where the spheres go with their fluid (not a sphere held where the flow pushes it into the free
 // surface, whose flow carries nothing: late in sample 2's column the grid's 88 um/s over 128 steps of
 // a solve made 297 cells, where the fastest sphere had moved the fifth of one that drift allows).
-void FixFluidFlow::check_carry(double peak)
+void FixFluidFlow::check_carry(double peak, double carried_by)
 {
   const bigint steps = std::max<bigint>(1, update->ntimestep - last_solve);
   last_solve = update->ntimestep;
-  const double cells = drift_limit > 0.0 ? drift : peak * update->dt * static_cast<double>(steps) / spacing[0];
+  const double cells = drift_limit > 0.0 ? drift : carried_by * update->dt * static_cast<double>(steps) / spacing[0];
   if (!(cells > 1.0)) {
     carries = 0;
     return;
@@ -1279,10 +1292,12 @@ void FixFluidFlow::check_carry(double peak)
   if (comm->me == 0)
     error->warning(FLERR, "Fix fluid/flow: the flow carries spheres {:.3g} cells between solves ({} steps of {:.3g} "
                    "/ cell {:.3g}, {}; step {}); above one cell it cannot follow the density it is solved from, and a "
-                   "dense scene can run away: take a smaller timestep, a coarser grid, or solve more often", cells,
-                   steps, update->dt, spacing[0],
-                   drift_limit > 0.0 ? "the fastest sphere's path" : fmt::format("largest velocity on the grid {:.3g}", peak),
-                   update->ntimestep);
+                   "dense scene can run away: {}", cells, steps, update->dt, spacing[0],
+                   drift_limit > 0.0 ? "the fastest sphere's path"
+                                     : fmt::format("largest velocity on the grid {:.3g}", carried_by),
+                   update->ntimestep,
+                   cfl > 0.0 ? "cfl shortens the steps by the flow from now on (the spheres' own settling is not limited)"
+                             : "take a smaller timestep, a coarser grid, solve more often, or give cfl");
 }
 
 // The lagged solve's instability (doc page, Stability): the spheres' fluid velocities reverse from

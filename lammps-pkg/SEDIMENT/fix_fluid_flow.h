@@ -178,8 +178,9 @@ class FixFluidFlow : public Fix {
   double largest_speed(double *const *v) const;
   bool stale();
   void limit_step();
+  void set_step(double dt);
   void check_stable(const double *change);
-  void check_carry(double peak);
+  void check_carry(double peak, double carried_by);
   void transform_solve();
   void plan_mirror_exchange();
   void separate_xy();

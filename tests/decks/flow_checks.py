@@ -371,7 +371,9 @@ def flow_step_limit(np_ranks: int):
     it changes, more than 0.5/1.2 where it is kept (it lengthens once it may grow by a fifth), and the
     time is the sum of the steps taken. Once the grains rest on the
     floor the flow stops and the step is the input's again. A timestep command gives a new longest
-    step; a run after a run keeps the last one; a run resumed from a restart file takes the same steps."""
+    step (in a run with pre no too); a run after a run keeps the last one; a run resumed from a restart
+    file takes the same steps, also when its deck gives the same timestep again. With every 2 the run
+    goes on at shortened steps (it stopped at its first solve, measured by the new flow: 5.3 cells)."""
     fixes = """fix fall all gravity 9.81 vector 0 0 -1
 fix water all fluid density 1000 viscosity 1e-3
 fix buoy all fluid/buoyancy water
@@ -381,7 +383,7 @@ fix step all nve/sphere/fluid floor z 0
 fix show all print 1 "STEP $(step) $(dt:%.17g) $(time:%.17g) $(f_flow[6])" screen yes
 """
     deck = quartz_box("p p f", (1e-3, 1e-3, 4e-3), """region top block 0 1e-3 0 1e-3 2e-3 3.9e-3
-create_atoms 1 random 300 2468 top""") + fixes + """restart 20 limit.*.restart
+create_atoms 1 random 300 2468 top""") + fixes + """restart 30 limit.*.restart
 dump u all custom 1 u.txt id f_flow[1] f_flow[2] f_flow[3]
 dump_modify u format float %.17g
 timestep 0.05
@@ -389,16 +391,22 @@ run 60
 undump u
 timestep 0.02
 run 5
-run 5
+timestep 0.03
+run 5 pre no
 """
     with tempfile.TemporaryDirectory() as tmp:
         path = Path(tmp) / "limit.lmp"
         path.write_text(deck)
         out = run_deck(path, {}, np_ranks, cwd=Path(tmp))
         frames = dump_frames(Path(tmp) / "u.txt", 4)
-        # resumed from step 20's restart file, with no timestep command: the steps as before
-        path.write_text("read_restart limit.20.restart\ncomm_modify cutoff 1e-4\n" + fixes + "run 40\n")
+        # resumed from step 30's restart file (a step the fix kept as the flow slowed), the input's step
+        # given again as a resumed deck's stage does: the steps as before
+        path.write_text("read_restart limit.30.restart\ncomm_modify cutoff 1e-4\n" + fixes + "timestep 0.05\nrun 30\n")
         resumed = step_rows(run_deck(path, {}, np_ranks, cwd=Path(tmp)).text)
+        # solved every 2 steps: the flow that moved the spheres, not the one just solved, is what the
+        # run-away check measures, and the steps shorten from the first solve
+        path.write_text(deck.replace("cfl 0.5", "every 2 cfl 0.5").split("restart 30")[0] + "timestep 0.05\nrun 30\n")
+        every = step_rows(run_deck(path, {}, np_ranks, cwd=Path(tmp)).text)
     rows = step_rows(out.text)
     cell = 1e-3 / 8
     fastest = {step: float(np.linalg.norm(frame[:, 1:], axis=1).max()) for step, frame in frames.items()}
@@ -407,7 +415,8 @@ run 5
     report(f"cfl 0.5: the next step carries the fastest fluid at a sphere {carried.max():.12f} cells at most, "
            f"{carried[shortened].min():.12f} where shortened ({shortened.sum()} steps; from {rows[1][0]:.4g} s, "
            f"shortest {min(rows[n][0] for n in range(61)):.4g} s); at step 60 {rows[60][2]:.0f} grains on the floor, "
-           f"step {rows[60][0]:g} s; after timestep 0.02: {rows[65][0]:g} and {rows[70][0]:g} s")
+           f"step {rows[60][0]:g} s; after timestep 0.02 and 0.03 (pre no): {rows[65][0]:g} and {rows[70][0]:g} s; "
+           f"every 2: {every[2][0]:.4g} s after its first solve")
     assert "shortened from 0.05 to 0.0106" in out.text
     changed = np.array([rows[n][0] != rows[n - 1][0] for n in range(1, 61)])
     assert np.all(carried <= 0.5 * (1 + 1e-12)) and np.all(np.abs(carried[shortened & changed] - 0.5) < 1e-9)
@@ -416,10 +425,11 @@ run 5
     times = np.array([rows[n][1] for n in range(61)])
     steps = np.array([0.05] + [rows[n][0] for n in range(60)])
     assert np.allclose(np.diff(times), steps[1:], rtol=1e-12, atol=0)
-    assert rows[65][0] == 0.02 and rows[70][0] == 0.02
+    assert rows[65][0] == 0.02 and rows[70][0] == 0.03    # a timestep command gives the longest, pre no too
+    assert every[2][0] < 0.006 and max(every[n][0] for n in range(2, 31)) < 0.05 and len(every) == 31
     # (the time is not compared: LAMMPS 2021's restart files do not keep it; fix layers/hdf5 does)
     assert all(resumed[n][0] == pytest.approx(rows[n][0], rel=1e-12) and resumed[n][2] == rows[n][2]
-               for n in range(20, 61))
+               for n in range(30, 61))
 
 
 def step_rows(text: str) -> dict[int, tuple[float, float, float]]:
