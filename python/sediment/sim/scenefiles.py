@@ -14,7 +14,8 @@ from ..lab.psd import PSD
 from ..lab.readout import Suspension
 from ..results import write_text
 from .provenance import RUN_OUTPUTS, inputs_id
-from .scene import FLOW_COURANT, LOAD_CONCENTRATION, OVERLAP_TOLERANCE, POISSON_RATIO, RESTART_SPACING, Scene
+from .scene import (FLOW_COURANT, LOAD_CONCENTRATION, OVERLAP_TOLERANCE, POISSON_RATIO, RESTART_SPACING, SORT_EVERY,
+                    Scene)
 
 
 SAMPLE_FILES = ("sample.data", "in.sedimentation", "input_psd.csv", "simulated_psd.csv", "classes.csv")
@@ -182,7 +183,7 @@ def _deck(scene: Scene, data: str, layer_file: str) -> str:
         f'  "read_data {data} fix weights NULL Weights"',
         f"# ranks side by side ({'* 1 1' if slab else '* * 1'}): each keeps its share of the grains as they settle",
         f"neighbor        {d_max:.6g} bin",
-        f"atom_modify     sort 1000 {scene.height / scene.layers:.6g}    # neighbours in memory, layer by layer",
+        f"atom_modify     sort {SORT_EVERY} {scene.height / scene.layers:.6g}    # neighbours in memory, layer by layer",
     ]
     if e.interacting:    # pair forces need ghosts within a contact or film reach and the skin, as LAMMPS finds them
         lines.append("comm_modify     vel yes")
@@ -236,8 +237,10 @@ def _deck(scene: Scene, data: str, layer_file: str) -> str:
         "# Two restart files in turn (one is always complete); each stage runs up to its last step, so a",
         "# resumed run skips the stages it has done and finishes the one it was in. One every twentieth of",
         f"# the run, and {RESTART_SPACING} steps apart at least: rank 0 writes each one, in several steps' time.",
+        f"# At multiples of the atoms' sort ({SORT_EVERY} steps), so that a resumed run sums in the order of one",
+        "# never stopped (a two-way column's flow grows round-off into another trajectory).",
         # max(a, b) written out: LAMMPS formulas have no two-argument max (its max() reduces a compute).
-        f"variable        restart_every equal ceil({total_steps}/20/v_dt_scale)",
+        f"variable        restart_every equal {SORT_EVERY}*ceil(ceil({total_steps}/20/v_dt_scale)/{SORT_EVERY})",
         f"restart         $(v_restart_every+(v_restart_every<{RESTART_SPACING})*({RESTART_SPACING}-v_restart_every)) "
         "restart.a.bin restart.b.bin",
         "variable        stage_end equal 0",
