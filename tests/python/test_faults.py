@@ -5,6 +5,7 @@ with exit status 0 and a wrong or partial result, or lose an earlier result."""
 from __future__ import annotations
 
 import hashlib
+import math
 import os
 import shutil
 import re
@@ -218,9 +219,10 @@ def test_restart_files_come_at_multiples_of_the_atoms_sort(tmp_path, dt_scale):
     restart file at step 300 summed its flow in another order of its atoms than the run never stopped,
     and left its trajectory (a layer's fraction 1.4 apart within 3000 steps); resumed at step 1000 it
     ran to the same frames bit for bit. The decks' restart files come at multiples of the sort at any
-    dt_scale (sample 2's 28 255 steps: every 2000, 4000 and 5000 steps)."""
-    done = sediment("sample", REPO / "examples" / "granulometry" / "psd" / "sample2.csv", "--particles", 1000,
-                    "--out", tmp_path)
+    dt_scale (sample 2's two-way column, 28 255 steps: every 2000, 4000 and 5000 steps, where 3819
+    and 4710 were at 0.37 and 0.3)."""
+    done = sediment("sample", REPO / "examples" / "granulometry" / "psd" / "sample2.csv", "--two-way", "--particles",
+                    1000, "--out", tmp_path)
     assert done.returncode == 0, done.stderr
     deck = (tmp_path / "in.sedimentation").read_text()
     head = deck[:deck.index("variable        stage_end equal 0")]
@@ -229,7 +231,8 @@ def test_restart_files_come_at_multiples_of_the_atoms_sort(tmp_path, dt_scale):
     every = int(re.search(r"^restart +(\d+) restart\.a\.bin", out.text, re.M).group(1))
     sort = int(re.search(r"^atom_modify +sort +(\d+)", out.text, re.M).group(1))
     planned = int(re.search(r"SEDIMENT plan steps (\d+)", out.text).group(1))
-    assert every % sort == 0 and every >= 2000 and every >= planned / 20
+    assert planned == math.ceil(28255 / float(dt_scale)) and every % sort == 0 and every >= max(2000, planned / 20)
+    assert every == {"1": 2000, "0.37": 4000, "0.3": 5000}[dt_scale]
 
 
 def test_a_batch_run_streams_its_lines_and_is_stopped_at_its_timeout(tmp_path):
