@@ -10,7 +10,7 @@ from pathlib import Path
 
 import numpy as np
 
-from harness import HERE, check, report, run_deck
+from harness import HERE, check, read_dump_frames, report, run_deck
 
 
 # ---- concentration grid ------------------------------------------------------------------------
@@ -89,19 +89,6 @@ def concentration_every(np_ranks: int):
     report(f"concentration grid every 5: refresh steps equal to every 1; in between the last field at the new "
            f"heights, differing from a fresh field by up to {stale:.2e}")
     assert stale > 0.0    # the spheres move: a field refreshed every step would differ
-
-
-def read_dump_frames(path: Path) -> dict[int, np.ndarray]:
-    """The frames of a LAMMPS text dump (columns after the header) by step."""
-    lines = path.read_text().splitlines()
-    frames, k = {}, 0
-    while k < len(lines):
-        step = int(lines[k + 1])
-        count = int(lines[k + 3])
-        start = k + 9
-        frames[step] = np.array([[float(v) for v in line.split()] for line in lines[start:start + count]])
-        k = start + count
-    return frames
 
 
 def read_profile_blocks(path: Path) -> dict[int, tuple[np.ndarray, np.ndarray]]:

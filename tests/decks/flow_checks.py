@@ -11,7 +11,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from harness import HERE, G, check, report, run_deck
+from harness import HERE, G, check, read_dump_frames, report, run_deck
 
 try:    # (the harness puts python/ on the path)
     from sediment import _core
@@ -352,16 +352,6 @@ print "RESULT left_out $(f_flow[6]) peak $(f_flow[5])"
     assert 0 < out.results["peak"] < 0.01
 
 
-def dump_frames(path: Path, columns: int) -> dict[int, np.ndarray]:
-    """The frames of a `dump custom` file: per step, its atoms' rows (`columns` values each)."""
-    lines, frames, k = path.read_text().splitlines(), {}, 0
-    while k < len(lines):
-        step, count = int(lines[k + 1]), int(lines[k + 3])
-        frames[step] = np.array([[float(v) for v in line.split()] for line in lines[k + 9:k + 9 + count]]).reshape(-1, columns)
-        k += 9 + count
-    return frames
-
-
 @check
 def flow_step_limit(np_ranks: int):
     """Keyword cfl 0.5: 300 quartz grains of 100 um fall 2-4 mm onto the floor of a closed column (8 x 8 x
@@ -398,7 +388,7 @@ run 5 pre no
         path = Path(tmp) / "limit.lmp"
         path.write_text(deck)
         out = run_deck(path, {}, np_ranks, cwd=Path(tmp))
-        frames = dump_frames(Path(tmp) / "u.txt", 4)
+        frames = read_dump_frames(Path(tmp) / "u.txt")
         # resumed from step 30's restart file (a step the fix kept as the flow slowed), the input's step
         # given again as a resumed deck's stage does: the steps as before
         path.write_text("read_restart limit.30.restart\ncomm_modify cutoff 1e-4\n" + fixes + "timestep 0.05\nrun 30\n")

@@ -2,7 +2,8 @@
 """Runs LAMMPS decks through lmp_sediment and reads what they print.
 
 Decks print "SAMPLE v1 v2 ..." rows and "RESULT key value key value ..." lines; checks compare
-them with analytic references from the physics core (sediment._core).
+them with analytic references from the physics core (sediment._core); `read_dump_frames` reads a
+text dump's frames by step.
 
 With SEDIMENT_PLUGIN naming a sedimentplugin.so, each deck runs on the lmp of SEDIMENT_LMP with that
 plugin loaded first, as a user of the plugin route writes it: a wrapper deck holds `plugin load
@@ -16,6 +17,8 @@ import os
 import sys
 import tempfile
 from pathlib import Path
+
+import numpy as np
 
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE.parents[1] / "python"))
@@ -69,6 +72,19 @@ G = 9.81    # the decks' gravity [m/s2]
 # name -> (function of the rank count, rank counts ctest runs it with: () once without --np; None:
 # not in the standard list, registered by tests/decks/CMakeLists.txt for a LAMMPS with PLUGIN only)
 CHECKS: dict = {}
+
+
+def read_dump_frames(path: Path) -> dict[int, np.ndarray]:
+    """The frames of a LAMMPS text dump (columns after the header) by step."""
+    lines = path.read_text().splitlines()
+    frames, k = {}, 0
+    while k < len(lines):
+        step = int(lines[k + 1])
+        count = int(lines[k + 3])
+        start = k + 9
+        frames[step] = np.array([[float(v) for v in line.split()] for line in lines[start:start + count]])
+        k = start + count
+    return frames
 
 
 def check(fn=None, *, ranks=(1, 2)):

@@ -530,19 +530,7 @@ def test_a_start_that_hangs_silently_is_tried_again_once(tmp_path, monkeypatch, 
         with pytest.raises(RuntimeError, match="printed nothing in 1 s after each of 2 starts"):
             run_batch(deck)
     assert time.monotonic() - began < 60    # the hung starts were stopped, not waited on
-    assert not _working_in(tmp_path)    # (another test's `sleep 600` may run beside this one)
-
-
-def _working_in(folder: Path) -> list[int]:
-    """PIDs of the processes whose working folder is `folder`."""
-    found = []
-    for entry in filter(str.isdigit, os.listdir("/proc")):
-        try:
-            if Path(f"/proc/{entry}/cwd").resolve() == folder.resolve():
-                found.append(int(entry))
-        except OSError:
-            pass
-    return found
+    assert not processes_in(tmp_path)    # (another test's `sleep 600` may run beside this one)
 
 
 def test_the_wait_for_the_runs_takes_a_signal_another_thread_received():
