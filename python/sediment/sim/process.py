@@ -10,10 +10,11 @@ import signal
 import subprocess
 import threading
 import time
-from collections.abc import Iterable, Iterator
+from collections.abc import Callable, Iterable, Iterator
 from concurrent.futures import FIRST_COMPLETED, Future, wait
 from contextlib import contextmanager
 from pathlib import Path
+from typing import TypeVar
 
 from .paths import lmp_executable, mpirun_prefix
 
@@ -120,6 +121,7 @@ def stop_process(proc: subprocess.Popen, grace: float = 10.0) -> None:
 
 START_WAIT = 120.0    # s: LAMMPS prints its banner within a second of its start, even on a loaded machine
 START_TRIES = 2
+T = TypeVar("T")
 
 
 class StartWatch:
@@ -149,10 +151,16 @@ class StartWatch:
         self._timer.cancel()
 
 
-def start_hung(cmd: list[str], tries: int) -> RuntimeError:
-    """The error of a run whose every start printed nothing (`StartWatch`)."""
-    return RuntimeError(f"LAMMPS printed nothing in {START_WAIT:g} s after each of {tries} starts ({' '.join(cmd)}): "
-                        "MPI_Init did not return (an Open MPI start that hung); nothing was run or written")
+def once_started(attempt: Callable[[], T | None], cmd: list[str]) -> T:
+    """What `attempt()`, a start of the run `cmd`, returns once it starts: it returns None where the run
+    printed nothing and was stopped (`StartWatch`), and is tried START_TRIES times at most."""
+    for _ in range(START_TRIES):
+        result = attempt()
+        if result is not None:
+            return result
+    raise RuntimeError(f"LAMMPS printed nothing in {START_WAIT:g} s after each of {START_TRIES} starts "
+                       f"({' '.join(cmd)}): MPI_Init did not return (an Open MPI start that hung); nothing was run or "
+                       "written")
 
 
 class RunInterrupted(RuntimeError):

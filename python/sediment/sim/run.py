@@ -26,7 +26,7 @@ from ..folders import folder_lock
 from ..progress import bar as progress_bar
 from ..results import write_atomic
 from .printed import parse_printed
-from .process import (START_TRIES, RunInterrupted, Runs, StartWatch, launch_command, release, signals_stop, start_hung,
+from .process import (RunInterrupted, Runs, StartWatch, launch_command, once_started, release, signals_stop,
                       start_process, stop_process)
 from .provenance import (COMPARED, RECORD, already_finished, check_partial, check_written, file_digest, finished,
                          input_files, layer_file_of, read_record, restart_damage, resume_id, run_id, stamp,
@@ -263,7 +263,8 @@ def _run(deck: Path, ranks: int, variables: dict[str, str], progress: bool) -> R
     proc = None
     try:
         with signals_stop() as launch:
-            for _ in range(START_TRIES):
+            def attempt() -> int | None:
+                nonlocal proc
                 proc = launch.start(cmd, env, folder, stdout=subprocess.PIPE, stderr=subprocess.STDOUT)
                 watch = StartWatch(proc)
                 assert proc.stdout is not None
@@ -272,11 +273,12 @@ def _run(deck: Path, ranks: int, variables: dict[str, str], progress: bool) -> R
                     take(line)
                 code = proc.wait()
                 watch.cancel()
-                if not watch.stalled:
-                    break
-                release(proc)
-            else:
-                raise start_hung(cmd, START_TRIES)
+                if watch.stalled:
+                    release(proc)
+                    return None
+                return code
+
+            code = once_started(attempt, cmd)
     except RunInterrupted as exc:
         layers = layer_file_of(deck, variables)
         if layers is not None and finished(layers, variables.get("sediment_run_id", "")):
@@ -377,15 +379,13 @@ def run_batch(deck: Path, variables: dict[str, object] | None = None, ranks: int
         raise FileNotFoundError(f"{deck}: no such deck")
     cmd, env = launch_command(str(deck), "none", ranks, variables)
     start = time.monotonic()
-    for _ in range(START_TRIES):
+
+    def attempt() -> tuple[str, str, int] | None:
         if getattr(running, "stopped", False):
             raise RunInterrupted("the runs were stopped before this one began")
-        printed = _collect(cmd, env, cwd or deck.parent, timeout, running, on_line)
-        if printed is not None:
-            break
-    else:
-        raise start_hung(cmd, START_TRIES)
-    stdout, stderr, returncode = printed
+        return _collect(cmd, env, cwd or deck.parent, timeout, running, on_line)
+
+    stdout, stderr, returncode = once_started(attempt, cmd)
     wall = time.monotonic() - start
     parsed = parse_printed(stdout)
     out = DeckOutput(stdout + stderr, returncode, wall, parsed.samples, parsed.results)
