@@ -46,19 +46,38 @@ constexpr int SCHEMA_VERSION = 1;
 constexpr const char *FRAME_SETS[4] = {"time", "step", "fraction", "fluid"};
 constexpr int FLUID_SET = 3;
 
+// The attribute that counts the frames written whole: set after their datasets are flushed, so that
+// a run killed while it wrote (or a full disk) leaves the frames past it, which may be torn (HDF5's
+// fill value, a chunk half written), outside the file's frames. Files of earlier versions have none:
+// all their frames count.
+constexpr const char *WRITTEN = "frames";
+
+long long frames_written(hid_t handle)
+{
+  if (H5Aexists(handle, WRITTEN) > 0) return static_cast<long long>(read_double_attribute(handle, WRITTEN));
+  Handle set(H5Dopen2(handle, "step", H5P_DEFAULT), H5Dclose, "dataset step");
+  Handle space(H5Dget_space(set), H5Sclose, "dataspace");
+  hsize_t count = 0;
+  H5Sget_simple_extent_dims(space, &count, nullptr);
+  return static_cast<long long>(count);
+}
+
 long long frames_before(hid_t handle, LAMMPS_NS::bigint step)
 {
   const std::vector<long long> steps = read_frames<long long>(handle, "step", H5T_NATIVE_LLONG);
+  const long long written = std::min(frames_written(handle), static_cast<long long>(steps.size()));
   long long kept = 0;
-  while (kept < static_cast<long long>(steps.size()) && steps[kept] < step) ++kept;
+  while (kept < written && steps[kept] < step) ++kept;
   return kept;
 }
 
-// The frame datasets read back whole, each chunk's checksum checked, one frame at a time (a large file is
-// not held in memory), with their shapes; `equal`: the three hold as many frames (a finished file: a run
-// killed between them may leave them uneven). Throws saying what does not read back.
+// The frames written (frames_written) read back whole, each chunk's checksum checked, one frame at a
+// time (a large file is not held in memory), with their datasets' shapes; `equal`: every dataset holds
+// exactly those frames (a finished file: a run killed while it wrote leaves them longer). Throws saying
+// what does not read back.
 void read_back(hid_t handle, bool equal)
 {
+  const hsize_t written = static_cast<hsize_t>(frames_written(handle));
   hsize_t centres = 0, counts[4] = {0, 0, 0, 0};
   {
     Handle set(H5Dopen2(handle, "layer_centre", H5P_DEFAULT), H5Dclose, "dataset layer_centre");
@@ -83,11 +102,13 @@ void read_back(hid_t handle, bool equal)
     if (k == FLUID_SET && dims[1] != 2)
       throw std::runtime_error(fmt::format("dataset fluid has {} values per frame, not 2", dims[1]));
     counts[k] = dims[0];
-    const hsize_t block[3] = {k == 2 ? 1 : dims[0], dims[1], dims[2]};
-    if (dims[0] == 0) continue;
+    if (dims[0] < written)
+      throw std::runtime_error(fmt::format("dataset {} holds {} frames of the {} written", name, dims[0], written));
+    const hsize_t block[3] = {k == 2 ? 1 : written, dims[1], dims[2]};
+    if (written == 0) continue;
     Handle memory(H5Screate_simple(rank, block, nullptr), H5Sclose, "dataspace");
     std::vector<double> values(block[0] * block[1] * block[2]);
-    for (hsize_t first = 0; first < dims[0]; first += block[0]) {
+    for (hsize_t first = 0; first < written; first += block[0]) {
       const hsize_t start[3] = {first, 0, 0};
       check(H5Sselect_hyperslab(space, H5S_SELECT_SET, start, nullptr, block, nullptr), "selection");
       if (H5Dread(set, H5T_NATIVE_DOUBLE, memory, space, H5P_DEFAULT, values.data()) < 0)
@@ -96,10 +117,10 @@ void read_back(hid_t handle, bool equal)
                                         : fmt::format("dataset {} does not read back (damaged: its checksum fails)", name));
     }
   }
-  if (equal && (counts[0] != counts[1] || counts[1] != counts[2] || (sets == 4 && counts[3] != counts[0])))
-    throw std::runtime_error(fmt::format("the frame datasets hold {} times, {} steps and {} fractions{}", counts[0],
-                                         counts[1], counts[2],
-                                         sets == 4 ? fmt::format(" and {} fluids", counts[3]) : std::string()));
+  if (equal && (counts[0] != written || counts[1] != written || counts[2] != written || (sets == 4 && counts[3] != written)))
+    throw std::runtime_error(fmt::format("the frame datasets hold {} times, {} steps and {} fractions{} of the {} "
+                                         "frames written", counts[0], counts[1], counts[2],
+                                         sets == 4 ? fmt::format(" and {} fluids", counts[3]) : std::string(), written));
 }
 
 
@@ -289,6 +310,7 @@ void FixLayersHDF5::open_file()
       open_frame_sets();
       for (int k = 0; k < 4; ++k)
         if (frame_sets[k] >= 0) put_frames(frame_sets[k], FRAME_SETS[k], H5T_NATIVE_DOUBLE, frames, 0, nullptr);
+      set_attribute(file, WRITTEN, static_cast<double>(frames));
       set_attribute(file, "complete", 0.0);
       check(H5Fflush(file, H5F_SCOPE_GLOBAL), "flush");
       return;
@@ -303,6 +325,7 @@ void FixLayersHDF5::open_file()
     write_attribute(file, "schema", SCHEMA);
     write_attribute(file, "schema_version", SCHEMA_VERSION);
     write_attribute(file, "complete", 0.0);
+    write_attribute(file, WRITTEN, 0.0);
     write_attribute(file, "units", update->unit_style);
     write_attribute(file, "axis", std::string(1, "xyz"[grid->layer_axis()]));
     write_attribute(file, "dimension", domain->dimension);
@@ -354,8 +377,9 @@ void FixLayersHDF5::take_frame(bool write_now)
   });
 }
 
-// Rank 0: the frames waiting, into the file, and the file flushed. Writes the frames' chunks and the
-// file's metadata: a killed run keeps every frame written so far, and a full disk shows here.
+// Rank 0: the frames waiting, into the file, and the file flushed; then the count of frames written,
+// flushed (the frames are the file's once both flushes are done). A killed run keeps every frame
+// written so far, and a full disk shows here.
 void FixLayersHDF5::write_pending()
 {
   last_write = MPI_Wtime();
@@ -366,6 +390,8 @@ void FixLayersHDF5::write_pending()
   put_frames(frame_sets[2], FRAME_SETS[2], H5T_NATIVE_DOUBLE, frames, count, pending_values.data());
   if (frame_sets[FLUID_SET] >= 0)
     put_frames(frame_sets[FLUID_SET], FRAME_SETS[FLUID_SET], H5T_NATIVE_DOUBLE, frames, count, pending_fluid.data());
+  check(H5Fflush(file, H5F_SCOPE_GLOBAL), "writing the frames (disk full?)");
+  set_attribute(file, WRITTEN, static_cast<double>(frames));
   check(H5Fflush(file, H5F_SCOPE_GLOBAL), "writing the frames (disk full?)");
   pending_fluid.clear();
   pending_time.clear();

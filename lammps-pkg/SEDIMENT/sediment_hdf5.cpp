@@ -33,8 +33,11 @@ double read_double_attribute(hid_t where, const char *name)
 
 void set_attribute(hid_t where, const char *name, double value)
 {
-  if (H5Aexists(where, name) > 0) check(H5Adelete(where, name), std::string("attribute ") + name);
-  write_attribute(where, name, value);
+  // written in place: a file flushed (or a process killed) between a delete and a create would hold
+  // no such attribute
+  if (H5Aexists(where, name) <= 0) return write_attribute(where, name, value);
+  Handle attr(H5Aopen(where, name, H5P_DEFAULT), H5Aclose, std::string("attribute ") + name);
+  check(H5Awrite(attr, H5T_NATIVE_DOUBLE, &value), std::string("attribute ") + name);
 }
 
 void write_attribute(hid_t where, const char *name, const std::string &value)

@@ -49,7 +49,7 @@ void check(herr_t status, const std::string &what);
 
 void write_attribute(hid_t where, const char *name, double value);
 void write_attribute(hid_t where, const char *name, const std::string &value);
-// Sets (or replaces) a scalar double attribute.
+// Sets (or overwrites in place) a scalar double attribute.
 void set_attribute(hid_t where, const char *name, double value);
 double read_double_attribute(hid_t where, const char *name);
 // "" if there is none or it is not a string.

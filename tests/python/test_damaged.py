@@ -75,6 +75,31 @@ def test_a_damaged_partial_is_refused_on_resume_naming_it(tmp_path):
     assert read_layers(folder / "layers.h5").complete
 
 
+def test_a_frame_torn_by_the_kill_is_dropped_on_resume(tmp_path):
+    # Clone 60: the kill came while fix layers/hdf5 flushed a frame, which the partial then held with
+    # HDF5's fill value in its time (the flush writes the datasets' chunks in no set order), and --resume
+    # refused the partial. Frames past those the fix counted as written are not the file's: the run
+    # resumes, and completes its frames.
+    deck = sample(tmp_path / "x", *SHORT)
+    folder = deck.parent
+    interrupted(folder)
+    partial = folder / "layers.h5.partial"
+    with h5py.File(partial, "r+", locking=False) as f:
+        written = int(f.attrs["frames"])
+        assert all(len(f[name]) == written for name in ("time", "step", "fraction"))
+        for name in ("time", "step", "fraction", "fluid"):
+            if name in f:
+                f[name].resize(written + 1, axis=0)    # the frame's space, and nothing written in it
+        f["fraction"][written] = 0.01                  # but its fractions and its fluid
+        f["fluid"][written] = f["fluid"][written - 1]
+    flip(partial, chunk_offset(partial, written) + 40)    # half written: its checksum fails
+    assert len(read_layers(partial).time) == written
+    done = sediment("run", deck, "--quiet", "--resume")
+    assert done.returncode == 0, done.stderr
+    layers = read_layers(folder / "layers.h5")
+    assert layers.complete and np.all(np.diff(layers.time) > 0) and layers.time[-1] >= 86400 * (1 - 1e-9)
+
+
 def test_frames_that_do_not_read_back_are_never_marked_complete(tmp_path):
     # A frame damaged between two runs of one deck, behind the fix's back: the file stays .partial.
     deck = (REPO / "lammps-pkg" / "examples" / "in.settling").read_text()

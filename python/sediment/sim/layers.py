@@ -102,17 +102,15 @@ def read_layers(path: str | Path) -> LayerFile:
             raise LayerFileError(f"{path}: layer schema version {version}; this reader understands "
                                  f"version {SCHEMA_VERSION}")
         try:
-            # A run killed between the datasets of a frame leaves them of different lengths:
-            # the frames present in all three are the complete ones.
+            # The file's frames are those its writer counted as written whole (attribute `frames`, set
+            # once they are flushed): a run killed or a disk filled while it wrote leaves the datasets
+            # longer, their last frames torn (HDF5's fill value, a chunk half written). Files of earlier
+            # versions have no count: the frames present in every dataset.
             frames = min(len(f[name]) for name in ("time", "step", "fraction", "fluid") if name in f)
+            if "frames" in f.attrs:
+                frames = min(frames, int(f.attrs["frames"]))
             fluid = np.asarray(f["fluid"][:frames], float) if "fluid" in f else None
             complete = f.attrs.get("complete", 0) == 1
-            if fluid is not None and fluid.shape == (frames, 2) and not complete:
-                # the fluid is written last of a frame's datasets: a frame whose write a full disk or a
-                # kill cut short holds HDF5's fill value (0) there, and is not one of the frames
-                whole = np.isfinite(fluid).all(axis=1) & (fluid > 0).all(axis=1)
-                frames = int(np.argmin(whole)) if not whole.all() else frames
-                fluid = fluid[:frames]
             if frames == 0:
                 raise LayerFileError(f"{path}: no frames (the run wrote none before it stopped)")
             columns = _text(f.attrs["columns"]).split(",")
