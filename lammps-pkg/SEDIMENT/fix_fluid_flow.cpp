@@ -393,23 +393,27 @@ int FixFluidFlow::settling_class(int i) const
 void FixFluidFlow::end_of_step()
 {
   if (stratify) displace();
-  if (stale()) solve();
+  if (drift_limit <= 0.0) {
+    solve();
+  } else {
+    const double speed = largest_speed(atom->v);
+    drift += speed * update->dt / spacing[0];
+    if (stale(speed)) {
+      solved_speed = speed;
+      solve();
+    }
+  }
   if (cfl > 0.0) limit_step();    // from the flow the next step takes
 }
 
-// Whether the flow is due a solve: at every call with every N; with drift, the flow follows the spheres'
-// positions and their forces: it is stale once they may have moved drift cells, or once their speeds
-// (their drag) have changed by that fraction, as when they start from rest or reach a floor, or while
-// the last solve changed their fluid velocities (and so their drags) by more than that fraction
-// (unsettled).
-bool FixFluidFlow::stale()
+// With drift, whether the flow is due a solve, the spheres' largest speed now `speed`: the flow
+// follows their positions and their forces, so it is stale once they may have moved drift cells, or
+// once their speeds (their drag) have changed by that fraction, as when they start from rest or reach
+// a floor, or while the last solve changed their fluid velocities (and so their drags) by more than
+// that fraction (unsettled).
+bool FixFluidFlow::stale(double speed) const
 {
-  if (drift_limit <= 0.0) return true;
-  const double speed = largest_speed(atom->v);
-  drift += speed * update->dt / spacing[0];
-  if (!unsettled && drift < drift_limit && std::abs(speed - solved_speed) <= drift_limit * solved_speed) return false;
-  solved_speed = speed;
-  return true;
+  return unsettled || !(drift < drift_limit && std::abs(speed - solved_speed) <= drift_limit * solved_speed);
 }
 
 // cfl: the lagged flow follows a density that it carries less than a cell between solves. Where it
@@ -426,8 +430,12 @@ void FixFluidFlow::limit_step()
   // longest again (a resumed deck's stage) continues at the step this fix had set, as the run that was
   // not stopped did.
   if (update->dt != applied_dt) {
-    if (applied_dt > 0.0 && update->dt == longest_dt) set_step(applied_dt);
-    else longest_dt = update->dt;
+    if (applied_dt > 0.0 && update->dt == longest_dt) {
+      set_step(applied_dt);
+    } else {
+      longest_dt = update->dt;
+      told_shortened = false;    // a new stage's first shortening is news (a run with pre no has no setup)
+    }
   }
   const double speed = largest_speed(velocity);
   const double between = drift_limit > 0.0 ? 1.0 : static_cast<double>(nevery);
@@ -438,7 +446,7 @@ void FixFluidFlow::limit_step()
   if (wanted < longest_dt && !told_shortened && comm->me == 0) {
     told_shortened = true;
     utils::logmesg(lmp, "fix {} fluid/flow: step {} shortened from {:.4g} to {:.4g} (the flow at a sphere up to {:.4g}, "
-                   "cfl {:.3g} cells of {:.4g}) (reported once a run; thermo keyword dt follows it)\n", id,
+                   "cfl {:.3g} cells of {:.4g}) (reported once a run and a timestep given; thermo keyword dt follows it)\n", id,
                    update->ntimestep, longest_dt, wanted, speed, cfl, spacing[0]);
   }
   set_step(wanted);

@@ -176,7 +176,7 @@ class FixFluidFlow : public Fix {
   bool fluid_changed() const;
   void report_settings() const;
   double largest_speed(double *const *v) const;
-  bool stale();
+  bool stale(double speed) const;
   void limit_step();
   void set_step(double dt);
   void check_stable(const double *change);

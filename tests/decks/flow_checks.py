@@ -395,8 +395,11 @@ run 5 pre no
         resumed = step_rows(run_deck(path, {}, np_ranks, cwd=Path(tmp)).text)
         # solved every 2 steps: the flow that moved the spheres, not the one just solved, is what the
         # run-away check measures, and the steps shorten from the first solve
-        path.write_text(deck.replace("cfl 0.5", "every 2 cfl 0.5").split("restart 30")[0] + "timestep 0.05\nrun 30\n")
-        every = step_rows(run_deck(path, {}, np_ranks, cwd=Path(tmp)).text)
+        # (and a new longest step given to a run with pre no: its first shortening is reported too)
+        path.write_text(deck.replace("cfl 0.5", "every 2 cfl 0.5").split("restart 30")[0]
+                        + "timestep 0.05\nrun 30\ntimestep 0.006\nrun 2 pre no\n")
+        every_text = run_deck(path, {}, np_ranks, cwd=Path(tmp)).text
+        every = step_rows(every_text)
     rows = step_rows(out.text)
     cell = 1e-3 / 8
     fastest = {step: float(np.linalg.norm(frame[:, 1:], axis=1).max()) for step, frame in frames.items()}
@@ -416,7 +419,8 @@ run 5 pre no
     steps = np.array([0.05] + [rows[n][0] for n in range(60)])
     assert np.allclose(np.diff(times), steps[1:], rtol=1e-12, atol=0)
     assert rows[65][0] == 0.02 and rows[70][0] == 0.03    # a timestep command gives the longest, pre no too
-    assert every[2][0] < 0.006 and max(every[n][0] for n in range(2, 31)) < 0.05 and len(every) == 31
+    assert every[2][0] < 0.006 and max(every[n][0] for n in range(2, 31)) < 0.05 and len(every) == 33
+    assert "step 32 shortened from 0.006 to" in every_text    # (every 2: the fix acts at even steps)
     # (the time is not compared: LAMMPS 2021's restart files do not keep it; fix layers/hdf5 does)
     assert all(resumed[n][0] == pytest.approx(rows[n][0], rel=1e-12) and resumed[n][2] == rows[n][2]
                for n in range(30, 61))
