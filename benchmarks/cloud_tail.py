@@ -23,23 +23,14 @@ import numpy as np
 
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE.parent / "python"))
+sys.path.insert(0, str(HERE.parent / "tests" / "decks"))
+from harness import read_dump_frames  # noqa: E402
 from sediment.sim.run import run_batch  # noqa: E402
 
 CLOUD = HERE.parent / "examples" / "falling_cloud" / "in.falling_cloud"
 R, BOX_R, TALL = 6e-3, 8, 6
 LOST = 1.5    # R: further than this from the cloud's centre, a sphere has left it
 UNIFORM_CORE = 1.0 - (1.0 - 0.35 ** 2) ** 1.5
-
-
-def dump_frames(path: Path):
-    """(step, positions sorted by id) per frame of a `dump custom id x y z`."""
-    lines = path.read_text().splitlines()
-    k = 0
-    while k < len(lines):
-        step, count = int(lines[k + 1]), int(lines[k + 3])
-        rows = np.array([[float(v) for v in line.split()] for line in lines[k + 9:k + 9 + count]])
-        yield step, rows[np.argsort(rows[:, 0]), 1:]
-        k += 9 + count
 
 
 def offsets(x: np.ndarray, centre: np.ndarray, period: np.ndarray) -> np.ndarray:
@@ -50,7 +41,8 @@ def offsets(x: np.ndarray, centre: np.ndarray, period: np.ndarray) -> np.ndarray
 def measure(path: Path, every: int) -> list[tuple]:
     period = np.array([BOX_R * R, BOX_R * R, TALL * BOX_R * R])
     rows, centre, fallen = [], None, 0.0
-    for step, x in dump_frames(path):
+    for step, frame in sorted(read_dump_frames(path).items()):
+        x = frame[np.argsort(frame[:, 0]), 1:]    # positions by id
         guess = np.array([period[0] / 2, period[1] / 2, period[2] - BOX_R * R / 2]) if centre is None else centre
         for _ in range(30):    # the centre of the spheres within LOST R of it
             d = offsets(x, guess, period)
